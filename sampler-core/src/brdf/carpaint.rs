@@ -1,0 +1,122 @@
+//! A layered car paint: a Lambertian base and a GGX metallic-flake lobe under a very sharp GGX
+//! clear coat with Schlick Fresnel (F0 = 0.04, i.e. η = 1.5). Light that the coat reflects does
+//! not reach the base: the base is weighted by (1 − F(cosθo))(1 − F(cosθi)).
+//! This is the paper's hard case: a wide lobe and a needle-sharp one in one BRDF.
+
+use super::microfacet::{Ggx, fresnel_schlick, half_vector};
+use super::{Brdf, BrdfSample, pick_lobe};
+use crate::env::luminance;
+use crate::sampling::{reflect, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use core::f32::consts::FRAC_1_PI;
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CarPaint {
+    pub base: Vec3,
+    pub flake: Vec3,
+    pub flake_ggx: Ggx,
+    pub coat: f32,
+    pub coat_ggx: Ggx,
+    pub coat_f0: f32,
+}
+
+impl Default for CarPaint {
+    /// A deep blue metallic paint: base (0.01, 0.03, 0.15), flakes (0.1, 0.2, 0.5) at α = 0.25,
+    /// coat weight 1 at α = 0.005.
+    fn default() -> Self {
+        Self::new(
+            Vec3::new(0.01, 0.03, 0.15),
+            Vec3::new(0.1, 0.2, 0.5),
+            0.25,
+            1.0,
+            0.005,
+        )
+    }
+}
+
+impl CarPaint {
+    #[must_use]
+    pub fn new(base: Vec3, flake: Vec3, flake_alpha: f32, coat: f32, coat_alpha: f32) -> Self {
+        Self {
+            base,
+            flake,
+            flake_ggx: Ggx::new(flake_alpha),
+            coat,
+            coat_ggx: Ggx::new(coat_alpha),
+            coat_f0: 0.04,
+        }
+    }
+
+    /// Sampling weights of (coat, flake, base). The coat gets a share well above its energy
+    /// (at least 1/4 of the samples when present): it is needle-sharp, so under a bright light
+    /// it dominates a tiny cone that the other lobes would never find.
+    fn lobe_weights(&self, wo: Vec3) -> [f32; 3] {
+        let transmit = 1.0 - fresnel_schlick(self.coat_f0, wo.z);
+        let flake = transmit * luminance(self.flake);
+        let base = transmit * luminance(self.base);
+        let coat = if self.coat > 0.0 {
+            (self.coat * fresnel_schlick(self.coat_f0, wo.z)).max((flake + base) / 3.0)
+        } else {
+            0.0
+        };
+        [coat, flake, base]
+    }
+}
+
+impl Brdf for CarPaint {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let Some(h) = half_vector(wo, wi) else {
+            return Vec3::ZERO;
+        };
+        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
+        let coat =
+            self.coat * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi) * c.g1(wo)
+                / (4.0 * wo.z);
+        let flake = f.d(h) * f.g1(wi) * f.g1(wo) / (4.0 * wo.z);
+        let transmit = (1.0 - fresnel_schlick(self.coat_f0, wo.z))
+            * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
+        Vec3::splat(coat) + transmit * (self.flake * flake + self.base * (FRAC_1_PI * wi.z))
+    }
+
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let mut ux = u.x;
+        let lobe = pick_lobe(self.lobe_weights(wo), &mut ux)?;
+        let u = Vec2::new(ux, u.y);
+        let wi = match lobe {
+            0 => reflect(wo, self.coat_ggx.sample_visible(wo, u)).normalize(),
+            1 => reflect(wo, self.flake_ggx.sample_visible(wo, u)).normalize(),
+            _ => square_to_cosine_hemisphere(u),
+        };
+        let pdf = self.pdf(wo, wi);
+        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
+            wi,
+            value: self.eval(wo, wi),
+            pdf,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        let w = self.lobe_weights(wo);
+        let total = w[0] + w[1] + w[2];
+        if total.is_nan() || total <= 0.0 {
+            return 0.0;
+        }
+        let (coat, flake) = match half_vector(wo, wi) {
+            Some(h) => (
+                self.coat_ggx.pdf_reflected(wo, h),
+                self.flake_ggx.pdf_reflected(wo, h),
+            ),
+            None => (0.0, 0.0),
+        };
+        (w[0] * coat + w[1] * flake + w[2] * square_to_cosine_hemisphere_pdf(wi)) / total
+    }
+}

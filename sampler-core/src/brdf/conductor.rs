@@ -1,0 +1,58 @@
+//! GGX rough conductor with Fresnel 1, as Mitsuba 3's `roughconductor` with the separable
+//! Smith shadowing: f = specular · D(h)·G1(ωi)·G1(ωo) / (4 cosθi cosθo).
+
+use super::microfacet::{Ggx, half_vector};
+use super::{Brdf, BrdfSample};
+use crate::sampling::reflect;
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughConductor {
+    pub ggx: Ggx,
+    pub specular: Vec3,
+}
+
+impl RoughConductor {
+    /// α is the GGX roughness (not squared), clamped to ≥ 1e-4.
+    #[must_use]
+    pub fn new(alpha: f32, specular: Vec3) -> Self {
+        Self {
+            ggx: Ggx::new(alpha),
+            specular,
+        }
+    }
+}
+
+impl Brdf for RoughConductor {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let Some(h) = half_vector(wo, wi) else {
+            return Vec3::ZERO;
+        };
+        let g = &self.ggx;
+        self.specular * (g.d(h) * g.g1(wi) * g.g1(wo) / (4.0 * wo.z))
+    }
+
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let m = self.ggx.sample_visible(wo, u);
+        let wi = reflect(wo, m).normalize();
+        let pdf = self.pdf(wo, wi);
+        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
+            wi,
+            value: self.eval(wo, wi),
+            pdf,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match half_vector(wo, wi) {
+            Some(h) => self.ggx.pdf_reflected(wo, h),
+            None => 0.0,
+        }
+    }
+}

@@ -1,0 +1,53 @@
+//! Lambertian diffuse reflection.
+
+use super::{Brdf, BrdfSample};
+use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use core::f32::consts::FRAC_1_PI;
+use glam::{Vec2, Vec3};
+
+/// f = albedo / π, sampled ∝ cosθ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambert {
+    pub albedo: Vec3,
+}
+
+impl Lambert {
+    #[must_use]
+    pub fn new(albedo: Vec3) -> Self {
+        Self { albedo }
+    }
+}
+
+impl Brdf for Lambert {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        self.albedo * (FRAC_1_PI * wi.z)
+    }
+
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = square_to_cosine_hemisphere(u);
+        let pdf = square_to_cosine_hemisphere_pdf(wi);
+        (pdf > 0.0).then(|| BrdfSample {
+            wi,
+            value: self.eval(wo, wi),
+            pdf,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 {
+            0.0
+        } else {
+            square_to_cosine_hemisphere_pdf(wi)
+        }
+    }
+
+    fn is_diffuse(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,86 @@
+//! The BRDF interface any engine can implement, and the built-in materials.
+//!
+//! All directions are unit vectors in the local shading frame (normal = +z) pointing away from
+//! the surface. `eval` returns BRDF × cosθ_i (the integrand's material part), so that
+//! `eval / pdf` is the weight of a sample. Surfaces are one-sided: when `wo.z ≤ 0` nothing is
+//! reflected and nothing is sampled.
+
+mod carpaint;
+mod conductor;
+mod lambert;
+pub mod microfacet;
+mod phong;
+
+pub use carpaint::CarPaint;
+pub use conductor::RoughConductor;
+pub use lambert::Lambert;
+pub use phong::Phong;
+
+use glam::{Vec2, Vec3};
+
+/// A direction drawn by a BRDF's own importance sampler.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrdfSample {
+    /// Sampled incident direction (local frame). May lie below the surface, where `value` is 0.
+    pub wi: Vec3,
+    /// BRDF × cosθ_i at `wi` (RGB).
+    pub value: Vec3,
+    /// Density with respect to solid angle; > 0.
+    pub pdf: f32,
+}
+
+/// A reflectance model that can be evaluated, importance-sampled, and whose sampling density
+/// can be evaluated for any direction (needed for MIS and for the product's guard).
+pub trait Brdf {
+    /// BRDF × cosθ_i. Zero when `wo` or `wi` is below the surface.
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
+
+    /// Draws `wi` from the sampling density of [`Brdf::pdf`] using `u ∈ [0,1)²`. `None` when
+    /// nothing can be sampled (e.g. `wo` below the surface).
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample>;
+
+    /// Density of [`Brdf::sample`] at `wi` with respect to solid angle (over the whole sphere).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+
+    /// True when the BRDF is so smooth (e.g. Lambert) that product sampling cannot beat plain
+    /// environment sampling by much; hosts may pick the cheaper sampler.
+    fn is_diffuse(&self) -> bool {
+        false
+    }
+}
+
+impl<B: Brdf + ?Sized> Brdf for &B {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        (**self).eval(wo, wi)
+    }
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
+        (**self).sample(wo, u)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        (**self).pdf(wo, wi)
+    }
+    fn is_diffuse(&self) -> bool {
+        (**self).is_diffuse()
+    }
+}
+
+/// Chooses one of up to three lobes with probability ∝ `weights`, rescaling `u` so that it is
+/// again uniform in [0, 1). Returns `None` when no weight is positive.
+#[inline]
+pub(crate) fn pick_lobe(weights: [f32; 3], u: &mut f32) -> Option<usize> {
+    let total = weights[0] + weights[1] + weights[2];
+    if total.is_nan() || total <= 0.0 || total.is_infinite() {
+        return None;
+    }
+    let last = (0..3).rev().find(|&k| weights[k] > 0.0)?;
+    let mut acc = 0.0;
+    for (k, &w) in weights.iter().enumerate() {
+        let p = w / total;
+        if p > 0.0 && (*u < acc + p || k == last) {
+            *u = ((*u - acc) / p).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+            return Some(k);
+        }
+        acc += p;
+    }
+    None
+}

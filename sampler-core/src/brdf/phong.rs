@@ -1,0 +1,101 @@
+//! Modified Phong (Lafortune & Willems 1994): a diffuse part plus a normalised cos^n lobe about
+//! the mirror direction. Accurate up to exponents of 1e6: 1 − cos α is formed from |r − ω|²
+//! instead of 1 − r·ω, and cos^n as exp(n·log1p(−δ)).
+
+use super::{Brdf, BrdfSample, pick_lobe};
+use crate::env::luminance;
+use crate::sampling::{
+    TWO_PI, basis_around, reflect_z, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf,
+};
+use core::f32::consts::FRAC_1_PI;
+use glam::{Vec2, Vec3};
+
+/// f = kd/π + ks·(n+2)/(2π)·cos^n α, α the angle between ωi and the mirror of ωo.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phong {
+    pub kd: Vec3,
+    pub ks: Vec3,
+    pub exponent: f32,
+}
+
+impl Phong {
+    /// A Phong BRDF; the exponent is clamped to [0, 1e7].
+    #[must_use]
+    pub fn new(kd: Vec3, ks: Vec3, exponent: f32) -> Self {
+        let exponent = if exponent.is_nan() {
+            0.0
+        } else {
+            exponent.clamp(0.0, 1e7)
+        };
+        Self { kd, ks, exponent }
+    }
+
+    /// cos^n α with δ = 1 − cos α given accurately.
+    #[inline]
+    fn lobe(&self, r: Vec3, wi: Vec3) -> f32 {
+        if r.dot(wi) <= 0.0 {
+            return 0.0;
+        }
+        let delta = 0.5 * (r - wi).length_squared();
+        libm::expf(self.exponent * libm::log1pf(-delta.min(1.0)))
+    }
+
+    fn lobe_weights(&self) -> [f32; 3] {
+        [luminance(self.kd), luminance(self.ks), 0.0]
+    }
+}
+
+impl Brdf for Phong {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let spec = (self.exponent + 2.0) / TWO_PI * self.lobe(reflect_z(wo), wi);
+        (self.kd * FRAC_1_PI + self.ks * spec) * wi.z
+    }
+
+    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let mut ux = u.x;
+        let lobe = pick_lobe(self.lobe_weights(), &mut ux)?;
+        let wi = if lobe == 0 {
+            square_to_cosine_hemisphere(Vec2::new(ux, u.y))
+        } else {
+            // 1 − cos α = −expm1(ln(1−u)/(n+1)), exact for huge n.
+            let one_minus_cos = -libm::expm1f(libm::logf(1.0 - ux) / (self.exponent + 1.0));
+            let one_minus_cos = one_minus_cos.clamp(0.0, 2.0);
+            let cos_a = 1.0 - one_minus_cos;
+            let sin_a = libm::sqrtf((one_minus_cos * (2.0 - one_minus_cos)).max(0.0));
+            let phi = TWO_PI * u.y;
+            let r = reflect_z(wo);
+            let (s, t) = basis_around(r);
+            (s * (sin_a * libm::cosf(phi)) + t * (sin_a * libm::sinf(phi)) + r * cos_a).normalize()
+        };
+        let pdf = self.pdf(wo, wi);
+        (pdf > 0.0).then(|| BrdfSample {
+            wi,
+            value: self.eval(wo, wi),
+            pdf,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        let w = self.lobe_weights();
+        let total = w[0] + w[1];
+        if total.is_nan() || total <= 0.0 {
+            return 0.0;
+        }
+        let diffuse = square_to_cosine_hemisphere_pdf(wi);
+        let spec = (self.exponent + 1.0) / TWO_PI * self.lobe(reflect_z(wo), wi);
+        (w[0] * diffuse + w[1] * spec) / total
+    }
+
+    fn is_diffuse(&self) -> bool {
+        luminance(self.ks) == 0.0
+    }
+}

@@ -1,0 +1,452 @@
+//! The environment hierarchy: a borrowed view over a caller-owned mip pyramid of the
+//! equal-area map.
+//!
+//! Level `k` is a `2^k × 2^k` grid of scalar importance (luminance), row-major (`x` along `u`,
+//! `y` along `v`), levels packed from the 1×1 root down to the finest level `K`: level `k`
+//! starts at [`level_offset`]`(k)`, the whole pyramid holds [`pyramid_len`]`(K)` values (4/3 of
+//! the finest level). Because every texel of the equal-area map covers the same solid angle,
+//! each coarser texel is the plain mean of its four children. RGB radiance for shading is kept
+//! at the finest level only. Lookups are nearest-texel, the same piecewise-constant function the
+//! sampling densities are built from, so radiance cancels exactly in the product estimator.
+
+use crate::mapping::{SPHERE_AREA, sphere_to_square, square_to_sphere, texel_of};
+use crate::warp::{child_offset, choose_child, point_in_cell};
+use glam::{DVec2, Mat3, Vec2, Vec3};
+
+/// Finest level supported: 2^14 = 16384² texels.
+pub const MAX_LEVEL: u32 = 14;
+
+/// Index of the first value of level `k` in a packed pyramid.
+#[inline]
+#[must_use]
+pub const fn level_offset(level: u32) -> usize {
+    ((1usize << (2 * level)) - 1) / 3
+}
+
+/// Number of values in a packed pyramid whose finest level is `2^finest × 2^finest`.
+#[inline]
+#[must_use]
+pub const fn pyramid_len(finest: u32) -> usize {
+    level_offset(finest + 1)
+}
+
+/// Rec. 709 luminance: the scalar importance of an RGB radiance.
+#[inline]
+#[must_use]
+pub fn luminance(c: Vec3) -> f32 {
+    0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
+}
+
+/// What can be wrong with the buffers handed to [`EnvHierarchy::new`] or [`fill_pyramid`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvError {
+    /// The finest level is larger than [`MAX_LEVEL`].
+    TooLarge { finest: u32 },
+    /// A buffer does not have the length its finest level implies.
+    WrongLength {
+        buffer: &'static str,
+        expected: usize,
+        found: usize,
+    },
+    /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
+    NotSanitized,
+}
+
+impl core::fmt::Display for EnvError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::TooLarge { finest } => {
+                write!(
+                    f,
+                    "environment level {finest} exceeds the maximum {MAX_LEVEL} (16384²)"
+                )
+            }
+            Self::WrongLength {
+                buffer,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "{buffer} buffer holds {found} values, expected {expected}"
+                )
+            }
+            Self::NotSanitized => write!(f, "environment holds NaN, infinite or negative values"),
+        }
+    }
+}
+
+impl core::error::Error for EnvError {}
+
+/// Replaces NaN, ±Inf and negative components by 0; returns how many texels were changed.
+pub fn sanitize_rgb(texels: &mut [[f32; 3]]) -> usize {
+    let mut bad = 0;
+    for t in texels {
+        let mut changed = false;
+        for c in t.iter_mut() {
+            if !c.is_finite() || *c < 0.0 {
+                *c = 0.0;
+                changed = true;
+            }
+        }
+        bad += usize::from(changed);
+    }
+    bad
+}
+
+/// Writes the luminance of each RGB texel into the finest level of `pyramid` and fills the
+/// coarser levels. The RGB must be sanitized ([`sanitize_rgb`]).
+pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Result<(), EnvError> {
+    check_lengths(finest, rgb.len(), pyramid.len())?;
+    let base = level_offset(finest);
+    for (dst, c) in pyramid[base..].iter_mut().zip(rgb) {
+        *dst = luminance(Vec3::from_array(*c));
+    }
+    fill_pyramid(finest, pyramid)
+}
+
+/// Fills levels `finest − 1 … 0` of a packed pyramid from its finest level (box average,
+/// accumulated in f64 so that radiances up to f32::MAX do not overflow).
+pub fn fill_pyramid(finest: u32, pyramid: &mut [f32]) -> Result<(), EnvError> {
+    if finest > MAX_LEVEL {
+        return Err(EnvError::TooLarge { finest });
+    }
+    if pyramid.len() != pyramid_len(finest) {
+        return Err(EnvError::WrongLength {
+            buffer: "pyramid",
+            expected: pyramid_len(finest),
+            found: pyramid.len(),
+        });
+    }
+    for level in (0..finest).rev() {
+        let (coarse, fine) = pyramid.split_at_mut(level_offset(level + 1));
+        let coarse = &mut coarse[level_offset(level)..];
+        let n = 1usize << level;
+        let nf = 2 * n;
+        for y in 0..n {
+            for x in 0..n {
+                let a = fine[(2 * y) * nf + 2 * x] as f64;
+                let b = fine[(2 * y) * nf + 2 * x + 1] as f64;
+                let c = fine[(2 * y + 1) * nf + 2 * x] as f64;
+                let d = fine[(2 * y + 1) * nf + 2 * x + 1] as f64;
+                coarse[y * n + x] = (0.25 * (a + b + c + d)) as f32;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError> {
+    if finest > MAX_LEVEL {
+        return Err(EnvError::TooLarge { finest });
+    }
+    let texels = 1usize << (2 * finest);
+    if rgb != texels {
+        return Err(EnvError::WrongLength {
+            buffer: "radiance",
+            expected: texels,
+            found: rgb,
+        });
+    }
+    if pyramid != pyramid_len(finest) {
+        return Err(EnvError::WrongLength {
+            buffer: "pyramid",
+            expected: pyramid_len(finest),
+            found: pyramid,
+        });
+    }
+    Ok(())
+}
+
+/// A direction drawn from the environment alone (density ∝ importance).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvSample {
+    /// World-space unit direction towards the environment.
+    pub dir: Vec3,
+    /// Point of the equal-area square it came from.
+    pub uv: Vec2,
+    /// Density with respect to solid angle.
+    pub pdf: f32,
+}
+
+/// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
+#[derive(Clone, Copy, Debug)]
+pub struct EnvHierarchy<'a> {
+    finest: u32,
+    pyramid: &'a [f32],
+    radiance: &'a [[f32; 3]],
+    /// 1 / mean importance, or 0 for a black map.
+    inv_mean: f32,
+    tint: Vec3,
+    world_to_map: Mat3,
+    map_to_world: Mat3,
+}
+
+impl<'a> EnvHierarchy<'a> {
+    /// A view over `pyramid` (filled by [`build_pyramid`]) and the finest-level `radiance`.
+    pub fn new(
+        finest: u32,
+        pyramid: &'a [f32],
+        radiance: &'a [[f32; 3]],
+    ) -> Result<Self, EnvError> {
+        check_lengths(finest, radiance.len(), pyramid.len())?;
+        let mean = pyramid[0];
+        if !mean.is_finite() || mean < 0.0 {
+            return Err(EnvError::NotSanitized);
+        }
+        let inv_mean = if mean > 0.0 { 1.0 / mean } else { 0.0 };
+        let inv_mean = if inv_mean.is_finite() { inv_mean } else { 0.0 };
+        Ok(Self {
+            finest,
+            pyramid,
+            radiance,
+            inv_mean,
+            tint: Vec3::ONE,
+            world_to_map: Mat3::IDENTITY,
+            map_to_world: Mat3::IDENTITY,
+        })
+    }
+
+    /// Orients the map: `map_to_world` takes directions of the map's own frame (the frame
+    /// [`square_to_sphere`] works in) to world space. Must be a rotation.
+    #[must_use]
+    pub fn with_rotation(mut self, map_to_world: Mat3) -> Self {
+        self.map_to_world = map_to_world;
+        self.world_to_map = map_to_world.transpose();
+        self
+    }
+
+    /// Multiplies every radiance lookup (e.g. a light's colour × intensity). Sampling
+    /// densities are unaffected.
+    #[must_use]
+    pub fn with_tint(mut self, tint: Vec3) -> Self {
+        self.tint = tint;
+        self
+    }
+
+    /// Finest level `K` (the map is `2^K × 2^K`).
+    #[inline]
+    #[must_use]
+    pub fn finest_level(&self) -> u32 {
+        self.finest
+    }
+
+    /// Side length of the finest level in texels.
+    #[inline]
+    #[must_use]
+    pub fn resolution(&self) -> u32 {
+        1 << self.finest
+    }
+
+    /// True when the map is black everywhere: nothing to sample, every estimate is 0.
+    #[inline]
+    #[must_use]
+    pub fn is_black(&self) -> bool {
+        self.inv_mean == 0.0
+    }
+
+    /// Mean importance of node `(x, y)` of `level`, relative to the whole map's mean (so the
+    /// map averages to 1 whatever its absolute scale).
+    #[inline]
+    #[must_use]
+    pub fn node_relative(&self, level: u32, x: u32, y: u32) -> f32 {
+        let n = 1usize << level;
+        self.pyramid[level_offset(level) + y as usize * n + x as usize] * self.inv_mean
+    }
+
+    /// The four children of node `(x, y)` of `level` (which must be < K), relative to the mean,
+    /// in [`child_offset`] order.
+    #[inline]
+    #[must_use]
+    pub fn children_relative(&self, level: u32, x: u32, y: u32) -> [f32; 4] {
+        let n = 2usize << level;
+        let base = level_offset(level + 1) + (2 * y as usize) * n + 2 * x as usize;
+        let p = self.pyramid;
+        let s = self.inv_mean;
+        [
+            p[base] * s,
+            p[base + 1] * s,
+            p[base + n] * s,
+            p[base + n + 1] * s,
+        ]
+    }
+
+    /// Mean importance (relative) of the region covered by a quadtree cell at any depth:
+    /// below the finest level a cell lies inside one texel.
+    #[inline]
+    #[must_use]
+    pub fn cell_relative(&self, depth: u32, x: u32, y: u32) -> f32 {
+        if depth <= self.finest {
+            self.node_relative(depth, x, y)
+        } else {
+            let sh = depth - self.finest;
+            self.node_relative(self.finest, x >> sh, y >> sh)
+        }
+    }
+
+    /// World direction → map direction.
+    #[inline]
+    #[must_use]
+    pub fn to_map(&self, world: Vec3) -> Vec3 {
+        self.world_to_map * world
+    }
+
+    /// Map direction → world direction.
+    #[inline]
+    #[must_use]
+    pub fn to_world(&self, map: Vec3) -> Vec3 {
+        self.map_to_world * map
+    }
+
+    /// Point of the equal-area square seen in world direction `dir`.
+    #[inline]
+    #[must_use]
+    pub fn square_of(&self, dir: Vec3) -> Vec2 {
+        sphere_to_square(self.to_map(dir))
+    }
+
+    /// World direction of a point of the square.
+    #[inline]
+    #[must_use]
+    pub fn dir_of(&self, uv: Vec2) -> Vec3 {
+        self.to_world(square_to_sphere(uv))
+    }
+
+    /// Finest-level texel containing a point of the square.
+    #[inline]
+    #[must_use]
+    pub fn texel_at(&self, uv: Vec2) -> (u32, u32) {
+        texel_of(uv, self.resolution())
+    }
+
+    /// RGB radiance of a finest-level texel (tint applied).
+    #[inline]
+    #[must_use]
+    pub fn radiance_texel(&self, x: u32, y: u32) -> Vec3 {
+        let i = y as usize * self.resolution() as usize + x as usize;
+        Vec3::from_array(self.radiance[i]) * self.tint
+    }
+
+    /// RGB radiance arriving from world direction `dir` (nearest texel).
+    #[inline]
+    #[must_use]
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        let (x, y) = self.texel_at(self.square_of(dir));
+        self.radiance_texel(x, y)
+    }
+
+    /// Env-only density per unit area of the square at `uv` (mean 1 over the square).
+    #[inline]
+    #[must_use]
+    pub fn pdf_square(&self, uv: Vec2) -> f32 {
+        let (x, y) = self.texel_at(uv);
+        self.node_relative(self.finest, x, y)
+    }
+
+    /// Env-only density with respect to solid angle of world direction `dir`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        self.pdf_square(self.square_of(dir)) / SPHERE_AREA
+    }
+
+    /// Warps `xi` from node `(x, y)` of `level` down to a finest-level texel, ∝ importance.
+    /// Returns the texel, or `None` if the node has no mass.
+    #[inline]
+    pub fn warp_down(&self, level: u32, x: u32, y: u32, xi: &mut DVec2) -> Option<(u32, u32)> {
+        let (mut x, mut y) = (x, y);
+        for l in level..self.finest {
+            let c = choose_child(self.children_relative(l, x, y), xi)?;
+            let (dx, dy) = child_offset(c);
+            (x, y) = (2 * x + dx, 2 * y + dy);
+        }
+        Some((x, y))
+    }
+
+    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy).
+    #[inline]
+    pub fn sample(&self, u: DVec2) -> Option<EnvSample> {
+        if self.is_black() {
+            return None;
+        }
+        let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
+        let (x, y) = self.warp_down(0, 0, 0, &mut xi)?;
+        let uv = point_in_cell(x, y, self.finest, xi);
+        let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
+        Some(EnvSample {
+            dir: self.dir_of(uv),
+            uv,
+            pdf,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pyramid_layout() {
+        assert_eq!(pyramid_len(0), 1);
+        assert_eq!(pyramid_len(1), 5);
+        assert_eq!(pyramid_len(2), 21);
+        assert_eq!(level_offset(2), 5);
+        let mut p = [0.0f32; 21];
+        let fine = [
+            1.0, 2.0, 0.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0, 8.0, 8.0, 0.0, 0.0, 8.0, 8.0,
+        ];
+        p[5..].copy_from_slice(&fine);
+        fill_pyramid(2, &mut p).unwrap();
+        assert_eq!(&p[1..5], &[2.5, 0.0, 0.0, 8.0]);
+        assert_eq!(p[0], 2.625);
+    }
+
+    #[test]
+    fn huge_radiance_does_not_overflow_the_mean() {
+        let rgb = [[3.0e38f32; 3]; 4];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &rgb, &mut p).unwrap();
+        assert!(p[0].is_finite());
+        let env = EnvHierarchy::new(1, &p, &rgb).unwrap();
+        assert!((env.node_relative(1, 1, 1) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sanitize_counts_bad_texels() {
+        let mut t = [
+            [1.0, f32::NAN, 0.0],
+            [f32::INFINITY, 0.0, 0.0],
+            [-1.0, 2.0, 3.0],
+            [1.0, 2.0, 3.0],
+        ];
+        assert_eq!(sanitize_rgb(&mut t), 3);
+        assert_eq!(t[0], [1.0, 0.0, 0.0]);
+        assert_eq!(t[2], [0.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn black_map_samples_nothing() {
+        let rgb = [[0.0f32; 3]; 4];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &rgb, &mut p).unwrap();
+        let env = EnvHierarchy::new(1, &p, &rgb).unwrap();
+        assert!(env.is_black());
+        assert!(env.sample(DVec2::splat(0.3)).is_none());
+        assert_eq!(env.pdf(Vec3::Z), 0.0);
+    }
+
+    #[test]
+    fn wrong_lengths_are_errors() {
+        let rgb = [[0.0f32; 3]; 4];
+        let p = [0.0f32; 4];
+        assert!(matches!(
+            EnvHierarchy::new(1, &p, &rgb),
+            Err(EnvError::WrongLength { .. })
+        ));
+        let p = [f32::NAN; 5];
+        assert_eq!(
+            EnvHierarchy::new(1, &p, &rgb).unwrap_err(),
+            EnvError::NotSanitized
+        );
+    }
+}

@@ -1,0 +1,164 @@
+//! Monte Carlo estimators of direct illumination from the environment, L_o = ∫ L·B·cos·V dω,
+//! one sample at a time. Each returns the weighted contribution f·V/p (times an MIS weight where
+//! there is one) and the densities it used, so hosts can average, inspect and test them.
+//! Visibility is asked only for directions whose unoccluded contribution is non-zero.
+
+use crate::brdf::Brdf;
+use crate::env::EnvHierarchy;
+use crate::frame::Frame;
+use crate::sampler::ProductSampler;
+use glam::{DVec2, Vec2, Vec3};
+
+/// Answers whether the environment is visible from the shading point in a world direction.
+pub trait Visibility {
+    fn visible(&mut self, dir: Vec3) -> bool;
+}
+
+impl<F: FnMut(Vec3) -> bool> Visibility for F {
+    fn visible(&mut self, dir: Vec3) -> bool {
+        self(dir)
+    }
+}
+
+/// Where and how a shading point reflects: its frame, the world direction to the viewer and
+/// its BRDF.
+#[derive(Clone, Copy)]
+pub struct ShadingPoint<'b, B: Brdf + ?Sized> {
+    pub frame: Frame,
+    /// World-space unit direction towards the viewer.
+    pub wo: Vec3,
+    pub brdf: &'b B,
+}
+
+impl<B: Brdf + ?Sized> ShadingPoint<'_, B> {
+    /// BRDF × cos for a world direction.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, dir: Vec3) -> Vec3 {
+        self.brdf
+            .eval(self.frame.to_local(self.wo), self.frame.to_local(dir))
+    }
+
+    /// The BRDF's own sampling density for a world direction.
+    #[inline]
+    #[must_use]
+    pub fn brdf_pdf(&self, dir: Vec3) -> f32 {
+        self.brdf
+            .pdf(self.frame.to_local(self.wo), self.frame.to_local(dir))
+    }
+}
+
+/// One sample's share of an estimate.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Contribution {
+    /// World direction sampled (zero when no direction could be drawn).
+    pub dir: Vec3,
+    /// f·V/p, times the MIS weight for MIS samples.
+    pub value: Vec3,
+    /// Density (solid angle) of the technique that drew the direction.
+    pub pdf: f32,
+    /// Density of the other technique at `dir` (MIS only; 0 otherwise).
+    pub other_pdf: f32,
+}
+
+#[inline]
+fn weighted(f: Vec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> Vec3 {
+    if pdf > 0.0 && f.cmpgt(Vec3::ZERO).any() && vis.visible(dir) {
+        f / pdf
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// Product importance sampling: one direction from the shading point's [`ProductSampler`].
+pub fn product<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u: DVec2,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = sampler.sample(u) else {
+        return Contribution::default();
+    };
+    let f = sampler.env().radiance(s.dir) * sp.eval(s.dir);
+    Contribution {
+        dir: s.dir,
+        value: weighted(f, s.pdf, vis, s.dir),
+        pdf: s.pdf,
+        other_pdf: 0.0,
+    }
+}
+
+/// Environment-only sampling through the same hierarchy.
+pub fn env<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u: DVec2,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = env.sample(u) else {
+        return Contribution::default();
+    };
+    let f = env.radiance(s.dir) * sp.eval(s.dir);
+    Contribution {
+        dir: s.dir,
+        value: weighted(f, s.pdf, vis, s.dir),
+        pdf: s.pdf,
+        other_pdf: 0.0,
+    }
+}
+
+/// BRDF-only sampling.
+pub fn brdf<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u: DVec2,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u.as_vec2()) else {
+        return Contribution::default();
+    };
+    let dir = sp.frame.to_world(s.wi);
+    let f = env.radiance(dir) * s.value;
+    Contribution {
+        dir,
+        value: weighted(f, s.pdf, vis, dir),
+        pdf: s.pdf,
+        other_pdf: 0.0,
+    }
+}
+
+/// Multiple importance sampling, balance heuristic, one environment and one BRDF sample
+/// (Veach 1997): each sample contributes f·V / (p_env + p_brdf). The sum of the two
+/// contributions is the estimate.
+pub fn mis<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_env: DVec2,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
+    let mut out = [Contribution::default(); 2];
+    if let Some(s) = env_h.sample(u_env) {
+        let p_brdf = sp.brdf_pdf(s.dir);
+        let f = env_h.radiance(s.dir) * sp.eval(s.dir);
+        out[0] = Contribution {
+            dir: s.dir,
+            value: weighted(f, s.pdf + p_brdf, vis, s.dir),
+            pdf: s.pdf,
+            other_pdf: p_brdf,
+        };
+    }
+    if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
+        let dir = sp.frame.to_world(s.wi);
+        let p_env = env_h.pdf(dir);
+        let f = env_h.radiance(dir) * s.value;
+        out[1] = Contribution {
+            dir,
+            value: weighted(f, s.pdf + p_env, vis, dir),
+            pdf: s.pdf,
+            other_pdf: p_env,
+        };
+    }
+    out
+}

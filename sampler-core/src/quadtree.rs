@@ -1,0 +1,212 @@
+//! The per-shading-point quadtree: BRDF samples in the equal-area square, subdivided until each
+//! leaf holds one sample, with the product B̃·L computed in the same (single) traversal.
+//!
+//! * Points are quantised to 24 bits per axis and sorted by Morton code, so every node is a
+//!   contiguous run of samples and its four children split that run by the next two bits.
+//! * A leaf with samples takes the mean of their B·cos (luminance) — one sample unless the depth
+//!   cap or the node capacity stopped the split (e.g. coincident samples).
+//! * An empty leaf takes the mean of its non-empty siblings: a piecewise-constant guess from its
+//!   neighbourhood instead of 0, so the product does not starve regions between samples.
+//!   (Regions where even that is 0 are covered by the sampler's defensive mixture.)
+//! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
+//!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
+//!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`).
+
+use crate::env::EnvHierarchy;
+use crate::warp::child_offset;
+use crate::wavelet::haar_product_mean;
+use heapless::Vec;
+
+/// Bits per axis of the quantised square coordinates; also the largest possible depth.
+pub const COORD_BITS: u32 = 24;
+
+/// One node of the product tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Node {
+    /// Index of the first of four consecutive children; 0 marks a leaf (the root is never a
+    /// child).
+    pub child: u32,
+    /// Mean of the product B̃ · (L / mean L) over the node.
+    pub product: f32,
+    /// Mean of B̃ over the node (the piecewise-constant value at a leaf).
+    pub btilde: f32,
+}
+
+impl Node {
+    #[inline]
+    #[must_use]
+    pub fn is_leaf(&self) -> bool {
+        self.child == 0
+    }
+}
+
+/// How internal nodes combine their children.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProductKind {
+    /// Average of the four children's products (Clarberg & Akenine-Möller 2008).
+    #[default]
+    Quadtree,
+    /// Product of the nonstandard Haar expansions of B̃ and L (wavelet importance sampling,
+    /// Clarberg et al. 2005). Equal to `Quadtree` in exact arithmetic: a cross-check.
+    Wavelet,
+}
+
+/// 24-bit fixed-point coordinates of a point of the square.
+#[inline]
+#[must_use]
+pub fn quantize(u: f32) -> u32 {
+    let max = (1u32 << COORD_BITS) - 1;
+    ((u * (1u32 << COORD_BITS) as f32) as u32).min(max)
+}
+
+/// Interleaves two 24-bit coordinates (x in the even bits).
+#[inline]
+#[must_use]
+pub fn morton(x: u32, y: u32) -> u64 {
+    spread(x) | (spread(y) << 1)
+}
+
+#[inline]
+fn spread(v: u32) -> u64 {
+    let mut x = v as u64 & 0xFFFF_FFFF;
+    x = (x | (x << 16)) & 0x0000_FFFF_0000_FFFF;
+    x = (x | (x << 8)) & 0x00FF_00FF_00FF_00FF;
+    x = (x | (x << 4)) & 0x0F0F_0F0F_0F0F_0F0F;
+    x = (x | (x << 2)) & 0x3333_3333_3333_3333;
+    (x | (x << 1)) & 0x5555_5555_5555_5555
+}
+
+/// Sort key: Morton code in the high 48 bits, sample index in the low 16.
+#[inline]
+#[must_use]
+pub fn sort_key(u: f32, v: f32, index: usize) -> u64 {
+    (morton(quantize(u), quantize(v)) << 16) | index as u64
+}
+
+/// The child digit (dx + 2·dy) of a key at `depth` (the split from depth to depth + 1).
+#[inline]
+fn digit(key: u64, depth: u32) -> usize {
+    ((key >> (16 + 2 * (COORD_BITS - 1 - depth))) & 3) as usize
+}
+
+/// Builds the tree over `keys` (sorted) whose sample values are `values[key & 0xFFFF]`.
+pub(crate) struct TreeBuilder<'b, 'e, const NODES: usize> {
+    pub keys: &'b [u64],
+    pub values: &'b [f32],
+    pub env: &'b EnvHierarchy<'e>,
+    pub nodes: &'b mut Vec<Node, NODES>,
+    pub max_depth: u32,
+    pub kind: ProductKind,
+}
+
+impl<const NODES: usize> TreeBuilder<'_, '_, NODES> {
+    /// Builds the whole tree; the root is node 0. Returns false when there are no samples.
+    pub fn build(&mut self) -> bool {
+        self.nodes.clear();
+        if self.keys.is_empty() {
+            return false;
+        }
+        let _ = self.nodes.push(Node::default());
+        self.node(0, 0, 0, 0, 0, self.keys.len());
+        true
+    }
+
+    /// Fills node `index` covering cell `(x, y)` at `depth` and samples `lo..hi` (non-empty).
+    fn node(&mut self, index: usize, depth: u32, x: u32, y: u32, lo: usize, hi: usize) -> Node {
+        let room = self.nodes.len() + 4 <= NODES;
+        if hi - lo == 1 || depth >= self.max_depth || !room {
+            let b = self.keys[lo..hi]
+                .iter()
+                .map(|k| self.values[(k & 0xFFFF) as usize])
+                .sum::<f32>()
+                / (hi - lo) as f32;
+            let leaf = Node {
+                child: 0,
+                btilde: b,
+                product: b * self.env.cell_relative(depth, x, y),
+            };
+            self.nodes[index] = leaf;
+            return leaf;
+        }
+        let first = self.nodes.len();
+        for _ in 0..4 {
+            let _ = self.nodes.push(Node::default());
+        }
+        // Split lo..hi by the next two Morton bits (the run is sorted).
+        let mut bounds = [lo; 5];
+        bounds[4] = hi;
+        for c in 1..4 {
+            bounds[c] = lo + self.keys[lo..hi].partition_point(|&k| digit(k, depth) < c);
+        }
+        let mut b = [0.0f32; 4];
+        let mut p = [0.0f32; 4];
+        let (mut sum_b, mut filled) = (0.0f32, 0u32);
+        for c in 0..4 {
+            if bounds[c + 1] > bounds[c] {
+                let (dx, dy) = child_offset(c);
+                let n = self.node(
+                    first + c,
+                    depth + 1,
+                    2 * x + dx,
+                    2 * y + dy,
+                    bounds[c],
+                    bounds[c + 1],
+                );
+                (b[c], p[c]) = (n.btilde, n.product);
+                sum_b += n.btilde;
+                filled += 1;
+            }
+        }
+        let fill = sum_b / filled as f32;
+        let mut l = [0.0f32; 4];
+        for c in 0..4 {
+            let (dx, dy) = child_offset(c);
+            l[c] = self.env.cell_relative(depth + 1, 2 * x + dx, 2 * y + dy);
+            if bounds[c + 1] == bounds[c] {
+                b[c] = fill;
+                p[c] = fill * l[c];
+                self.nodes[first + c] = Node {
+                    child: 0,
+                    btilde: fill,
+                    product: p[c],
+                };
+            }
+        }
+        let product = match self.kind {
+            ProductKind::Quadtree => 0.25 * ((p[0] + p[1]) + (p[2] + p[3])),
+            ProductKind::Wavelet => haar_product_mean(b, l, p),
+        };
+        let node = Node {
+            child: first as u32,
+            btilde: fill,
+            product,
+        };
+        self.nodes[index] = node;
+        node
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn morton_interleaves_x_in_even_bits() {
+        assert_eq!(morton(1, 0), 1);
+        assert_eq!(morton(0, 1), 2);
+        assert_eq!(morton(0b11, 0b01), 0b0111);
+        let top = 1u32 << 23;
+        let k = sort_key(0.75, 0.25, 5);
+        assert_eq!(digit(k, 0), 1); // right, bottom
+        assert_eq!(digit(k, 1), 3); // 0.75 = 0.11b, 0.25 = 0.01b
+        assert_eq!(morton(top, top) >> 46, 3);
+    }
+
+    #[test]
+    fn quantize_clamps() {
+        assert_eq!(quantize(1.0), (1 << 24) - 1);
+        assert_eq!(quantize(-0.5), 0);
+        assert_eq!(quantize(f32::NAN), 0);
+        assert_eq!(quantize(0.5), 1 << 23);
+    }
+}
