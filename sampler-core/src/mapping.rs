@@ -126,9 +126,12 @@ pub fn square_to_sphere(p: Vec2) -> Vec3 {
 #[inline]
 #[must_use]
 pub fn sphere_to_square(d: Vec3) -> Vec2 {
-    let (ax, ay, az) = (d.x.abs(), d.y.abs(), d.z.abs());
-    let xy2 = d.x * d.x + d.y * d.y;
-    let len = (xy2 + d.z * d.z).sqrt_core();
+    // Scale by the largest component first: squares of tiny or huge inputs would under/overflow.
+    let m = d.x.abs().max(d.y.abs()).max(d.z.abs()).max(TINY);
+    let (x, y, z) = (d.x / m, d.y / m, d.z / m);
+    let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+    let xy2 = x * x + y * y;
+    let len = (xy2 + z * z).sqrt_core();
     // r² = 1 − |z|/len, written without cancellation near the poles.
     let r = (xy2 / (len * (len + az)).max(TINY)).min(1.0).sqrt_core();
     let a = ax.min(ay) / ax.max(ay).max(TINY);
@@ -136,10 +139,10 @@ pub fn sphere_to_square(d: Vec3) -> Vec2 {
     let phi = if ay > ax { 1.0 - phi } else { phi };
     let mut tp = phi * r;
     let mut sp = r - tp;
-    if d.z < 0.0 {
+    if z < 0.0 {
         (sp, tp) = (1.0 - tp, 1.0 - sp);
     }
-    Vec2::new(0.5 * sp.copysign(d.x) + 0.5, 0.5 * tp.copysign(d.y) + 0.5)
+    Vec2::new(0.5 * sp.copysign(x) + 0.5, 0.5 * tp.copysign(y) + 0.5)
 }
 
 /// Four points at a time (structure of arrays): `u`, `v` → `(x, y, z)`.
@@ -172,6 +175,8 @@ pub fn square_to_sphere_x4(u: Vec4, v: Vec4) -> [Vec4; 3] {
 pub fn sphere_to_square_x4(x: Vec4, y: Vec4, z: Vec4) -> [Vec4; 2] {
     let one = Vec4::ONE;
     let tiny = Vec4::splat(TINY);
+    let m = x.abs().max(y.abs()).max(z.abs()).max(tiny);
+    let (x, y, z) = (x / m, y / m, z / m);
     let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
     let xy2 = x * x + y * y;
     let len = sqrt4(xy2 + z * z);

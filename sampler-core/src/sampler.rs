@@ -253,6 +253,15 @@ impl<'e> ProductSampler<'_, 'e> {
         Some((node, depth))
     }
 
+    /// Depth of the dyadic cell around `uv` on which the density is constant: the deeper of
+    /// the B̃ leaf and the environment's finest level. Lets tests and tools integrate the
+    /// density exactly.
+    #[must_use]
+    pub fn constant_depth_at(&self, uv: Vec2) -> u32 {
+        let leaf = self.leaf_at(uv).map_or(0, |(_, d)| d);
+        leaf.max(self.env.finest_level())
+    }
+
     /// Density per unit area of the square at `uv` (the mixture; integrates to 1 over [0,1]²).
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {

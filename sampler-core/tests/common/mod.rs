@@ -1,0 +1,414 @@
+//! Shared helpers of the statistical tests: charts of the sphere, a χ² goodness-of-fit harness
+//! (after Mitsuba 3's `ChiSquareTest`), quadrature, and test environments.
+#![allow(dead_code)]
+
+use glam::{DVec2, Vec2, Vec3};
+use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+use sampler_core::frame::Frame;
+use sampler_core::mapping::{sphere_to_square, square_to_sphere};
+use sampler_core::rng::Pcg32;
+use std::f64::consts::PI;
+
+/// A parametrisation of the sphere by [0,1]² used for binning and quadrature.
+#[derive(Clone, Copy, Debug)]
+pub enum Chart {
+    /// The equal-area square (constant Jacobian 4π).
+    EqualArea,
+    /// Polar coordinates about `axis`, concentrated within ~`scale` radians of it:
+    /// tan(θ/2) = scale·tan(π t/2), φ = 2π s.
+    Polar { axis: Vec3, scale: f64 },
+}
+
+impl Chart {
+    /// Direction of chart point `c` and the solid angle per unit chart area there.
+    pub fn dir_jacobian(&self, c: DVec2) -> (Vec3, f64) {
+        match *self {
+            Chart::EqualArea => (square_to_sphere(c.as_vec2()), 4.0 * PI),
+            Chart::Polar { axis, scale } => {
+                let a = 0.5 * PI * c.x;
+                let ta = a.tan();
+                let theta = 2.0 * (scale * ta).atan();
+                let dtheta =
+                    2.0 * scale * 0.5 * PI / (a.cos().powi(2) * (1.0 + scale * scale * ta * ta));
+                let phi = 2.0 * PI * c.y;
+                let f = Frame::from_normal(axis);
+                let local = Vec3::new(
+                    (theta.sin() * phi.cos()) as f32,
+                    (theta.sin() * phi.sin()) as f32,
+                    theta.cos() as f32,
+                );
+                (f.to_world(local), theta.sin() * dtheta * 2.0 * PI)
+            }
+        }
+    }
+
+    /// Chart point of a direction.
+    pub fn point_of(&self, d: Vec3) -> DVec2 {
+        match *self {
+            Chart::EqualArea => sphere_to_square(d).as_dvec2(),
+            Chart::Polar { axis, scale } => {
+                let f = Frame::from_normal(axis);
+                let l = f.to_local(d).as_dvec3();
+                let theta = l.x.hypot(l.y).atan2(l.z);
+                let t = 2.0 / PI * ((theta * 0.5).tan() / scale).atan();
+                let mut phi = l.y.atan2(l.x) / (2.0 * PI);
+                if phi < 0.0 {
+                    phi += 1.0;
+                }
+                DVec2::new(t, phi)
+            }
+        }
+    }
+}
+
+/// ∫ f dω over the sphere by the midpoint rule on an n×n grid of `chart`, each cell split into
+/// `sub`×`sub` points.
+pub fn integrate(chart: Chart, n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let c = DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+            let (d, jac) = chart.dir_jacobian(c);
+            sum += f(d) * jac;
+        }
+    }
+    sum / (n * n) as f64
+}
+
+/// Upper regularised incomplete gamma Q(a, x) (Numerical Recipes gammq).
+pub fn gamma_q(a: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 1.0;
+    }
+    let gln = ln_gamma(a);
+    if x < a + 1.0 {
+        let (mut ap, mut sum) = (a, 1.0 / a);
+        let mut del = sum;
+        for _ in 0..10_000 {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+            if del.abs() < sum.abs() * 1e-15 {
+                break;
+            }
+        }
+        1.0 - sum * (-x + a * x.ln() - gln).exp()
+    } else {
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / 1e-300;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < 1e-300 {
+                d = 1e-300;
+            }
+            c = b + an / c;
+            if c.abs() < 1e-300 {
+                c = 1e-300;
+            }
+            d = 1.0 / d;
+            let del = d * c;
+            h *= del;
+            if (del - 1.0).abs() < 1e-15 {
+                break;
+            }
+        }
+        (-x + a * x.ln() - gln).exp() * h
+    }
+}
+
+fn ln_gamma(x: f64) -> f64 {
+    // Lanczos approximation (g = 7, n = 9).
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + 7.5;
+    for (i, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Result of a χ² test.
+#[derive(Debug)]
+pub struct ChiSquare {
+    pub stat: f64,
+    pub dof: usize,
+    pub p_value: f64,
+    /// Samples the sampler drew where the pdf integrates to (numerically) nothing.
+    pub impossible: usize,
+    /// Fraction of samples whose returned pdf differs from pdf(dir) by more than 1e-4 relative.
+    pub pdf_mismatch: f64,
+    /// Fraction of draws that returned no direction.
+    pub failed: f64,
+}
+
+/// χ² goodness-of-fit of `samples` draws of `sample` against `pdf`, binned on a `res`×`res`
+/// grid of `chart`; expected counts integrate the pdf with `sub`×`sub` points per bin. Bins
+/// expecting fewer than 5 samples are pooled. The mass the pdf misses (failed draws) is a bin
+/// of its own.
+pub fn chi_square(
+    chart: Chart,
+    res: usize,
+    sub: usize,
+    samples: usize,
+    seed: u64,
+    mut sample: impl FnMut(DVec2) -> Option<(Vec3, f32)>,
+    pdf: impl Fn(Vec3) -> f32,
+) -> ChiSquare {
+    let mut observed = vec![0.0f64; res * res];
+    let mut rng = Pcg32::new(seed, 0x0c41_5eed);
+    let (mut failed, mut mismatch) = (0usize, 0usize);
+    for _ in 0..samples {
+        let u = DVec2::new(rng.next_f64(), rng.next_f64());
+        match sample(u) {
+            Some((d, p)) => {
+                assert!(
+                    d.is_finite() && p.is_finite() && p > 0.0,
+                    "bad sample {d:?} pdf {p}"
+                );
+                let q = pdf(d);
+                if (q - p).abs() > 1e-4 * p.max(q) {
+                    mismatch += 1;
+                }
+                let c = chart.point_of(d);
+                let i = ((c.x * res as f64) as usize).min(res - 1);
+                let j = ((c.y * res as f64) as usize).min(res - 1);
+                observed[j * res + i] += 1.0;
+            }
+            None => failed += 1,
+        }
+    }
+    let mut expected = vec![0.0f64; res * res];
+    let m = res * sub;
+    for j in 0..m {
+        for i in 0..m {
+            let c = DVec2::new((i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64);
+            let (d, jac) = chart.dir_jacobian(c);
+            expected[(j / sub) * res + i / sub] +=
+                pdf(d) as f64 * jac / (m * m) as f64 * samples as f64;
+        }
+    }
+    let total_expected: f64 = expected.iter().sum();
+    // Pool small bins; a separate bin holds the missing mass (failed draws).
+    let mut cells: Vec<(f64, f64)> = Vec::new();
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    let mut impossible = 0;
+    for (o, e) in observed.iter().zip(&expected) {
+        if *e == 0.0 && *o > 0.0 {
+            impossible += *o as usize;
+        }
+        if *e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            cells.push((*o, *e));
+        }
+    }
+    let missing_e = (samples as f64 - total_expected).max(0.0);
+    pool_o += failed as f64;
+    pool_e += missing_e;
+    if pool_e >= 5.0 {
+        cells.push((pool_o, pool_e));
+    } else if let Some(last) = cells.last_mut() {
+        last.0 += pool_o;
+        last.1 += pool_e;
+    }
+    let stat: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    let dof = cells.len().saturating_sub(1).max(1);
+    ChiSquare {
+        stat,
+        dof,
+        p_value: gamma_q(dof as f64 / 2.0, stat / 2.0),
+        impossible,
+        pdf_mismatch: mismatch as f64 / samples as f64,
+        failed: failed as f64 / samples as f64,
+    }
+}
+
+/// An environment owned by a test: RGB texels and the importance pyramid.
+pub struct TestEnv {
+    pub level: u32,
+    pub rgb: Vec<[f32; 3]>,
+    pub pyramid: Vec<f32>,
+}
+
+impl TestEnv {
+    pub fn new(level: u32, rgb: Vec<[f32; 3]>) -> Self {
+        let mut pyramid = vec![0.0; pyramid_len(level)];
+        build_pyramid(level, &rgb, &mut pyramid).unwrap();
+        Self {
+            level,
+            rgb,
+            pyramid,
+        }
+    }
+
+    pub fn view(&self) -> EnvHierarchy<'_> {
+        EnvHierarchy::new(self.level, &self.pyramid, &self.rgb).unwrap()
+    }
+
+    /// Smooth random sky: a few random lobes over a dim floor, coloured.
+    pub fn random_smooth(level: u32, seed: u64) -> Self {
+        let n = 1usize << level;
+        let mut rng = Pcg32::new(seed, 11);
+        let lobes: Vec<(Vec3, f32, f32)> = (0..4)
+            .map(|_| {
+                let d = square_to_sphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+                (d, 2.0 + 30.0 * rng.next_f32(), 0.5 + 5.0 * rng.next_f32())
+            })
+            .collect();
+        let mut rgb = vec![[0.0; 3]; n * n];
+        for y in 0..n {
+            for x in 0..n {
+                let d = square_to_sphere(Vec2::new(
+                    (x as f32 + 0.5) / n as f32,
+                    (y as f32 + 0.5) / n as f32,
+                ));
+                let mut v = 0.05;
+                for (axis, sharp, w) in &lobes {
+                    v += w * (sharp * (d.dot(*axis) - 1.0)).exp();
+                }
+                rgb[y * n + x] = [v * 0.9, v, v * 1.2];
+            }
+        }
+        Self::new(level, rgb)
+    }
+
+    /// Blue-ish sky with one texel `ratio` times brighter (a sun) at texel `sun`.
+    pub fn sun(level: u32, sun: (usize, usize), ratio: f32) -> Self {
+        let n = 1usize << level;
+        let mut rgb = vec![[0.3, 0.5, 1.0]; n * n];
+        rgb[sun.1 * n + sun.0] = [ratio, ratio, ratio];
+        Self::new(level, rgb)
+    }
+
+    /// Constant radiance everywhere.
+    pub fn constant(level: u32, value: f32) -> Self {
+        let n = 1usize << level;
+        Self::new(level, vec![[value; 3]; n * n])
+    }
+}
+
+/// Exact χ² test of a density that is piecewise constant on dyadic cells of the equal-area
+/// square: `depth_at(uv)` tells the depth of the constant cell around `uv` and `pdf_square(uv)`
+/// its density per unit area. Bins are an adaptive dyadic partition refined until each expects
+/// at most `per_bin` samples (down to depth 24), so needle-sharp products are resolved.
+pub fn chi_square_dyadic(
+    samples: usize,
+    seed: u64,
+    per_bin: f64,
+    mut sample: impl FnMut(DVec2) -> Option<Vec2>,
+    depth_at: impl Fn(Vec2) -> u32,
+    pdf_square: impl Fn(Vec2) -> f32,
+) -> ChiSquare {
+    use std::collections::HashMap;
+    let n = samples as f64;
+    let centre = |d: u32, x: u64, y: u64| {
+        let s = 1.0 / (1u64 << d) as f64;
+        Vec2::new(((x as f64 + 0.5) * s) as f32, ((y as f64 + 0.5) * s) as f32)
+    };
+    // Exact mass of a dyadic cell.
+    fn mass(
+        d: u32,
+        x: u64,
+        y: u64,
+        centre: &dyn Fn(u32, u64, u64) -> Vec2,
+        depth_at: &dyn Fn(Vec2) -> u32,
+        pdf: &dyn Fn(Vec2) -> f32,
+    ) -> f64 {
+        let c = centre(d, x, y);
+        if depth_at(c) <= d || d >= 24 {
+            return pdf(c) as f64 / (1u64 << (2 * d)) as f64;
+        }
+        (0..4)
+            .map(|k| {
+                mass(
+                    d + 1,
+                    2 * x + (k & 1),
+                    2 * y + (k >> 1),
+                    centre,
+                    depth_at,
+                    pdf,
+                )
+            })
+            .sum()
+    }
+    let mut bins: HashMap<(u32, u64, u64), (f64, f64)> = HashMap::new();
+    let mut stack = vec![(0u32, 0u64, 0u64)];
+    while let Some((d, x, y)) = stack.pop() {
+        let m = mass(d, x, y, &centre, &depth_at, &pdf_square);
+        if m * n > per_bin && d < 24 {
+            for k in 0..4 {
+                stack.push((d + 1, 2 * x + (k & 1), 2 * y + (k >> 1)));
+            }
+        } else {
+            bins.insert((d, x, y), (0.0, m * n));
+        }
+    }
+    let mut rng = Pcg32::new(seed, 0xd1ad);
+    let mut failed = 0;
+    let mut impossible = 0;
+    for _ in 0..samples {
+        let u = DVec2::new(rng.next_f64(), rng.next_f64());
+        let Some(uv) = sample(u) else {
+            failed += 1;
+            continue;
+        };
+        let q = |v: f32| ((v as f64 * (1u64 << 24) as f64) as u64).min((1 << 24) - 1);
+        let (qx, qy) = (q(uv.x), q(uv.y));
+        let key = (0..=24u32)
+            .map(|d| (d, qx >> (24 - d), qy >> (24 - d)))
+            .find(|k| bins.contains_key(k));
+        match key.and_then(|k| bins.get_mut(&k)) {
+            Some(b) if b.1 > 0.0 => b.0 += 1.0,
+            _ => impossible += 1,
+        }
+    }
+    let mut cells: Vec<(f64, f64)> = Vec::new();
+    let (mut pool_o, mut pool_e) = (failed as f64, 0.0);
+    let total_e: f64 = bins.values().map(|b| b.1).sum();
+    pool_e += (n - total_e).max(0.0);
+    for (o, e) in bins.values() {
+        if *e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            cells.push((*o, *e));
+        }
+    }
+    if pool_e >= 5.0 {
+        cells.push((pool_o, pool_e));
+    } else if let Some(last) = cells.last_mut() {
+        last.0 += pool_o;
+        last.1 += pool_e;
+    }
+    let stat: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    let dof = cells.len().saturating_sub(1).max(1);
+    ChiSquare {
+        stat,
+        dof,
+        p_value: gamma_q(dof as f64 / 2.0, stat / 2.0),
+        impossible,
+        pdf_mismatch: 0.0,
+        failed: failed as f64 / n,
+    }
+}
+
+/// Šidák-corrected significance level for one of `tests` tests at overall level 1%.
+pub fn sidak(tests: usize) -> f64 {
+    1.0 - 0.99f64.powf(1.0 / tests as f64)
+}
