@@ -412,3 +412,45 @@ pub fn chi_square_dyadic(
 pub fn sidak(tests: usize) -> f64 {
     1.0 - 0.99f64.powf(1.0 / tests as f64)
 }
+
+/// ∫ f dω for an f with a sharp lobe of angular width `width` about `axis` plus wide parts:
+/// a polar chart inside the cone of half-angle 30·width (capped at π) and an equal-area grid
+/// outside it, each `n`×`n`.
+pub fn integrate_lobe(axis: Vec3, width: f64, n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+    let cone = (30.0 * width).min(PI);
+    let cos_cone = cone.cos();
+    let axis_d = axis.as_dvec3().normalize();
+    // Polar chart with θ = cone·g(t), g concentrating points near the axis.
+    let frame = Frame::from_normal(axis);
+    let mut inner = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let t = (i as f64 + 0.5) / n as f64;
+            let s = (j as f64 + 0.5) / n as f64;
+            // θ = cone·t²: dense near the axis, dθ = 2·cone·t dt.
+            let theta = cone * t * t;
+            let dtheta = 2.0 * cone * t;
+            let phi = 2.0 * PI * s;
+            let local = glam::DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            let d = frame.to_world(local.as_vec3());
+            inner += f(d) * theta.sin() * dtheta * 2.0 * PI;
+        }
+    }
+    inner /= (n * n) as f64;
+    let outer = if cone >= PI {
+        0.0
+    } else {
+        integrate(Chart::EqualArea, n, |d| {
+            if d.as_dvec3().normalize().dot(axis_d) < cos_cone {
+                f(d)
+            } else {
+                0.0
+            }
+        })
+    };
+    inner + outer
+}
