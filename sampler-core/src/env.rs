@@ -284,6 +284,13 @@ impl<'a> EnvHierarchy<'a> {
         }
     }
 
+    /// The rotation taking world directions to the map's frame.
+    #[inline]
+    #[must_use]
+    pub fn world_to_map(&self) -> Mat3 {
+        self.world_to_map
+    }
+
     /// World direction → map direction.
     #[inline]
     #[must_use]

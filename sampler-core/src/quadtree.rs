@@ -107,26 +107,36 @@ impl<const NODES: usize> TreeBuilder<'_, '_, NODES> {
             return false;
         }
         let _ = self.nodes.push(Node::default());
-        self.node(0, 0, 0, 0, 0, self.keys.len());
+        let root_env = self.env.cell_relative(0, 0, 0);
+        self.node(0, 0, 0, 0, root_env, 0, self.keys.len());
         true
     }
 
-    /// Fills node `index` covering cell `(x, y)` at `depth` and samples `lo..hi` (non-empty).
-    fn node(&mut self, index: usize, depth: u32, x: u32, y: u32, lo: usize, hi: usize) -> Node {
+    /// Fills node `index` covering cell `(x, y)` at `depth` and samples `lo..hi` (non-empty);
+    /// returns its (B̃ mean, product mean). Fields are written in place: building a `Node` on
+    /// the stack and copying it back costs a failed store-forward per node.
+    /// `env` is the environment's relative mean over the cell (fetched by the parent).
+    #[allow(clippy::too_many_arguments)]
+    fn node(
+        &mut self,
+        index: usize,
+        depth: u32,
+        x: u32,
+        y: u32,
+        env: f32,
+        lo: usize,
+        hi: usize,
+    ) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || depth >= self.max_depth || !room {
-            let b = self.keys[lo..hi]
+            let sum: f32 = self.keys[lo..hi]
                 .iter()
                 .map(|k| self.values[(k & 0xFFFF) as usize])
-                .sum::<f32>()
-                / (hi - lo) as f32;
-            let leaf = Node {
-                child: 0,
-                btilde: b,
-                product: b * self.env.cell_relative(depth, x, y),
-            };
-            self.nodes[index] = leaf;
-            return leaf;
+                .sum();
+            let b = sum / (hi - lo) as f32;
+            let product = b * env;
+            set(&mut self.nodes[index], 0, b, product);
+            return (b, product);
         }
         let first = self.nodes.len();
         for _ in 0..4 {
@@ -138,52 +148,48 @@ impl<const NODES: usize> TreeBuilder<'_, '_, NODES> {
         for c in 1..4 {
             bounds[c] = lo + self.keys[lo..hi].partition_point(|&k| digit(k, depth) < c);
         }
+        // The environment over the four children: one 2×2 block of the pyramid (or the texel
+        // containing them, below the finest level).
+        let l = if depth < self.env.finest_level() {
+            self.env.children_relative(depth, x, y)
+        } else {
+            [env; 4]
+        };
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
         for c in 0..4 {
             if bounds[c + 1] > bounds[c] {
                 let (dx, dy) = child_offset(c);
-                let n = self.node(
-                    first + c,
-                    depth + 1,
-                    2 * x + dx,
-                    2 * y + dy,
-                    bounds[c],
-                    bounds[c + 1],
-                );
-                (b[c], p[c]) = (n.btilde, n.product);
-                sum_b += n.btilde;
+                let (cx, cy) = (2 * x + dx, 2 * y + dy);
+                (b[c], p[c]) =
+                    self.node(first + c, depth + 1, cx, cy, l[c], bounds[c], bounds[c + 1]);
+                sum_b += b[c];
                 filled += 1;
             }
         }
         let fill = sum_b / filled as f32;
-        let mut l = [0.0f32; 4];
         for c in 0..4 {
-            let (dx, dy) = child_offset(c);
-            l[c] = self.env.cell_relative(depth + 1, 2 * x + dx, 2 * y + dy);
             if bounds[c + 1] == bounds[c] {
                 b[c] = fill;
                 p[c] = fill * l[c];
-                self.nodes[first + c] = Node {
-                    child: 0,
-                    btilde: fill,
-                    product: p[c],
-                };
+                set(&mut self.nodes[first + c], 0, fill, p[c]);
             }
         }
         let product = match self.kind {
             ProductKind::Quadtree => 0.25 * ((p[0] + p[1]) + (p[2] + p[3])),
             ProductKind::Wavelet => haar_product_mean(b, l, p),
         };
-        let node = Node {
-            child: first as u32,
-            btilde: fill,
-            product,
-        };
-        self.nodes[index] = node;
-        node
+        set(&mut self.nodes[index], first as u32, fill, product);
+        (fill, product)
     }
+}
+
+#[inline(always)]
+fn set(n: &mut Node, child: u32, btilde: f32, product: f32) {
+    n.child = child;
+    n.btilde = btilde;
+    n.product = product;
 }
 
 #[cfg(test)]

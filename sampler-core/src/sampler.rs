@@ -19,10 +19,10 @@ use crate::brdf::Brdf;
 use crate::env::{EnvHierarchy, luminance};
 use crate::frame::Frame;
 use crate::mapping::{SPHERE_AREA, sphere_to_square_batch};
-use crate::points::sobol02;
+use crate::points::sobol02_shifted;
 use crate::quadtree::{COORD_BITS, Node, ProductKind, TreeBuilder, quantize, sort_key};
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, point_in_cell};
-use glam::{DVec2, Vec2, Vec3};
+use glam::{DVec2, Mat3, Vec2, Vec3};
 use heapless::Vec;
 
 /// Settings of the per-shading-point product.
@@ -53,8 +53,13 @@ impl Default for ProductParams {
 /// Reused from point to point; never allocates. The size in bytes is
 /// `size_of::<ProductArena<K, NODES>>()` (≈ 25·K + 12·NODES).
 pub struct ProductArena<const K: usize = 256, const NODES: usize = 4096> {
+    /// BRDF sample points, then the samples' points of the equal-area square.
+    points: [Vec2; K],
+    /// (ωi in the shading frame, BRDF × cos) of each BRDF sample.
+    samples: [(Vec3, Vec3); K],
+    /// Usable samples' directions in the map frame.
     dirs: [Vec3; K],
-    uvs: [Vec2; K],
+    /// Usable samples' B·cos (luminance).
     values: [f32; K],
     keys: Vec<u64, K>,
     nodes: Vec<Node, NODES>,
@@ -74,8 +79,9 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
     pub const fn new() -> Self {
         let () = Self::CAPACITY_OK;
         Self {
+            points: [Vec2::ZERO; K],
+            samples: [(Vec3::ZERO, Vec3::ZERO); K],
             dirs: [Vec3::ZERO; K],
-            uvs: [Vec2::ZERO; K],
             values: [0.0; K],
             keys: Vec::new(),
             nodes: Vec::new(),
@@ -98,26 +104,22 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
         self.keys.clear();
         let mut count = 0;
         if !env.is_black() && k > 0 {
-            // Draw the BRDF samples from a scrambled (0,2)-sequence, 16 points at a time.
-            let mut points = [DVec2::ZERO; 16];
-            let mut i = 0;
-            while i < k {
-                let n = (k - i).min(16);
-                sobol02(seed, i as u32, &mut points[..n]);
-                for p in &points[..n] {
-                    if let Some(s) = brdf.sample(wo_local, p.as_vec2()) {
-                        let v = luminance(s.value);
-                        if v.is_finite() && v >= 0.0 && s.pdf > 0.0 {
-                            self.dirs[count] = env.to_map(frame.to_world(s.wi));
-                            self.values[count] = v;
-                            count += 1;
-                        }
-                    }
+            // K BRDF samples from a randomised (0,2)-sequence, in one call.
+            sobol02_shifted(seed, 0, &mut self.points[..k]);
+            let drawn = brdf.sample_values(wo_local, &self.points[..k], &mut self.samples[..k]);
+            // Shading frame → map frame in one matrix.
+            let local_to_map = env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n);
+            for &(wi, value) in &self.samples[..drawn.min(k)] {
+                let v = luminance(value);
+                if v.is_finite() && v >= 0.0 && wi.is_finite() {
+                    self.dirs[count] = local_to_map * wi;
+                    self.values[count] = v;
+                    count += 1;
                 }
-                i += n;
             }
-            sphere_to_square_batch(&self.dirs[..count], &mut self.uvs[..count]);
-            for (idx, uv) in self.uvs[..count].iter().enumerate() {
+            let uvs = &mut self.points[..count];
+            sphere_to_square_batch(&self.dirs[..count], uvs);
+            for (idx, uv) in uvs.iter().enumerate() {
                 let _ = self.keys.push(sort_key(uv.x, uv.y, idx));
             }
             self.keys.sort_unstable();
@@ -203,24 +205,34 @@ impl<'e> ProductSampler<'_, 'e> {
     pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
         let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
         let eps = self.defensive as f64;
-        let uv = if xi.x < eps {
+        let (uv, pdf_square) = if xi.x < eps {
             xi.x = (xi.x / eps).min(ONE_MINUS_EPSILON);
             let (x, y) = self.env.warp_down(0, 0, 0, &mut xi)?;
-            point_in_cell(x, y, self.env.finest_level(), xi)
+            let uv = point_in_cell(x, y, self.env.finest_level(), xi);
+            (uv, self.pdf_square(uv))
         } else {
             xi.x = ((xi.x - eps) / (1.0 - eps)).clamp(0.0, ONE_MINUS_EPSILON);
-            self.warp_product(&mut xi)?
+            let (uv, btilde, texel) = self.warp_product(&mut xi)?;
+            // The warp knows the leaf and the texel: no second descent for the pdf.
+            (
+                uv,
+                self.mixture(
+                    btilde,
+                    self.env
+                        .node_relative(self.env.finest_level(), texel.0, texel.1),
+                ),
+            )
         };
-        let pdf = self.pdf_square(uv) / SPHERE_AREA;
         Some(DirectionSample {
             dir: self.env.dir_of(uv),
             uv,
-            pdf,
+            pdf: pdf_square / SPHERE_AREA,
         })
     }
 
     /// Warps through the product tree, then below the leaf through the environment's levels.
-    fn warp_product(&self, xi: &mut DVec2) -> Option<Vec2> {
+    /// Returns the point, the leaf's B̃ and the finest-level texel.
+    fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f32, (u32, u32))> {
         let (mut i, mut depth, mut x, mut y) = (0usize, 0u32, 0u32, 0u32);
         while !self.nodes[i].is_leaf() {
             let first = self.nodes[i].child as usize;
@@ -229,13 +241,26 @@ impl<'e> ProductSampler<'_, 'e> {
             let (dx, dy) = child_offset(child);
             (i, depth, x, y) = (first + child, depth + 1, 2 * x + dx, 2 * y + dy);
         }
+        let btilde = self.nodes[i].btilde;
         let finest = self.env.finest_level();
         if depth < finest {
-            let (tx, ty) = self.env.warp_down(depth, x, y, xi)?;
-            Some(point_in_cell(tx, ty, finest, *xi))
+            let texel = self.env.warp_down(depth, x, y, xi)?;
+            Some((point_in_cell(texel.0, texel.1, finest, *xi), btilde, texel))
         } else {
-            Some(point_in_cell(x, y, depth, *xi))
+            let sh = depth - finest;
+            Some((point_in_cell(x, y, depth, *xi), btilde, (x >> sh, y >> sh)))
         }
+    }
+
+    /// The mixture density per unit square area, given the leaf's B̃ and the texel's relative
+    /// importance.
+    #[inline]
+    fn mixture(&self, btilde: f32, env_relative: f32) -> f32 {
+        if self.defensive >= 1.0 {
+            return env_relative;
+        }
+        let product = btilde * env_relative / self.product_mean();
+        (1.0 - self.defensive) * product + self.defensive * env_relative
     }
 
     /// The leaf containing a point of the square, and its depth.
@@ -265,15 +290,9 @@ impl<'e> ProductSampler<'_, 'e> {
     /// Density per unit area of the square at `uv` (the mixture; integrates to 1 over [0,1]²).
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
-        let env_pdf = self.env.pdf_square(uv);
-        if self.defensive >= 1.0 {
-            return env_pdf;
-        }
-        let product = match self.leaf_at(uv) {
-            Some((leaf, _)) => leaf.btilde * env_pdf / self.product_mean(),
-            None => 0.0,
-        };
-        (1.0 - self.defensive) * product + self.defensive * env_pdf
+        let env_relative = self.env.pdf_square(uv);
+        let btilde = self.leaf_at(uv).map_or(0.0, |(leaf, _)| leaf.btilde);
+        self.mixture(btilde, env_relative)
     }
 
     /// Density with respect to solid angle of world direction `dir`.

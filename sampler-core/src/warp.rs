@@ -38,14 +38,15 @@ pub fn choose_child(mass: [f32; 4], xi: &mut DVec2) -> Option<usize> {
 }
 
 /// Chooses side 0 with probability a/total (side 1 otherwise) and rescales `x` into it.
+/// One division: t = x·total is compared against a, then divided by the chosen side's mass.
 #[inline(always)]
 fn pick(a: f64, b: f64, total: f64, x: &mut f64) -> usize {
-    let p = a / total;
-    if (*x < p && a > 0.0) || b <= 0.0 {
-        *x = (*x / p).min(ONE_MINUS_EPSILON);
+    let t = *x * total;
+    if (t < a && a > 0.0) || b <= 0.0 {
+        *x = (t / a).clamp(0.0, ONE_MINUS_EPSILON);
         0
     } else {
-        *x = ((*x - p) / (1.0 - p)).clamp(0.0, ONE_MINUS_EPSILON);
+        *x = ((t - a) / b).clamp(0.0, ONE_MINUS_EPSILON);
         1
     }
 }

@@ -61,6 +61,21 @@ impl CarPaint {
         };
         [coat, flake, base]
     }
+
+    /// A direction from the lobe mixture.
+    fn sample_direction(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let mut ux = u.x;
+        let lobe = pick_lobe(self.lobe_weights(wo), &mut ux)?;
+        let u = Vec2::new(ux, u.y);
+        Some(match lobe {
+            0 => reflect(wo, self.coat_ggx.sample_visible(wo, u)).normalize(),
+            1 => reflect(wo, self.flake_ggx.sample_visible(wo, u)).normalize(),
+            _ => square_to_cosine_hemisphere(u),
+        })
+    }
 }
 
 impl Brdf for CarPaint {
@@ -82,23 +97,18 @@ impl Brdf for CarPaint {
     }
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let mut ux = u.x;
-        let lobe = pick_lobe(self.lobe_weights(wo), &mut ux)?;
-        let u = Vec2::new(ux, u.y);
-        let wi = match lobe {
-            0 => reflect(wo, self.coat_ggx.sample_visible(wo, u)).normalize(),
-            1 => reflect(wo, self.flake_ggx.sample_visible(wo, u)).normalize(),
-            _ => square_to_cosine_hemisphere(u),
-        };
+        let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
         (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
             wi,
             value: self.eval(wo, wi),
             pdf,
         })
+    }
+
+    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
+        let wi = self.sample_direction(wo, u)?;
+        Some((wi, self.eval(wo, wi)))
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

@@ -36,11 +36,7 @@ impl Brdf for RoughConductor {
     }
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let m = self.ggx.sample_visible(wo, u);
-        let wi = reflect(wo, m).normalize();
+        let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
         (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
             wi,
@@ -54,5 +50,44 @@ impl Brdf for RoughConductor {
             Some(h) => self.ggx.pdf_reflected(wo, h),
             None => 0.0,
         }
+    }
+
+    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
+        let wi = self.sample_direction(wo, u)?;
+        Some((wi, self.eval(wo, wi)))
+    }
+
+    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+        if wo.z <= 0.0 {
+            return 0;
+        }
+        // Per view, once: the stretched view and G1(wo)/(4 cosθo).
+        let g = &self.ggx;
+        let w = g.stretch(wo);
+        let k = g.g1(wo) / (4.0 * wo.z);
+        for (p, o) in u.iter().zip(out.iter_mut()) {
+            let m = g.sample_visible_stretched(w, *p);
+            let wi = reflect(wo, m);
+            // m is the half vector of (wo, wi) by construction: no need to recompute it.
+            let f = if wi.z > 0.0 {
+                g.d(m) * g.g1(wi) * k
+            } else {
+                0.0
+            };
+            *o = (wi, self.specular * f);
+        }
+        u.len().min(out.len())
+    }
+}
+
+impl RoughConductor {
+    /// Reflection of `wo` about a visible microfacet normal.
+    #[inline]
+    fn sample_direction(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let m = self.ggx.sample_visible(wo, u);
+        Some(reflect(wo, m).normalize())
     }
 }

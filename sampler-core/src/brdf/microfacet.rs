@@ -2,7 +2,7 @@
 //! Smith G1, and visible-normal sampling (spherical caps, Dupuy & Benyoub 2023), in local
 //! coordinates (normal = +z). Written to stay accurate for α down to 1e-4.
 
-use crate::sampling::TWO_PI;
+use crate::sampling::sin_cos_2pi;
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
@@ -64,12 +64,26 @@ impl Ggx {
     #[inline]
     #[must_use]
     pub fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        self.sample_visible_stretched(self.stretch(wo), u)
+    }
+
+    /// The view in the stretched (α = 1) configuration; depends on `wo` only, so batch samplers
+    /// compute it once.
+    #[inline]
+    #[must_use]
+    pub fn stretch(&self, wo: Vec3) -> Vec3 {
+        Vec3::new(wo.x * self.alpha, wo.y * self.alpha, wo.z).normalize()
+    }
+
+    /// [`Self::sample_visible`] given `w = self.stretch(wo)`.
+    #[inline]
+    #[must_use]
+    pub fn sample_visible_stretched(&self, w: Vec3, u: Vec2) -> Vec3 {
         let a = self.alpha;
-        let w = Vec3::new(wo.x * a, wo.y * a, wo.z).normalize();
-        let phi = TWO_PI * u.x;
+        let (sin_phi, cos_phi) = sin_cos_2pi(u.x);
         let z = (1.0 - u.y) * (1.0 + w.z) - w.z;
         let sin_theta = libm::sqrtf((1.0 - z * z).clamp(0.0, 1.0));
-        let c = Vec3::new(sin_theta * libm::cosf(phi), sin_theta * libm::sinf(phi), z);
+        let c = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, z);
         let h = c + w;
         let m = Vec3::new(h.x * a, h.y * a, h.z.max(0.0));
         let len2 = m.length_squared();

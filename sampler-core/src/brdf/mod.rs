@@ -42,6 +42,28 @@ pub trait Brdf {
     /// Density of [`Brdf::sample`] at `wi` with respect to solid angle (over the whole sphere).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
 
+    /// Draws `wi` like [`Brdf::sample`] and returns it with BRDF × cos but without the density:
+    /// all that building B̃ needs (256 times per shading point). Override it when the density
+    /// costs more than the direction.
+    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
+        self.sample(wo, u).map(|s| (s.wi, s.value))
+    }
+
+    /// [`Brdf::sample_value`] for many points at once: writes `(wi, BRDF × cos)` of each
+    /// successful draw into `out` and returns how many were written (≤ `u.len()`, which must not
+    /// exceed `out.len()`). One call per shading point, so implementations can hoist what
+    /// depends only on `wo`.
+    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+        let mut n = 0;
+        for p in u {
+            if let Some(s) = self.sample_value(wo, *p) {
+                out[n] = s;
+                n += 1;
+            }
+        }
+        n
+    }
+
     /// True when the BRDF is so smooth (e.g. Lambert) that product sampling cannot beat plain
     /// environment sampling by much; hosts may pick the cheaper sampler.
     fn is_diffuse(&self) -> bool {
@@ -58,6 +80,12 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         (**self).pdf(wo, wi)
+    }
+    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
+        (**self).sample_value(wo, u)
+    }
+    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+        (**self).sample_values(wo, u, out)
     }
     fn is_diffuse(&self) -> bool {
         (**self).is_diffuse()

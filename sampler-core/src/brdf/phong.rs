@@ -5,7 +5,8 @@
 use super::{Brdf, BrdfSample, pick_lobe};
 use crate::env::luminance;
 use crate::sampling::{
-    TWO_PI, basis_around, reflect_z, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf,
+    TWO_PI, basis_around, reflect_z, sin_cos_2pi, square_to_cosine_hemisphere,
+    square_to_cosine_hemisphere_pdf,
 };
 use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
@@ -43,6 +44,27 @@ impl Phong {
     fn lobe_weights(&self) -> [f32; 3] {
         [luminance(self.kd), luminance(self.ks), 0.0]
     }
+
+    /// A direction from the lobe mixture (diffuse ∝ cos, specular ∝ cos^n about the mirror).
+    fn sample_direction(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let mut ux = u.x;
+        let lobe = pick_lobe(self.lobe_weights(), &mut ux)?;
+        if lobe == 0 {
+            return Some(square_to_cosine_hemisphere(Vec2::new(ux, u.y)));
+        }
+        // 1 − cos α = −expm1(ln(1−u)/(n+1)), exact for huge n.
+        let one_minus_cos =
+            (-libm::expm1f(libm::logf(1.0 - ux) / (self.exponent + 1.0))).clamp(0.0, 2.0);
+        let cos_a = 1.0 - one_minus_cos;
+        let sin_a = libm::sqrtf((one_minus_cos * (2.0 - one_minus_cos)).max(0.0));
+        let (sin_phi, cos_phi) = sin_cos_2pi(u.y);
+        let r = reflect_z(wo);
+        let (s, t) = basis_around(r);
+        Some((s * (sin_a * cos_phi) + t * (sin_a * sin_phi) + r * cos_a).normalize())
+    }
 }
 
 impl Brdf for Phong {
@@ -55,30 +77,18 @@ impl Brdf for Phong {
     }
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let mut ux = u.x;
-        let lobe = pick_lobe(self.lobe_weights(), &mut ux)?;
-        let wi = if lobe == 0 {
-            square_to_cosine_hemisphere(Vec2::new(ux, u.y))
-        } else {
-            // 1 − cos α = −expm1(ln(1−u)/(n+1)), exact for huge n.
-            let one_minus_cos = -libm::expm1f(libm::logf(1.0 - ux) / (self.exponent + 1.0));
-            let one_minus_cos = one_minus_cos.clamp(0.0, 2.0);
-            let cos_a = 1.0 - one_minus_cos;
-            let sin_a = libm::sqrtf((one_minus_cos * (2.0 - one_minus_cos)).max(0.0));
-            let phi = TWO_PI * u.y;
-            let r = reflect_z(wo);
-            let (s, t) = basis_around(r);
-            (s * (sin_a * libm::cosf(phi)) + t * (sin_a * libm::sinf(phi)) + r * cos_a).normalize()
-        };
+        let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
         (pdf > 0.0).then(|| BrdfSample {
             wi,
             value: self.eval(wo, wi),
             pdf,
         })
+    }
+
+    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
+        let wi = self.sample_direction(wo, u)?;
+        Some((wi, self.eval(wo, wi)))
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

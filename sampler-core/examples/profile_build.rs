@@ -1,0 +1,60 @@
+//! Runs many shading-point builds in a loop, for profilers (`perf record`, callgrind).
+//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations]`
+
+use glam::{DVec2, Vec2, Vec3};
+use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
+use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+use sampler_core::frame::Frame;
+use sampler_core::mapping::square_to_sphere;
+use sampler_core::points::sobol02;
+use sampler_core::rng::Pcg32;
+use sampler_core::sampler::{ProductArena, ProductParams};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let which = args.get(1).map_or("ggx", String::as_str);
+    let iters: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(50_000);
+    let brdf: Box<dyn Brdf> = match which {
+        "lambert" => Box::new(Lambert::new(Vec3::splat(0.5))),
+        "phong" => Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),
+        "carpaint" => Box::new(CarPaint::default()),
+        _ => Box::new(RoughConductor::new(0.1, Vec3::ONE)),
+    };
+    let level = 10;
+    let n = 1usize << level;
+    let mut rgb = vec![[0.5f32; 3]; n * n];
+    rgb[n * 300 + 200] = [1e5; 3];
+    let mut pyramid = vec![0.0; pyramid_len(level)];
+    build_pyramid(level, &rgb, &mut pyramid).unwrap();
+    let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
+    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    let mut rng = Pcg32::new(1, 1);
+    let mut acc = 0.0f64;
+    let mut nodes = 0usize;
+    let t = std::time::Instant::now();
+    for i in 0..iters {
+        let normal = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
+        let frame = Frame::from_normal(normal);
+        let wo = frame.to_world(Vec3::new(0.2, 0.1, 1.0).normalize());
+        let s = arena.build(
+            &env,
+            brdf.as_ref(),
+            &frame,
+            wo,
+            &ProductParams::default(),
+            i,
+        );
+        nodes += s.node_count();
+        let mut pts = [DVec2::ZERO; 16];
+        sobol02(i, 0, &mut pts);
+        for u in pts {
+            acc += s.sample(u).map_or(0.0, |d| d.pdf as f64);
+        }
+    }
+    let dt = t.elapsed().as_secs_f64();
+    println!(
+        "{which}: {:.2} µs per shading point, {:.0} nodes on average ({acc:.3e})",
+        dt / iters as f64 * 1e6,
+        nodes as f64 / iters as f64
+    );
+}
