@@ -52,6 +52,60 @@ fn main() {
         }
     }
     let dt = t.elapsed().as_secs_f64();
+    // Stages, each over the same shading points.
+    let mut frames = Vec::new();
+    let mut rng = Pcg32::new(1, 1);
+    for _ in 0..1000 {
+        let normal = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
+        let frame = Frame::from_normal(normal);
+        frames.push((frame, frame.to_world(Vec3::new(0.2, 0.1, 1.0).normalize())));
+    }
+    let reps = (iters / 1000).max(1);
+    let per = |t: std::time::Instant| t.elapsed().as_secs_f64() / (reps * 1000) as f64 * 1e6;
+    let mut pts = vec![Vec2::ZERO; 256];
+    let mut out = vec![(Vec3::ZERO, Vec3::ZERO); 256];
+    let t0 = std::time::Instant::now();
+    for r in 0..reps {
+        for (i, (frame, wo)) in frames.iter().enumerate() {
+            sampler_core::points::sobol02_shifted(r * 1000 + i as u64, 0, &mut pts);
+            let n = brdf.sample_values(frame.to_local(*wo), &pts, &mut out);
+            acc += out[n / 2].1.x as f64;
+        }
+    }
+    let a = per(t0);
+    let t0 = std::time::Instant::now();
+    for r in 0..reps {
+        for (i, (frame, wo)) in frames.iter().enumerate() {
+            let s = arena.build(
+                &env,
+                brdf.as_ref(),
+                frame,
+                *wo,
+                &ProductParams::default(),
+                r * 1000 + i as u64,
+            );
+            nodes += s.node_count();
+        }
+    }
+    let b = per(t0);
+    let t0 = std::time::Instant::now();
+    let s = arena.build(
+        &env,
+        brdf.as_ref(),
+        &frames[0].0,
+        frames[0].1,
+        &ProductParams::default(),
+        1,
+    );
+    let mut p16 = [DVec2::ZERO; 16];
+    for r in 0..reps * 1000 {
+        sobol02(r, 0, &mut p16);
+        for u in p16 {
+            acc += s.sample(u).map_or(0.0, |d| d.pdf as f64);
+        }
+    }
+    let c = per(t0);
+    println!("stages: 256 BRDF samples {a:.2} µs, full build {b:.2} µs, 16 warps {c:.2} µs");
     println!(
         "{which}: {:.2} µs per shading point, {:.0} nodes on average ({acc:.3e})",
         dt / iters as f64 * 1e6,

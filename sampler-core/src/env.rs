@@ -1,12 +1,14 @@
 //! The environment hierarchy: a borrowed view over a caller-owned mip pyramid of the
 //! equal-area map.
 //!
-//! Level `k` is a `2^k × 2^k` grid of scalar importance (luminance), row-major (`x` along `u`,
-//! `y` along `v`), levels packed from the 1×1 root down to the finest level `K`: level `k`
-//! starts at [`level_offset`]`(k)`, the whole pyramid holds [`pyramid_len`]`(K)` values (4/3 of
-//! the finest level). Because every texel of the equal-area map covers the same solid angle,
-//! each coarser texel is the plain mean of its four children. RGB radiance for shading is kept
-//! at the finest level only. Lookups are nearest-texel, the same piecewise-constant function the
+//! Level `k` is a `2^k × 2^k` grid of scalar importance (luminance) with `x` along `u` and `y`
+//! along `v`, stored in Morton (Z) order so that a node's four children are one contiguous
+//! 16-byte block and a subtree stays together in memory — the warp touches one cache line per
+//! level. Levels are packed from the 1×1 root down to the finest level `K`: level `k` starts at
+//! [`level_offset`]`(k)`, node `(x, y)` sits at [`pyramid_index`]; the whole pyramid holds
+//! [`pyramid_len`]`(K)` values (4/3 of the finest level). Because every texel of the equal-area
+//! map covers the same solid angle, each coarser texel is the plain mean of its four children.
+//! RGB radiance for shading is kept at the finest level only, row-major. Lookups are nearest-texel, the same piecewise-constant function the
 //! sampling densities are built from, so radiance cancels exactly in the product estimator.
 
 use crate::mapping::{SPHERE_AREA, sphere_to_square, square_to_sphere, texel_of};
@@ -30,6 +32,27 @@ pub const fn pyramid_len(finest: u32) -> usize {
     level_offset(finest + 1)
 }
 
+/// Index of node `(x, y)` of `level` in a packed pyramid (Morton order within the level).
+#[inline]
+#[must_use]
+pub fn pyramid_index(level: u32, x: u32, y: u32) -> usize {
+    level_offset(level) + morton2(x, y)
+}
+
+/// Interleaves the bits of two 16-bit coordinates (x in the even bits).
+#[inline]
+#[must_use]
+pub fn morton2(x: u32, y: u32) -> usize {
+    fn spread(v: u32) -> u32 {
+        let mut v = v & 0xFFFF;
+        v = (v | (v << 8)) & 0x00FF_00FF;
+        v = (v | (v << 4)) & 0x0F0F_0F0F;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    }
+    (spread(x) | (spread(y) << 1)) as usize
+}
+
 /// Rec. 709 luminance: the scalar importance of an RGB radiance.
 #[inline]
 #[must_use]
@@ -37,7 +60,7 @@ pub fn luminance(c: Vec3) -> f32 {
     0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
 }
 
-/// What can be wrong with the buffers handed to [`EnvHierarchy::new`] or [`fill_pyramid`].
+/// What can be wrong with the buffers handed to [`EnvHierarchy::new`] or [`build_pyramid`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvError {
     /// The finest level is larger than [`MAX_LEVEL`].
@@ -94,46 +117,47 @@ pub fn sanitize_rgb(texels: &mut [[f32; 3]]) -> usize {
     bad
 }
 
-/// Writes the luminance of each RGB texel into the finest level of `pyramid` and fills the
-/// coarser levels. The RGB must be sanitized ([`sanitize_rgb`]).
+/// Writes the luminance of each RGB texel (row-major, sanitized with [`sanitize_rgb`]) into the
+/// finest level of `pyramid` and fills the coarser levels.
 pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Result<(), EnvError> {
     check_lengths(finest, rgb.len(), pyramid.len())?;
-    let base = level_offset(finest);
-    for (dst, c) in pyramid[base..].iter_mut().zip(rgb) {
-        *dst = luminance(Vec3::from_array(*c));
+    let n = 1usize << finest;
+    for (i, c) in rgb.iter().enumerate() {
+        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] =
+            luminance(Vec3::from_array(*c));
     }
-    fill_pyramid(finest, pyramid)
+    fill_pyramid(finest, pyramid);
+    Ok(())
 }
 
-/// Fills levels `finest − 1 … 0` of a packed pyramid from its finest level (box average,
-/// accumulated in f64 so that radiances up to f32::MAX do not overflow).
-pub fn fill_pyramid(finest: u32, pyramid: &mut [f32]) -> Result<(), EnvError> {
-    if finest > MAX_LEVEL {
-        return Err(EnvError::TooLarge { finest });
+/// Like [`build_pyramid`] from a row-major scalar importance of the finest level (any
+/// non-negative finite weight that is > 0 wherever the radiance is).
+pub fn build_pyramid_from_importance(
+    finest: u32,
+    importance: &[f32],
+    pyramid: &mut [f32],
+) -> Result<(), EnvError> {
+    check_lengths(finest, importance.len(), pyramid.len())?;
+    let n = 1usize << finest;
+    for (i, v) in importance.iter().enumerate() {
+        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = *v;
     }
-    if pyramid.len() != pyramid_len(finest) {
-        return Err(EnvError::WrongLength {
-            buffer: "pyramid",
-            expected: pyramid_len(finest),
-            found: pyramid.len(),
-        });
-    }
+    fill_pyramid(finest, pyramid);
+    Ok(())
+}
+
+/// Fills levels `finest − 1 … 0` from the finest level: in Morton order the four children of
+/// node `i` are `4i .. 4i + 4` of the next level. Accumulated in f64 so that radiances up to
+/// f32::MAX do not overflow.
+fn fill_pyramid(finest: u32, pyramid: &mut [f32]) {
     for level in (0..finest).rev() {
         let (coarse, fine) = pyramid.split_at_mut(level_offset(level + 1));
         let coarse = &mut coarse[level_offset(level)..];
-        let n = 1usize << level;
-        let nf = 2 * n;
-        for y in 0..n {
-            for x in 0..n {
-                let a = fine[(2 * y) * nf + 2 * x] as f64;
-                let b = fine[(2 * y) * nf + 2 * x + 1] as f64;
-                let c = fine[(2 * y + 1) * nf + 2 * x] as f64;
-                let d = fine[(2 * y + 1) * nf + 2 * x + 1] as f64;
-                coarse[y * n + x] = (0.25 * (a + b + c + d)) as f32;
-            }
+        for (i, c) in coarse.iter_mut().enumerate() {
+            let q = &fine[4 * i..4 * i + 4];
+            *c = (0.25 * ((q[0] as f64 + q[1] as f64) + (q[2] as f64 + q[3] as f64))) as f32;
         }
     }
-    Ok(())
 }
 
 fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError> {
@@ -250,8 +274,7 @@ impl<'a> EnvHierarchy<'a> {
     #[inline]
     #[must_use]
     pub fn node_relative(&self, level: u32, x: u32, y: u32) -> f32 {
-        let n = 1usize << level;
-        self.pyramid[level_offset(level) + y as usize * n + x as usize] * self.inv_mean
+        self.pyramid[pyramid_index(level, x, y)] * self.inv_mean
     }
 
     /// The four children of node `(x, y)` of `level` (which must be < K), relative to the mean,
@@ -259,16 +282,10 @@ impl<'a> EnvHierarchy<'a> {
     #[inline]
     #[must_use]
     pub fn children_relative(&self, level: u32, x: u32, y: u32) -> [f32; 4] {
-        let n = 2usize << level;
-        let base = level_offset(level + 1) + (2 * y as usize) * n + 2 * x as usize;
-        let p = self.pyramid;
+        let base = level_offset(level + 1) + 4 * morton2(x, y);
+        let q = &self.pyramid[base..base + 4];
         let s = self.inv_mean;
-        [
-            p[base] * s,
-            p[base + 1] * s,
-            p[base + n] * s,
-            p[base + n + 1] * s,
-        ]
+        [q[0] * s, q[1] * s, q[2] * s, q[3] * s]
     }
 
     /// Mean importance (relative) of the region covered by a quadtree cell at any depth:
@@ -403,9 +420,36 @@ mod tests {
             1.0, 2.0, 0.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0, 8.0, 8.0, 0.0, 0.0, 8.0, 8.0,
         ];
         p[5..].copy_from_slice(&fine);
-        fill_pyramid(2, &mut p).unwrap();
+        build_pyramid_from_importance(2, &fine, &mut p).unwrap();
         assert_eq!(&p[1..5], &[2.5, 0.0, 0.0, 8.0]);
         assert_eq!(p[0], 2.625);
+    }
+
+    #[test]
+    fn children_are_the_next_level_and_average_to_the_parent() {
+        let mut rgb = [[0.0f32; 3]; 64];
+        for (i, t) in rgb.iter_mut().enumerate() {
+            *t = [(i * 7 % 11) as f32, 1.0, (i % 5) as f32];
+        }
+        let mut p = [0.0f32; 85];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        let e = EnvHierarchy::new(3, &p, &rgb).unwrap();
+        for l in 0..3u32 {
+            for y in 0..(1u32 << l) {
+                for x in 0..(1u32 << l) {
+                    let c = e.children_relative(l, x, y);
+                    let at = |dx, dy| e.node_relative(l + 1, 2 * x + dx, 2 * y + dy);
+                    assert_eq!(c, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)]);
+                    let mean = 0.25 * c.iter().sum::<f32>();
+                    assert!((mean - e.node_relative(l, x, y)).abs() <= 1e-6 * mean);
+                }
+            }
+        }
+        // The finest level reads back the row-major input.
+        assert_eq!(
+            e.node_relative(3, 5, 2) / e.inv_mean,
+            luminance(Vec3::from_array(rgb[2 * 8 + 5]))
+        );
     }
 
     #[test]

@@ -56,37 +56,70 @@ pub fn best_candidate(rng: &mut Pcg32, candidates: usize, out: &mut [DVec2]) {
     }
 }
 
+/// Generator matrix columns of the first two Sobol' dimensions: the identity (van der
+/// Corput, bits reversed) and the primitive polynomial x + 1 (vₖ = vₖ₋₁ ⊕ (vₖ₋₁ >> 1)).
+const fn generator(dim: usize) -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        v[k] = if dim == 0 {
+            1 << (31 - k)
+        } else if k == 0 {
+            1 << 31
+        } else {
+            v[k - 1] ^ (v[k - 1] >> 1)
+        };
+        k += 1;
+    }
+    v
+}
+
+/// Sobol' points are linear over GF(2) in the index bits: x(i) = ⊕ over the bytes of i of a
+/// 256-entry table per byte. Four byte tables per dimension (8 KB in all), built at compile time.
+const fn byte_tables(dim: usize) -> [[u32; 256]; 4] {
+    let v = generator(dim);
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut i = 0;
+        while i < 256 {
+            let mut x = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if i & (1 << bit) != 0 {
+                    x ^= v[8 * b + bit];
+                }
+                bit += 1;
+            }
+            t[b][i] = x;
+            i += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
+static SOBOL_TABLES: [[[u32; 256]; 4]; 2] = [byte_tables(0), byte_tables(1)];
+
+#[inline(always)]
+fn sobol(dim: usize, index: u32) -> u32 {
+    let t = &SOBOL_TABLES[dim];
+    let b = index.to_le_bytes();
+    t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize]
+}
+
 /// Point `index` of the first Sobol' dimension (van der Corput) as a 32-bit fraction.
 #[inline]
 #[must_use]
 pub fn sobol_dim0(index: u32) -> u32 {
-    index.reverse_bits()
+    sobol(0, index)
 }
-
-/// Generator matrix columns of the second Sobol' dimension (primitive polynomial x + 1):
-/// v₀ = 2³¹, vₖ = vₖ₋₁ ⊕ (vₖ₋₁ >> 1).
-const SOBOL1: [u32; 32] = {
-    let mut v = [0u32; 32];
-    v[0] = 1 << 31;
-    let mut k = 1;
-    while k < 32 {
-        v[k] = v[k - 1] ^ (v[k - 1] >> 1);
-        k += 1;
-    }
-    v
-};
 
 /// Point `index` of the second Sobol' dimension.
 #[inline]
 #[must_use]
 pub fn sobol_dim1(index: u32) -> u32 {
-    let mut x = 0u32;
-    let mut i = index;
-    while i != 0 {
-        x ^= SOBOL1[i.trailing_zeros() as usize];
-        i &= i - 1;
-    }
-    x
+    sobol(1, index)
 }
 
 /// Owen scrambling by hashing (Burley 2020, after Laine & Karras 2011).
@@ -136,6 +169,23 @@ pub fn sobol02_shifted(seed: u64, first: u32, out: &mut [Vec2]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tables_match_the_definition() {
+        for i in [0u32, 1, 2, 3, 255, 256, 1000, 65_537, u32::MAX] {
+            assert_eq!(sobol_dim0(i), i.reverse_bits());
+            let mut v = 1u32 << 31;
+            let (mut x, mut j) = (0u32, i);
+            while j != 0 {
+                if j & 1 != 0 {
+                    x ^= v;
+                }
+                j >>= 1;
+                v ^= v >> 1;
+            }
+            assert_eq!(sobol_dim1(i), x, "{i}");
+        }
+    }
 
     /// Every elementary interval of area 1/n holds exactly one point.
     fn is_02_net(points: &[DVec2]) -> bool {

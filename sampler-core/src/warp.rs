@@ -57,17 +57,16 @@ fn pick(a: f64, b: f64, total: f64, x: &mut f64) -> usize {
 #[inline]
 #[must_use]
 pub fn point_in_cell(x: u32, y: u32, level: u32, xi: DVec2) -> glam::Vec2 {
-    let inv = 1.0 / (1u64 << level) as f64;
+    // 2^−level exactly, without a division.
+    let inv = f64::from_bits((1023 - level as u64) << 52);
     let coord = |i: u32, f: f64| -> f32 {
-        let lo = i as f64 * inv;
-        let hi = (i + 1) as f64 * inv;
+        let lo = (i as f64 * inv) as f32; // exact: dyadic
+        let hi = ((i + 1) as f64 * inv) as f32;
         let c = ((i as f64 + f) * inv) as f32;
-        let hi_f = hi as f32; // exact: dyadic
-        let lo_f = lo as f32;
-        if c >= hi_f {
-            next_down(hi_f).max(lo_f)
+        if c >= hi {
+            next_down(hi).max(lo)
         } else {
-            c.max(lo_f)
+            c.max(lo)
         }
     };
     glam::Vec2::new(coord(x, xi.x), coord(y, xi.y))

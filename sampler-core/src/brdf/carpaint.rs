@@ -111,6 +111,49 @@ impl Brdf for CarPaint {
         Some((wi, self.eval(wo, wi)))
     }
 
+    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+        let w = self.lobe_weights(wo);
+        let total = w[0] + w[1] + w[2];
+        if wo.z <= 0.0 || total.is_nan() || total <= 0.0 {
+            return 0;
+        }
+        // Per view, once: stretched views, G1(wo)/(4 cosθo) of both lobes, the coat's
+        // transmission towards the viewer and the cumulative lobe probabilities.
+        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
+        let (wc, wf) = (c.stretch(wo), f.stretch(wo));
+        let kc = self.coat * c.g1(wo) / (4.0 * wo.z);
+        let kf = f.g1(wo) / (4.0 * wo.z);
+        let transmit_o = 1.0 - fresnel_schlick(self.coat_f0, wo.z);
+        let (p0, p1) = (w[0] / total, (w[0] + w[1]) / total);
+        let base = self.base * FRAC_1_PI;
+        for (p, o) in u.iter().zip(out.iter_mut()) {
+            let wi = if p.x < p0 {
+                reflect(wo, c.sample_visible_stretched(wc, Vec2::new(p.x / p0, p.y)))
+            } else if p.x < p1 {
+                reflect(
+                    wo,
+                    f.sample_visible_stretched(wf, Vec2::new((p.x - p0) / (p1 - p0), p.y)),
+                )
+            } else {
+                square_to_cosine_hemisphere(Vec2::new(
+                    ((p.x - p1) / (1.0 - p1)).min(1.0 - f32::EPSILON / 2.0),
+                    p.y,
+                ))
+            };
+            let value = match half_vector(wo, wi) {
+                Some(h) if wi.z > 0.0 => {
+                    let coat = kc * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi);
+                    let flake = kf * f.d(h) * f.g1(wi);
+                    let transmit = transmit_o * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
+                    Vec3::splat(coat) + transmit * (self.flake * flake + base * wi.z)
+                }
+                _ => Vec3::ZERO,
+            };
+            *o = (wi, value);
+        }
+        u.len().min(out.len())
+    }
+
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 {
             return 0.0;

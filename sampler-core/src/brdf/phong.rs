@@ -9,6 +9,9 @@ use crate::sampling::{
     square_to_cosine_hemisphere_pdf,
 };
 use core::f32::consts::FRAC_1_PI;
+
+/// Largest f32 below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 use glam::{Vec2, Vec3};
 
 /// f = kd/π + ks·(n+2)/(2π)·cos^n α, α the angle between ωi and the mirror of ωo.
@@ -89,6 +92,52 @@ impl Brdf for Phong {
     fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
         let wi = self.sample_direction(wo, u)?;
         Some((wi, self.eval(wo, wi)))
+    }
+
+    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+        let w = self.lobe_weights();
+        let total = w[0] + w[1];
+        if wo.z <= 0.0 || total.is_nan() || total <= 0.0 {
+            return 0;
+        }
+        // Per view, once: the mirror frame, the normalisations and the lobe choice.
+        let p_diffuse = w[0] / total;
+        let r = reflect_z(wo);
+        let (s, t) = basis_around(r);
+        let kd = self.kd * FRAC_1_PI;
+        let ks = self.ks * ((self.exponent + 2.0) / TWO_PI);
+        let inv_n1 = 1.0 / (self.exponent + 1.0);
+        for (p, o) in u.iter().zip(out.iter_mut()) {
+            let (wi, lobe) = if p.x < p_diffuse {
+                let wi =
+                    square_to_cosine_hemisphere(Vec2::new((p.x / p_diffuse).min(ONE_BELOW), p.y));
+                (wi, self.lobe(r, wi))
+            } else {
+                let ux = ((p.x - p_diffuse) / (1.0 - p_diffuse)).clamp(0.0, ONE_BELOW);
+                let ln = libm::logf(1.0 - ux);
+                let one_minus_cos = (-libm::expm1f(ln * inv_n1)).clamp(0.0, 2.0);
+                let cos_a = 1.0 - one_minus_cos;
+                let sin_a = libm::sqrtf((one_minus_cos * (2.0 - one_minus_cos)).max(0.0));
+                let (sin_phi, cos_phi) = sin_cos_2pi(p.y);
+                let wi = (s * (sin_a * cos_phi) + t * (sin_a * sin_phi) + r * cos_a).normalize();
+                // cosⁿα = (1 − u)^(n/(n+1)): no need to evaluate the lobe again.
+                let lobe = if cos_a > 0.0 {
+                    libm::expf(ln * self.exponent * inv_n1)
+                } else {
+                    0.0
+                };
+                (wi, lobe)
+            };
+            *o = (
+                wi,
+                if wi.z > 0.0 {
+                    (kd + ks * lobe) * wi.z
+                } else {
+                    Vec3::ZERO
+                },
+            );
+        }
+        u.len().min(out.len())
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
