@@ -182,7 +182,7 @@ fn shading_points(c: &mut Criterion) {
         g.finish();
     }
     eprintln!(
-        "arena: ProductArena<256, 4096> = {} bytes",
+        "arena: ProductArena<256, 2048> = {} bytes",
         std::mem::size_of::<ProductArena>()
     );
 }
