@@ -63,13 +63,13 @@ fn main() {
     let reps = (iters / 1000).max(1);
     let per = |t: std::time::Instant| t.elapsed().as_secs_f64() / (reps * 1000) as f64 * 1e6;
     let mut pts = vec![Vec2::ZERO; 256];
-    let mut out = vec![(Vec3::ZERO, Vec3::ZERO); 256];
+    let mut out = vec![sampler_core::brdf::BrdfDraw::default(); 256];
     let t0 = std::time::Instant::now();
     for r in 0..reps {
         for (i, (frame, wo)) in frames.iter().enumerate() {
             sampler_core::points::sobol02_shifted(r * 1000 + i as u64, 0, &mut pts);
-            let n = brdf.sample_values(frame.to_local(*wo), &pts, &mut out);
-            acc += out[n / 2].1.x as f64;
+            let n = brdf.sample_batch(frame.to_local(*wo), &pts, &mut out);
+            acc += out[n / 2].value as f64;
         }
     }
     let a = per(t0);

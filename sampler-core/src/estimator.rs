@@ -162,3 +162,40 @@ pub fn mis<B: Brdf + ?Sized>(
     }
     out
 }
+
+/// MIS of product sampling and BRDF sampling, balance heuristic, one sample each: the product
+/// keeps its edge where lighting varies, and BRDF sampling keeps needle-sharp lobes under
+/// smooth lighting (where f/p_brdf is nearly constant) as good as they can be. The sum of the
+/// two contributions is the estimate.
+pub fn product_mis<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: DVec2,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
+    let env_h = sampler.env();
+    let mut out = [Contribution::default(); 2];
+    if let Some(s) = sampler.sample(u_product) {
+        let p_brdf = sp.brdf_pdf(s.dir);
+        let f = env_h.radiance(s.dir) * sp.eval(s.dir);
+        out[0] = Contribution {
+            dir: s.dir,
+            value: weighted(f, s.pdf + p_brdf, vis, s.dir),
+            pdf: s.pdf,
+            other_pdf: p_brdf,
+        };
+    }
+    if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
+        let dir = sp.frame.to_world(s.wi);
+        let p_product = sampler.pdf(dir);
+        let f = env_h.radiance(dir) * s.value;
+        out[1] = Contribution {
+            dir,
+            value: weighted(f, s.pdf + p_product, vis, dir),
+            pdf: s.pdf,
+            other_pdf: p_product,
+        };
+    }
+    out
+}

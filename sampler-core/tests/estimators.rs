@@ -212,6 +212,37 @@ fn run(estimator: &str) {
                     .map(|_| lum(estimator::env(&e, &sp, u(), &mut vis).value))
                     .collect()
             }
+            "product-mis" => {
+                let params = ProductParams::default();
+                (0..600u64)
+                    .map(|seed| {
+                        let s = arena.build(
+                            &e,
+                            case.brdf.as_ref(),
+                            &case.frame,
+                            case.wo,
+                            &params,
+                            seed,
+                        );
+                        let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
+                        sobol02(seed ^ 0xdef, 0, &mut pts);
+                        sobol02(seed ^ 0x123, 0, &mut qts);
+                        (0..32)
+                            .map(|k| {
+                                let [a, b] = estimator::product_mis(
+                                    &s,
+                                    &sp,
+                                    pts[k],
+                                    qts[k].as_vec2(),
+                                    &mut vis,
+                                );
+                                lum(a.value + b.value)
+                            })
+                            .sum::<f64>()
+                            / 32.0
+                    })
+                    .collect()
+            }
             "brdf" => (0..200_000)
                 .map(|_| lum(estimator::brdf(&e, &sp, u(), &mut vis).value))
                 .collect(),
@@ -241,6 +272,11 @@ fn product_estimator_is_unbiased() {
 #[test]
 fn wavelet_product_estimator_is_unbiased() {
     run("wavelet");
+}
+
+#[test]
+fn product_mis_estimator_is_unbiased() {
+    run("product-mis");
 }
 
 #[test]

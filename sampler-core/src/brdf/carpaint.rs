@@ -4,7 +4,7 @@
 //! This is the paper's hard case: a wide lobe and a needle-sharp one in one BRDF.
 
 use super::microfacet::{Ggx, fresnel_schlick, half_vector};
-use super::{Brdf, BrdfSample, pick_lobe};
+use super::{Brdf, BrdfDraw, BrdfSample, pick_lobe};
 use crate::env::luminance;
 use crate::sampling::{reflect, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use core::f32::consts::FRAC_1_PI;
@@ -106,12 +106,7 @@ impl Brdf for CarPaint {
         })
     }
 
-    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
-        let wi = self.sample_direction(wo, u)?;
-        Some((wi, self.eval(wo, wi)))
-    }
-
-    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         let w = self.lobe_weights(wo);
         let total = w[0] + w[1] + w[2];
         if wo.z <= 0.0 || total.is_nan() || total <= 0.0 {
@@ -121,11 +116,10 @@ impl Brdf for CarPaint {
         // transmission towards the viewer and the cumulative lobe probabilities.
         let (c, f) = (&self.coat_ggx, &self.flake_ggx);
         let (wc, wf) = (c.stretch(wo), f.stretch(wo));
-        let kc = self.coat * c.g1(wo) / (4.0 * wo.z);
-        let kf = f.g1(wo) / (4.0 * wo.z);
+        let (gc, gf) = (c.g1(wo) / (4.0 * wo.z), f.g1(wo) / (4.0 * wo.z));
         let transmit_o = 1.0 - fresnel_schlick(self.coat_f0, wo.z);
         let (p0, p1) = (w[0] / total, (w[0] + w[1]) / total);
-        let base = self.base * FRAC_1_PI;
+        let (flake, base) = (luminance(self.flake), luminance(self.base) * FRAC_1_PI);
         for (p, o) in u.iter().zip(out.iter_mut()) {
             let wi = if p.x < p0 {
                 reflect(wo, c.sample_visible_stretched(wc, Vec2::new(p.x / p0, p.y)))
@@ -142,14 +136,17 @@ impl Brdf for CarPaint {
             };
             let value = match half_vector(wo, wi) {
                 Some(h) if wi.z > 0.0 => {
-                    let coat = kc * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi);
-                    let flake = kf * f.d(h) * f.g1(wi);
+                    let coat = self.coat
+                        * gc
+                        * fresnel_schlick(self.coat_f0, wo.dot(h))
+                        * c.d(h)
+                        * c.g1(wi);
                     let transmit = transmit_o * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
-                    Vec3::splat(coat) + transmit * (self.flake * flake + base * wi.z)
+                    coat + transmit * (flake * gf * f.d(h) * f.g1(wi) + base * wi.z)
                 }
-                _ => Vec3::ZERO,
+                _ => 0.0,
             };
-            *o = (wi, value);
+            *o = BrdfDraw { wi, value };
         }
         u.len().min(out.len())
     }

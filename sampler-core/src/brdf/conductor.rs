@@ -2,7 +2,8 @@
 //! Smith shadowing: f = specular · D(h)·G1(ωi)·G1(ωo) / (4 cosθi cosθo).
 
 use super::microfacet::{Ggx, half_vector};
-use super::{Brdf, BrdfSample};
+use super::{Brdf, BrdfDraw, BrdfSample};
+use crate::env::luminance;
 use crate::sampling::reflect;
 use glam::{Vec2, Vec3};
 
@@ -52,29 +53,23 @@ impl Brdf for RoughConductor {
         }
     }
 
-    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
-        let wi = self.sample_direction(wo, u)?;
-        Some((wi, self.eval(wo, wi)))
-    }
-
-    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         if wo.z <= 0.0 {
             return 0;
         }
         // Per view, once: the stretched view and G1(wo)/(4 cosθo).
         let g = &self.ggx;
         let w = g.stretch(wo);
-        let k = g.g1(wo) / (4.0 * wo.z);
+        let spec = luminance(self.specular);
+        let k = spec * g.g1(wo) / (4.0 * wo.z);
         for (p, o) in u.iter().zip(out.iter_mut()) {
             let m = g.sample_visible_stretched(w, *p);
             let wi = reflect(wo, m);
             // m is the half vector of (wo, wi) by construction: no need to recompute it.
-            let f = if wi.z > 0.0 {
-                g.d(m) * g.g1(wi) * k
-            } else {
-                0.0
+            *o = BrdfDraw {
+                wi,
+                value: g.d(m) * g.g1(wi) * k,
             };
-            *o = (wi, self.specular * f);
         }
         u.len().min(out.len())
     }

@@ -1,6 +1,7 @@
 //! Lambertian diffuse reflection.
 
-use super::{Brdf, BrdfSample};
+use super::{Brdf, BrdfDraw, BrdfSample};
+use crate::env::luminance;
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
@@ -45,6 +46,21 @@ impl Brdf for Lambert {
         } else {
             square_to_cosine_hemisphere_pdf(wi)
         }
+    }
+
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
+        if wo.z <= 0.0 {
+            return 0;
+        }
+        let albedo = luminance(self.albedo);
+        for (p, o) in u.iter().zip(out.iter_mut()) {
+            let wi = square_to_cosine_hemisphere(*p);
+            *o = BrdfDraw {
+                wi,
+                value: albedo * FRAC_1_PI * wi.z.max(0.0),
+            };
+        }
+        u.len().min(out.len())
     }
 
     fn is_diffuse(&self) -> bool {

@@ -16,6 +16,7 @@ pub use conductor::RoughConductor;
 pub use lambert::Lambert;
 pub use phong::Phong;
 
+use crate::env::luminance;
 use glam::{Vec2, Vec3};
 
 /// A direction drawn by a BRDF's own importance sampler.
@@ -27,6 +28,15 @@ pub struct BrdfSample {
     pub value: Vec3,
     /// Density with respect to solid angle; > 0.
     pub pdf: f32,
+}
+
+/// A direction drawn for building B̃: luminances only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BrdfDraw {
+    /// Sampled incident direction (local frame).
+    pub wi: Vec3,
+    /// Luminance of BRDF × cosθ_i at `wi`.
+    pub value: f32,
 }
 
 /// A reflectance model that can be evaluated, importance-sampled, and whose sampling density
@@ -42,22 +52,18 @@ pub trait Brdf {
     /// Density of [`Brdf::sample`] at `wi` with respect to solid angle (over the whole sphere).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
 
-    /// Draws `wi` like [`Brdf::sample`] and returns it with BRDF × cos but without the density:
-    /// all that building B̃ needs (256 times per shading point). Override it when the density
-    /// costs more than the direction.
-    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
-        self.sample(wo, u).map(|s| (s.wi, s.value))
-    }
-
-    /// [`Brdf::sample_value`] for many points at once: writes `(wi, BRDF × cos)` of each
-    /// successful draw into `out` and returns how many were written (≤ `u.len()`, which must not
-    /// exceed `out.len()`). One call per shading point, so implementations can hoist what
-    /// depends only on `wo`.
-    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+    /// Draws one direction per point of `u` like [`Brdf::sample`], for building B̃: writes
+    /// each successful draw's direction and the luminance of BRDF × cos into `out`, and returns how many were written (≤ `u.len()` ≤
+    /// `out.len()`). One call per shading point, so implementations can hoist what depends only
+    /// on `wo`, and skip the RGB work.
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         let mut n = 0;
         for p in u {
-            if let Some(s) = self.sample_value(wo, *p) {
-                out[n] = s;
+            if let Some(s) = self.sample(wo, *p) {
+                out[n] = BrdfDraw {
+                    wi: s.wi,
+                    value: luminance(s.value),
+                };
                 n += 1;
             }
         }
@@ -81,11 +87,8 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         (**self).pdf(wo, wi)
     }
-    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
-        (**self).sample_value(wo, u)
-    }
-    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
-        (**self).sample_values(wo, u, out)
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
+        (**self).sample_batch(wo, u, out)
     }
     fn is_diffuse(&self) -> bool {
         (**self).is_diffuse()

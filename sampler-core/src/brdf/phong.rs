@@ -2,7 +2,7 @@
 //! the mirror direction. Accurate up to exponents of 1e6: 1 − cos α is formed from |r − ω|²
 //! instead of 1 − r·ω, and cos^n as exp(n·log1p(−δ)).
 
-use super::{Brdf, BrdfSample, pick_lobe};
+use super::{Brdf, BrdfDraw, BrdfSample, pick_lobe};
 use crate::env::luminance;
 use crate::sampling::{
     TWO_PI, basis_around, reflect_z, sin_cos_2pi, square_to_cosine_hemisphere,
@@ -89,12 +89,7 @@ impl Brdf for Phong {
         })
     }
 
-    fn sample_value(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
-        let wi = self.sample_direction(wo, u)?;
-        Some((wi, self.eval(wo, wi)))
-    }
-
-    fn sample_values(&self, wo: Vec3, u: &[Vec2], out: &mut [(Vec3, Vec3)]) -> usize {
+    fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         let w = self.lobe_weights();
         let total = w[0] + w[1];
         if wo.z <= 0.0 || total.is_nan() || total <= 0.0 {
@@ -104,8 +99,8 @@ impl Brdf for Phong {
         let p_diffuse = w[0] / total;
         let r = reflect_z(wo);
         let (s, t) = basis_around(r);
-        let kd = self.kd * FRAC_1_PI;
-        let ks = self.ks * ((self.exponent + 2.0) / TWO_PI);
+        let kd = luminance(self.kd) * FRAC_1_PI;
+        let ks = luminance(self.ks) * ((self.exponent + 2.0) / TWO_PI);
         let inv_n1 = 1.0 / (self.exponent + 1.0);
         for (p, o) in u.iter().zip(out.iter_mut()) {
             let (wi, lobe) = if p.x < p_diffuse {
@@ -128,14 +123,10 @@ impl Brdf for Phong {
                 };
                 (wi, lobe)
             };
-            *o = (
+            *o = BrdfDraw {
                 wi,
-                if wi.z > 0.0 {
-                    (kd + ks * lobe) * wi.z
-                } else {
-                    Vec3::ZERO
-                },
-            );
+                value: (kd + ks * lobe) * wi.z.max(0.0),
+            };
         }
         u.len().min(out.len())
     }
