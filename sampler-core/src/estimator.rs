@@ -138,29 +138,8 @@ pub fn mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let mut out = [Contribution::default(); 2];
-    if let Some(s) = env_h.sample(u_env) {
-        let p_brdf = sp.brdf_pdf(s.dir);
-        let f = env_h.radiance(s.dir) * sp.eval(s.dir);
-        out[0] = Contribution {
-            dir: s.dir,
-            value: weighted(f, s.pdf + p_brdf, vis, s.dir),
-            pdf: s.pdf,
-            other_pdf: p_brdf,
-        };
-    }
-    if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
-        let dir = sp.frame.to_world(s.wi);
-        let p_env = env_h.pdf(dir);
-        let f = env_h.radiance(dir) * s.value;
-        out[1] = Contribution {
-            dir,
-            value: weighted(f, s.pdf + p_env, vis, dir),
-            pdf: s.pdf,
-            other_pdf: p_env,
-        };
-    }
-    out
+    let drawn = env_h.sample(u_env).map(|s| (s.dir, s.pdf));
+    mis_with_brdf(env_h, sp, drawn, |d| env_h.pdf(d), u_brdf, vis)
 }
 
 /// MIS of product sampling and BRDF sampling, balance heuristic, one sample each: the product
@@ -174,27 +153,40 @@ pub fn product_mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let env_h = sampler.env();
+    let drawn = sampler.sample(u_product).map(|s| (s.dir, s.pdf));
+    mis_with_brdf(sampler.env(), sp, drawn, |d| sampler.pdf(d), u_brdf, vis)
+}
+
+/// Balance-heuristic MIS of one direction `drawn` by a technique whose density is `pdf`, and
+/// one BRDF sample.
+fn mis_with_brdf<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<(Vec3, f32)>,
+    pdf: impl Fn(Vec3) -> f32,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
     let mut out = [Contribution::default(); 2];
-    if let Some(s) = sampler.sample(u_product) {
-        let p_brdf = sp.brdf_pdf(s.dir);
-        let f = env_h.radiance(s.dir) * sp.eval(s.dir);
+    if let Some((dir, p)) = drawn {
+        let p_brdf = sp.brdf_pdf(dir);
+        let f = env_h.radiance(dir) * sp.eval(dir);
         out[0] = Contribution {
-            dir: s.dir,
-            value: weighted(f, s.pdf + p_brdf, vis, s.dir),
-            pdf: s.pdf,
+            dir,
+            value: weighted(f, p + p_brdf, vis, dir),
+            pdf: p,
             other_pdf: p_brdf,
         };
     }
     if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
         let dir = sp.frame.to_world(s.wi);
-        let p_product = sampler.pdf(dir);
+        let p_other = pdf(dir);
         let f = env_h.radiance(dir) * s.value;
         out[1] = Contribution {
             dir,
-            value: weighted(f, s.pdf + p_product, vis, dir),
+            value: weighted(f, s.pdf + p_other, vis, dir),
             pdf: s.pdf,
-            other_pdf: p_product,
+            other_pdf: p_other,
         };
     }
     out
