@@ -1,2 +1,16 @@
-//! `host-std`: the renderer around `sampler-core` (environment maps, tracer, command line).
-//! Tracked by the host-std issue; this crate currently only hosts the `ppis` entry point.
+//! `host-std`: the renderer around `sampler-core` — environment maps, scenes, a BVH, the
+//! threaded tracer and the `ppis` command line.
+
+pub mod bvh;
+pub mod camera;
+pub mod default_scene;
+pub mod env_io;
+pub mod environment;
+pub mod integrator;
+pub mod mesh;
+pub mod output;
+pub mod render;
+pub mod resample;
+pub mod scene;
+pub mod scene_json;
+pub mod sky;

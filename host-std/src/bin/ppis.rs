@@ -1,10 +1,317 @@
-//! `ppis` command line. The renderer lands with the host-std issue; until then every
-//! subcommand reports that plainly and exits with status 2.
+//! `ppis`: render scenes with product importance sampling of environment light.
+//! Every failure prints one line naming the file or option and exits with status 2.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use host_std::bvh::Bvh;
+use host_std::environment::{EnvSource, Environment, Placement};
+use host_std::integrator::Method;
+use host_std::render::{self, Settings};
+use host_std::scene::Scene;
+use host_std::{default_scene, output, scene_json};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(
+    name = "ppis",
+    version,
+    about = "Product importance sampling of environment light × BRDF (Clarberg & Akenine-Möller 2008)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene (the embedded default scene when none is given) to linear EXR + sRGB PNG.
+    Render(RenderArgs),
+    /// Print what a scene holds and what a render of it would build.
+    Info(InfoArgs),
+}
+
+#[derive(Args)]
+struct SceneArgs {
+    /// Scene file (.json, see docs/scene-format.md). Without it: the embedded default scene.
+    scene: Option<PathBuf>,
+    /// Environment map replacing the scene's (lat-long .exr/.hdr/.png/.jpg, or a square
+    /// equal-area map).
+    #[arg(long)]
+    env: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// product, wavelet, env, brdf, mis, product-mis or auto.
+    #[arg(long, default_value = "product", value_parser = parse_method)]
+    method: Method,
+    /// Visibility samples (shadow rays) per pixel.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: u32,
+    /// Primary rays (shading points) per pixel; must divide --spp. Each builds its own product
+    /// sampler and spends spp/P visibility samples.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    shading_points: u32,
+    /// BRDF samples per product sampler (the paper's K).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
+    brdf_samples: u32,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+    /// Write timings and counts as JSON.
+    #[arg(long)]
+    stats_json: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}
 
 fn main() {
-    let cmd = std::env::args().nth(1).unwrap_or_default();
-    eprintln!(
-        "ppis: `{cmd}` is not available yet: the renderer (host-std issue) has not landed; sampler-core is usable as a library"
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render_command(args),
+        Command::Info(args) => info_command(args),
+    };
+    if let Err(e) = result {
+        eprintln!("ppis: error: {e:#}");
+        std::process::exit(2);
+    }
+}
+
+/// Loads the scene the arguments name (or the default scene) and applies `--env`.
+fn load_scene(args: &SceneArgs) -> Result<Scene> {
+    let mut scene = match &args.scene {
+        None => default_scene::scene(),
+        Some(path) => {
+            let ext = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or_default()
+                .to_ascii_lowercase();
+            match ext.as_str() {
+                "json" => scene_json::load(path)?,
+                "usd" | "usda" | "usdc" | "usdz" => {
+                    bail!(
+                        "{}: USD scenes are not supported yet (host-usd issue)",
+                        path.display()
+                    )
+                }
+                _ => bail!("{}: unknown scene format (expected .json)", path.display()),
+            }
+        }
+    };
+    if let Some(env) = &args.env {
+        if !env.exists() {
+            bail!("{}: environment map not found", env.display());
+        }
+        scene.env = Some((EnvSource::File(env.clone()), Placement::default()));
+    }
+    Ok(scene)
+}
+
+fn render_command(args: RenderArgs) -> Result<()> {
+    if !args.spp.is_multiple_of(args.shading_points) {
+        bail!(
+            "--shading-points {} must divide --spp {}",
+            args.shading_points,
+            args.spp
+        );
+    }
+    let exr_path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("render.exr"));
+    let png_path = exr_path.with_extension("png");
+    check_writable(&exr_path)?;
+
+    let t_load = Instant::now();
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(w) = args.width {
+        scene.camera.width = w;
+    }
+    if let Some(h) = args.height {
+        scene.camera.height = h;
+    }
+    let load_seconds_scene = t_load.elapsed().as_secs_f64();
+
+    // Preprocess: only what this render uses.
+    let environment = match &scene.env {
+        Some((source, placement)) => Some(Environment::build(source, *placement)?),
+        None => None,
+    };
+    let t_bvh = Instant::now();
+    let bvh = Bvh::build(&scene);
+    let bvh_seconds = t_bvh.elapsed().as_secs_f64();
+    if let Some(env) = &environment
+        && env.stats.sanitized > 0
+    {
+        eprintln!(
+            "ppis: warning: {}: {} texels were NaN, infinite or negative and were set to 0",
+            env.stats.source, env.stats.sanitized
+        );
+    }
+
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
     );
-    std::process::exit(2);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let settings = Settings {
+        method: args.method,
+        spp: args.spp as usize,
+        shading_points: args.shading_points as usize,
+        brdf_samples: args.brdf_samples as usize,
+        seed: args.seed,
+        progress: true,
+    };
+    let hierarchy = environment.as_ref().map(Environment::hierarchy);
+    let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+
+    output::write_exr(&exr_path, image.width, image.height, &image.pixels)?;
+    output::write_png(&png_path, image.width, image.height, &image.pixels)?;
+
+    let env_load = environment.as_ref().map_or(0.0, |e| e.stats.load_seconds);
+    let env_build = environment.as_ref().map_or(0.0, |e| e.stats.build_seconds);
+    let samples = image.shadow_rays as f64;
+    if let Some(path) = &args.stats_json {
+        let stats = serde_json::json!({
+            "scene": scene.name,
+            "method": args.method.name(),
+            "spp": args.spp,
+            "shading_points_per_pixel": args.shading_points,
+            "brdf_samples": args.brdf_samples,
+            "threads": threads,
+            "seed": args.seed,
+            "width": image.width,
+            "height": image.height,
+            "load_seconds": load_seconds_scene + env_load,
+            "preprocess_seconds": env_build + bvh_seconds,
+            "env_build_seconds": env_build,
+            "bvh_seconds": bvh_seconds,
+            "render_seconds": image.render_seconds,
+            "shading_points": image.shading_points,
+            "shadow_rays": image.shadow_rays,
+            "camera_rays": image.camera_rays,
+            "non_finite_pixels": image.non_finite,
+            "env_level": environment.as_ref().map(|e| e.level),
+            "env_bytes": environment.as_ref().map(|e| e.stats.bytes),
+            "env_sanitized_texels": environment.as_ref().map(|e| e.stats.sanitized),
+            "primitives": bvh.primitive_count(),
+        });
+        output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
+    }
+    let t = image.render_seconds.max(1e-9);
+    eprintln!(
+        "ppis: {}×{} {} spp ({} shading points/pixel), method {}, {} threads: {:.2} s, {:.2} M samples/s, {:.0} k shading points/s; wrote {} and {}",
+        image.width,
+        image.height,
+        args.spp,
+        args.shading_points,
+        args.method,
+        threads,
+        image.render_seconds,
+        samples / t * 1e-6,
+        image.shading_points as f64 / t * 1e-3,
+        exr_path.display(),
+        png_path.display()
+    );
+    if image.non_finite > 0 {
+        eprintln!(
+            "ppis: warning: {} pixels were not finite and were written as 0",
+            image.non_finite
+        );
+    }
+    Ok(())
+}
+
+/// Fails early (before any work) when the output folder does not exist.
+fn check_writable(path: &Path) -> Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!("{}: the output folder does not exist", path.display());
+    }
+    Ok(())
+}
+
+fn info_command(args: InfoArgs) -> Result<()> {
+    let scene = load_scene(&args.scene)?;
+    let c = &scene.camera;
+    println!("scene {}", scene.name);
+    println!(
+        "camera: {}×{}, fov {}°, from {:?} to {:?}",
+        c.width,
+        c.height,
+        c.fov_y_deg,
+        c.origin.to_array(),
+        c.target.to_array()
+    );
+    println!(
+        "objects: {} ({} triangles)",
+        scene.objects.len(),
+        scene.triangle_count()
+    );
+    for (i, m) in scene.materials.iter().enumerate() {
+        println!(
+            "  material {i}: {}{}",
+            m.bsdf.kind(),
+            if m.twosided { ", two-sided" } else { "" }
+        );
+    }
+    match &scene.env {
+        None => println!(
+            "environment: none — a render builds no env hierarchy and is black except for hits"
+        ),
+        Some((EnvSource::Sky { level }, _)) => {
+            println!(
+                "environment: built-in sky, equal-area {}² (pyramid {} MB)",
+                1u32 << level,
+                pyramid_mb(*level)
+            )
+        }
+        Some((EnvSource::File(path), p)) => println!(
+            "environment: {} (scale {}, rotate_y {}°), resampled to a power-of-two equal-area square",
+            path.display(),
+            p.scale,
+            p.rotate_y_deg
+        ),
+    }
+    println!(
+        "a render builds: {} BVH primitives{}; per shading point a product sampler for methods product, wavelet, product-mis (auto: non-diffuse, non-needle materials)",
+        Bvh::build(&scene).primitive_count(),
+        if scene.env.is_some() {
+            ", the env hierarchy"
+        } else {
+            ""
+        }
+    );
+    Ok(())
+}
+
+fn pyramid_mb(level: u32) -> f64 {
+    (sampler_core::env::pyramid_len(level) * 4 + (1usize << (2 * level)) * 12) as f64 / 1e6
 }

@@ -1,0 +1,45 @@
+//! Pinhole camera with the scene format's exact convention: f = normalize(target − origin),
+//! r = normalize(f × up), u = r × f, t = tan(fov_y/2), a = W/H; film position (x, y), x ∈ [0, W]
+//! to the right, y ∈ [0, H] downwards, has direction normalize(f + (2x/W − 1)·t·a·r + (1 − 2y/H)·t·u).
+
+use crate::scene::CameraSpec;
+use sampler_core::glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub origin: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    tan_half: f32,
+    aspect: f32,
+    pub width: u32,
+    pub height: u32,
+    pub near_clip: f32,
+}
+
+impl Camera {
+    pub fn new(spec: &CameraSpec) -> Self {
+        let forward = (spec.target - spec.origin).normalize();
+        let right = forward.cross(spec.up).normalize();
+        let up = right.cross(forward);
+        Self {
+            origin: spec.origin,
+            forward,
+            right,
+            up,
+            tan_half: (spec.fov_y_deg.to_radians() * 0.5).tan(),
+            aspect: spec.width as f32 / spec.height as f32,
+            width: spec.width,
+            height: spec.height,
+            near_clip: spec.near_clip,
+        }
+    }
+
+    /// Unit direction through film position (x, y).
+    pub fn direction(&self, x: f32, y: f32) -> Vec3 {
+        let sx = (2.0 * x / self.width as f32 - 1.0) * self.tan_half * self.aspect;
+        let sy = (1.0 - 2.0 * y / self.height as f32) * self.tan_half;
+        (self.forward + sx * self.right + sy * self.up).normalize()
+    }
+}

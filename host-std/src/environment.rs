@@ -1,0 +1,166 @@
+//! The scene's environment light, owned by the host: the equal-area RGB map and its importance
+//! pyramid, built once; `sampler-core` borrows both through an `EnvHierarchy`.
+
+use crate::env_io::{self, LoadError, RgbImage};
+use crate::resample;
+use crate::sky::Sky;
+use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+use sampler_core::glam::Mat3;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where an environment comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvSource {
+    /// The built-in procedural sky at `2^level`.
+    Sky { level: u32 },
+    /// An image file: lat-long (2:1) or an equal-area square.
+    File(PathBuf),
+}
+
+/// How an environment is placed: radiance scale and rotation about +Y (degrees), as in the
+/// scene format: d_world = R_y(angle)·d_local.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub scale: f32,
+    pub rotate_y_deg: f32,
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Self {
+            scale: 1.0,
+            rotate_y_deg: 0.0,
+        }
+    }
+}
+
+/// Facts about a built environment, for the summary and the stats file.
+#[derive(Clone, Debug, Default)]
+pub struct EnvStats {
+    pub source: String,
+    pub source_size: (usize, usize),
+    pub level: u32,
+    pub sanitized: usize,
+    /// Mean radiance over the sphere: of the source, and of the equal-area map.
+    pub source_mean: [f64; 3],
+    pub map_mean: [f64; 3],
+    pub load_seconds: f64,
+    pub build_seconds: f64,
+    pub bytes: usize,
+}
+
+/// Equal-area texels, their level, and the source's mean radiance over the sphere.
+type EqualArea = (Vec<[f32; 3]>, u32, [f64; 3]);
+
+/// An environment map ready for sampling.
+pub struct Environment {
+    pub level: u32,
+    pub rgb: Vec<[f32; 3]>,
+    pub pyramid: Vec<f32>,
+    pub map_to_world: Mat3,
+    pub stats: EnvStats,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum EnvError {
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    #[error(
+        "{path}: a {width}×{height} image is neither a 2:1 lat-long map nor a square power-of-two equal-area map"
+    )]
+    Layout {
+        path: PathBuf,
+        width: usize,
+        height: usize,
+    },
+    #[error("{0}")]
+    Core(#[from] sampler_core::env::EnvError),
+}
+
+impl Environment {
+    /// Loads or generates the map, resamples it into the equal-area square and builds the
+    /// pyramid.
+    pub fn build(source: &EnvSource, placement: Placement) -> Result<Self, EnvError> {
+        let t0 = Instant::now();
+        let (mut rgb, level, mut stats) = match source {
+            EnvSource::Sky { level } => {
+                let rgb = Sky::default().equal_area(*level);
+                let stats = EnvStats {
+                    source: "built-in sky".into(),
+                    source_size: (1 << level, 1 << level),
+                    ..EnvStats::default()
+                };
+                (rgb, *level, stats)
+            }
+            EnvSource::File(path) => {
+                let image = env_io::load(path)?;
+                let load_seconds = t0.elapsed().as_secs_f64();
+                let (rgb, level, source_mean) = Self::to_equal_area(path, &image)?;
+                let stats = EnvStats {
+                    source: path.display().to_string(),
+                    source_size: (image.width, image.height),
+                    sanitized: image.sanitized,
+                    source_mean,
+                    load_seconds,
+                    ..EnvStats::default()
+                };
+                (rgb, level, stats)
+            }
+        };
+        if placement.scale != 1.0 {
+            let s = placement.scale.max(0.0);
+            rgb.iter_mut().for_each(|t| *t = t.map(|c| c * s));
+        }
+        sampler_core::env::sanitize_rgb(&mut rgb);
+        let mut pyramid = vec![0.0f32; pyramid_len(level)];
+        build_pyramid(level, &rgb, &mut pyramid)?;
+        stats.level = level;
+        stats.map_mean = resample::equal_area_mean(&rgb);
+        if matches!(source, EnvSource::Sky { .. }) {
+            stats.source_mean = stats.map_mean;
+        } else {
+            stats.source_mean = stats.source_mean.map(|m| m * placement.scale as f64);
+        }
+        // Everything after reading the file: resampling, scaling, the pyramid.
+        stats.build_seconds = t0.elapsed().as_secs_f64() - stats.load_seconds;
+        stats.bytes = rgb.len() * 12 + pyramid.len() * 4;
+        let map_to_world = Mat3::from_rotation_y(placement.rotate_y_deg.to_radians());
+        Ok(Self {
+            level,
+            rgb,
+            pyramid,
+            map_to_world,
+            stats,
+        })
+    }
+
+    /// The equal-area texels, their level, and the source's mean radiance.
+    fn to_equal_area(path: &Path, image: &RgbImage) -> Result<EqualArea, EnvError> {
+        let (w, h) = (image.width, image.height);
+        if w == 2 * h {
+            let level = resample::equal_area_level(w, h);
+            let rgb = resample::latlong_to_equal_area(image, level, 2);
+            Ok((rgb, level, resample::latlong_mean(image)))
+        } else if w == h
+            && w.is_power_of_two()
+            && w.trailing_zeros() <= sampler_core::env::MAX_LEVEL
+        {
+            let mean = resample::equal_area_mean(&image.texels);
+            Ok((image.texels.clone(), w.trailing_zeros(), mean))
+        } else {
+            Err(EnvError::Layout {
+                path: path.to_owned(),
+                width: w,
+                height: h,
+            })
+        }
+    }
+
+    /// The core's view of this map.
+    pub fn hierarchy(&self) -> EnvHierarchy<'_> {
+        EnvHierarchy::new(self.level, &self.pyramid, &self.rgb)
+            .expect("buffers built by Environment::build have matching lengths")
+            .with_rotation(self.map_to_world)
+    }
+}

@@ -1,0 +1,197 @@
+//! Direct illumination from the environment at one shading point, by each method, with the
+//! same budget: `budget` visibility samples (shadow rays) per shading point. MIS methods spend
+//! them in pairs (one per technique), so they take ⌊budget/2⌋ pairs (at least one).
+
+use crate::scene::Bsdf;
+use sampler_core::brdf::Brdf;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::{self, ShadingPoint, Visibility};
+use sampler_core::glam::{DVec2, Vec3};
+use sampler_core::points::sobol02;
+use sampler_core::quadtree::ProductKind;
+use sampler_core::rng::hash_combine;
+use sampler_core::sampler::{ProductArena, ProductParams};
+use std::fmt;
+use std::str::FromStr;
+
+/// How the light is sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Product importance sampling, quadtree product (the paper).
+    Product,
+    /// Product importance sampling, Haar wavelet product.
+    Wavelet,
+    /// Environment-only importance sampling through the same hierarchy.
+    Env,
+    /// BRDF importance sampling.
+    Brdf,
+    /// MIS (balance heuristic) of env and BRDF sampling, as Mitsuba's `direct` integrator.
+    Mis,
+    /// MIS of product and BRDF sampling.
+    ProductMis,
+    /// Per material, the method expected to be cheapest at equal error (see `Method::for_material`).
+    Auto,
+}
+
+impl Method {
+    pub const ALL: [Method; 7] = [
+        Method::Product,
+        Method::Wavelet,
+        Method::Env,
+        Method::Brdf,
+        Method::Mis,
+        Method::ProductMis,
+        Method::Auto,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Product => "product",
+            Method::Wavelet => "wavelet",
+            Method::Env => "env",
+            Method::Brdf => "brdf",
+            Method::Mis => "mis",
+            Method::ProductMis => "product-mis",
+            Method::Auto => "auto",
+        }
+    }
+
+    /// True when the method builds a product sampler per shading point.
+    pub fn uses_product(self) -> bool {
+        matches!(
+            self,
+            Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto
+        )
+    }
+
+    /// `auto`: BRDF sampling for needle-sharp lobes (where it is nearly exact under smooth
+    /// light, sampler-core's tests/efficiency.rs), environment sampling for Lambert (cheap and
+    /// adequate: the product's build costs more than its variance gain there), the product
+    /// otherwise. Provisional until `ppis report` measures it at equal time.
+    pub fn for_material(self, bsdf: &Bsdf) -> Method {
+        if self != Method::Auto {
+            return self;
+        }
+        match bsdf {
+            Bsdf::Diffuse(_) => Method::Env,
+            Bsdf::Conductor(c) if c.ggx.alpha() < 0.01 => Method::Brdf,
+            Bsdf::Phong(p) if p.exponent > 2000.0 && p.kd == Vec3::ZERO => Method::Brdf,
+            _ => Method::Product,
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+                format!(
+                    "unknown method \"{s}\" (expected one of: {})",
+                    names.join(", ")
+                )
+            })
+    }
+}
+
+/// Counts the shadow rays a visibility closure traces.
+pub struct CountingVisibility<F: FnMut(Vec3) -> bool> {
+    pub test: F,
+    pub rays: u64,
+}
+
+impl<F: FnMut(Vec3) -> bool> Visibility for CountingVisibility<F> {
+    fn visible(&mut self, dir: Vec3) -> bool {
+        self.rays += 1;
+        (self.test)(dir)
+    }
+}
+
+/// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
+/// visibility samples of `method` (not `Auto`: resolve it per material first).
+#[allow(clippy::too_many_arguments)]
+pub fn shade<B: Brdf + ?Sized>(
+    method: Method,
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    budget: usize,
+    brdf_samples: usize,
+    seed: u64,
+    arena: &mut Option<Box<ProductArena>>,
+    vis: &mut impl Visibility,
+) -> Vec3 {
+    let budget = budget.max(1);
+    let pairs = (budget / 2).max(1);
+    let n = if matches!(method, Method::Mis | Method::ProductMis) {
+        pairs
+    } else {
+        budget
+    };
+    let mut points = [DVec2::ZERO; 64];
+    let mut others = [DVec2::ZERO; 64];
+    let mut sum = Vec3::ZERO;
+    let kind = if method == Method::Wavelet {
+        ProductKind::Wavelet
+    } else {
+        ProductKind::Quadtree
+    };
+    let params = ProductParams {
+        brdf_samples,
+        kind,
+        ..ProductParams::default()
+    };
+    let product = if matches!(
+        method,
+        Method::Product | Method::Wavelet | Method::ProductMis
+    ) {
+        // The arena exists only once a method needs it (36 KB per worker).
+        let arena = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
+        Some(arena.build(
+            env,
+            sp.brdf,
+            &sp.frame,
+            sp.wo,
+            &params,
+            hash_combine(seed, 0xb5df),
+        ))
+    } else {
+        None
+    };
+    // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
+    let mut done = 0;
+    while done < n {
+        let m = (n - done).min(64);
+        sobol02(hash_combine(seed, 1), done as u32, &mut points[..m]);
+        sobol02(hash_combine(seed, 2), done as u32, &mut others[..m]);
+        for k in 0..m {
+            let u = points[k];
+            sum += match (method, &product) {
+                (Method::Product | Method::Wavelet, Some(p)) => {
+                    estimator::product(p, sp, u, vis).value
+                }
+                (Method::ProductMis, Some(p)) => {
+                    let [a, b] = estimator::product_mis(p, sp, u, others[k].as_vec2(), vis);
+                    a.value + b.value
+                }
+                (Method::Env, _) => estimator::env(env, sp, u, vis).value,
+                (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
+                (Method::Mis, _) => {
+                    let [a, b] = estimator::mis(env, sp, u, others[k].as_vec2(), vis);
+                    a.value + b.value
+                }
+                _ => Vec3::ZERO,
+            };
+        }
+        done += m;
+    }
+    sum / n as f32
+}

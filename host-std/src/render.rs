@@ -1,0 +1,213 @@
+//! The tracer: rayon over 16×16 tiles, every pixel seeded from (seed, pixel index) — so the
+//! image depends only on the scene, the settings and the seed, never on the thread count or on
+//! which thread rendered which tile. Each pixel gets P shading points (primary rays jittered
+//! uniformly inside the pixel: a box filter) and each shading point spp/P visibility samples.
+
+use crate::bvh::Bvh;
+use crate::camera::Camera;
+use crate::integrator::{self, CountingVisibility, Method};
+use crate::scene::Scene;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::ShadingPoint;
+use sampler_core::frame::Frame;
+use sampler_core::glam::{DVec2, Vec3};
+use sampler_core::points::sobol02;
+use sampler_core::rng::hash_combine;
+use sampler_core::sampler::ProductArena;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// What to render and how.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    pub method: Method,
+    /// Visibility samples per pixel.
+    pub spp: usize,
+    /// Primary rays (shading points) per pixel; divides `spp`.
+    pub shading_points: usize,
+    /// BRDF samples that build each product sampler.
+    pub brdf_samples: usize,
+    pub seed: u64,
+    /// Show a progress bar on stderr (after the first second).
+    pub progress: bool,
+}
+
+/// A rendered image and what it took.
+pub struct Rendered {
+    pub width: usize,
+    pub height: usize,
+    /// Linear RGB, rows top to bottom.
+    pub pixels: Vec<[f32; 3]>,
+    pub render_seconds: f64,
+    pub shading_points: u64,
+    pub shadow_rays: u64,
+    pub camera_rays: u64,
+    /// Pixel values that came out NaN or infinite and were set to 0 (should stay 0).
+    pub non_finite: u64,
+}
+
+const TILE: usize = 16;
+
+/// Renders the scene. `env` is `None` when the scene has no environment light.
+pub fn render(
+    scene: &Scene,
+    bvh: &Bvh,
+    env: Option<&EnvHierarchy<'_>>,
+    settings: &Settings,
+) -> Rendered {
+    let camera = Camera::new(&scene.camera);
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
+        .collect();
+    let counters = [
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+        AtomicU64::new(0),
+    ];
+    let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% ETA {eta}")
+            .expect("valid template"),
+    );
+    let start = Instant::now();
+    let shown = std::sync::atomic::AtomicBool::new(false);
+    let results: Vec<Vec<[f32; 3]>> = tiles
+        .par_iter()
+        .map(|&(tx, ty)| {
+            let mut arena: Option<Box<ProductArena>> = None;
+            let mut out = Vec::with_capacity(TILE * TILE);
+            let mut local = [0u64; 4];
+            for y in ty * TILE..((ty + 1) * TILE).min(h) {
+                for x in tx * TILE..((tx + 1) * TILE).min(w) {
+                    out.push(pixel(
+                        scene, bvh, env, &camera, settings, x, y, &mut arena, &mut local,
+                    ));
+                }
+            }
+            for (c, l) in counters.iter().zip(local) {
+                c.fetch_add(l, Ordering::Relaxed);
+            }
+            if settings.progress
+                && start.elapsed().as_secs_f64() > 1.0
+                && !shown.swap(true, Ordering::Relaxed)
+            {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+            bar.inc(1);
+            out
+        })
+        .collect();
+    bar.finish_and_clear();
+    let render_seconds = start.elapsed().as_secs_f64();
+    let mut pixels = vec![[0.0f32; 3]; w * h];
+    for (&(tx, ty), tile) in tiles.iter().zip(&results) {
+        let mut k = 0;
+        for y in ty * TILE..((ty + 1) * TILE).min(h) {
+            for x in tx * TILE..((tx + 1) * TILE).min(w) {
+                pixels[y * w + x] = tile[k];
+                k += 1;
+            }
+        }
+    }
+    let [shading_points, shadow_rays, camera_rays, non_finite] = counters.map(|c| c.into_inner());
+    Rendered {
+        width: w,
+        height: h,
+        pixels,
+        render_seconds,
+        shading_points,
+        shadow_rays,
+        camera_rays,
+        non_finite,
+    }
+}
+
+/// One pixel: the mean over its shading points. `stats` counts shading points, shadow rays,
+/// camera rays and non-finite values.
+#[allow(clippy::too_many_arguments)]
+fn pixel(
+    scene: &Scene,
+    bvh: &Bvh,
+    env: Option<&EnvHierarchy<'_>>,
+    camera: &Camera,
+    s: &Settings,
+    x: usize,
+    y: usize,
+    arena: &mut Option<Box<ProductArena>>,
+    stats: &mut [u64; 4],
+) -> [f32; 3] {
+    let seed = hash_combine(s.seed, (y * camera.width as usize + x) as u64);
+    let p = s.shading_points.max(1);
+    let budget = (s.spp / p).max(1);
+    let mut film = [DVec2::ZERO; 64];
+    let mut sum = Vec3::ZERO;
+    let mut done = 0;
+    while done < p {
+        let m = (p - done).min(64);
+        sobol02(seed, done as u32, &mut film[..m]);
+        for (k, f) in film[..m].iter().enumerate() {
+            let dir = camera.direction(x as f32 + f.x as f32, y as f32 + f.y as f32);
+            stats[2] += 1;
+            let value = match bvh.intersect(camera.origin, dir, camera.near_clip, f32::INFINITY) {
+                None => match (env, scene.hide_emitters) {
+                    (Some(e), false) => e.radiance(dir),
+                    _ => Vec3::ZERO,
+                },
+                Some(hit) => {
+                    let material = &scene.materials[hit.material as usize];
+                    let wo = -dir;
+                    let mut n = hit.normal;
+                    if n.dot(wo) < 0.0 {
+                        // Seen from the back, a one-sided surface reflects nothing.
+                        if !material.twosided {
+                            continue;
+                        }
+                        n = -n;
+                    }
+                    let Some(env) = env else {
+                        continue;
+                    };
+                    stats[0] += 1;
+                    let sp = ShadingPoint {
+                        frame: Frame::from_normal(n),
+                        wo,
+                        brdf: material.bsdf.as_brdf(),
+                    };
+                    let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
+                    let origin = hit.point + n * eps;
+                    let mut vis = CountingVisibility {
+                        test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY),
+                        rays: 0,
+                    };
+                    let method = s.method.for_material(&material.bsdf);
+                    let sp_seed = hash_combine(seed, (done + k + 1) as u64);
+                    let v = integrator::shade(
+                        method,
+                        env,
+                        &sp,
+                        budget,
+                        s.brdf_samples,
+                        sp_seed,
+                        arena,
+                        &mut vis,
+                    );
+                    stats[1] += vis.rays;
+                    v
+                }
+            };
+            sum += value;
+        }
+        done += m;
+    }
+    let mean = sum / p as f32;
+    if mean.is_finite() {
+        mean.to_array()
+    } else {
+        stats[3] += 1;
+        [0.0; 3]
+    }
+}

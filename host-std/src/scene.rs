@@ -1,0 +1,109 @@
+//! The renderer's scene: camera, shapes with materials, and an optional environment light.
+//! Filled by the embedded default scene, the JSON reader, and (later) the USD importer.
+
+use crate::environment::{EnvSource, Placement};
+use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
+use sampler_core::glam::Vec3;
+
+/// A pinhole camera, the scene format's exact convention (see `camera.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSpec {
+    pub origin: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_deg: f32,
+    pub width: u32,
+    pub height: u32,
+    pub near_clip: f32,
+}
+
+/// Geometry of one shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// The points p0 + s·e1 + t·e2, s, t ∈ [0, 1]; front normal normalize(e1 × e2).
+    Rectangle {
+        p0: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+    },
+    /// Triangles (counter-clockwise front faces) with face normals.
+    Mesh {
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// A material: one of the core's BRDFs, one- or two-sided.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub bsdf: Bsdf,
+    /// Seen from the back, a one-sided surface reflects nothing.
+    pub twosided: bool,
+}
+
+/// The built-in BRDFs, by value (enum dispatch; each is a few floats).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Bsdf {
+    Diffuse(Lambert),
+    Conductor(RoughConductor),
+    Phong(Phong),
+    CarPaint(CarPaint),
+}
+
+impl Bsdf {
+    pub fn as_brdf(&self) -> &dyn Brdf {
+        match self {
+            Bsdf::Diffuse(b) => b,
+            Bsdf::Conductor(b) => b,
+            Bsdf::Phong(b) => b,
+            Bsdf::CarPaint(b) => b,
+        }
+    }
+
+    /// A short name for summaries.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Bsdf::Diffuse(_) => "diffuse",
+            Bsdf::Conductor(_) => "roughconductor",
+            Bsdf::Phong(_) => "phong",
+            Bsdf::CarPaint(_) => "carpaint",
+        }
+    }
+}
+
+/// One shape and the index of its material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub shape: Shape,
+    pub material: usize,
+}
+
+/// A whole scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub name: String,
+    pub camera: CameraSpec,
+    pub objects: Vec<Object>,
+    pub materials: Vec<Material>,
+    pub env: Option<(EnvSource, Placement)>,
+    /// Camera rays that miss return 0 instead of the environment.
+    pub hide_emitters: bool,
+}
+
+impl Scene {
+    /// Triangles a render will intersect (rectangles count 2, spheres 0).
+    pub fn triangle_count(&self) -> usize {
+        self.objects
+            .iter()
+            .map(|o| match &o.shape {
+                Shape::Mesh { triangles, .. } => triangles.len(),
+                Shape::Rectangle { .. } => 2,
+                Shape::Sphere { .. } => 0,
+            })
+            .sum()
+    }
+}
