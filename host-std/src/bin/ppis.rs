@@ -218,6 +218,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
             "env_level": environment.as_ref().map(|e| e.level),
             "env_bytes": environment.as_ref().map(|e| e.stats.bytes),
             "env_sanitized_texels": environment.as_ref().map(|e| e.stats.sanitized),
+            "env_source_mean_rgb": environment.as_ref().map(|e| e.stats.source_mean),
+            "env_map_mean_rgb": environment.as_ref().map(|e| e.stats.map_mean),
+            "env_mean_relative_error": environment.as_ref().map(|e| {
+                (0..3).map(|c| (e.stats.map_mean[c] / e.stats.source_mean[c].max(1e-300) - 1.0).abs()).fold(0.0, f64::max)
+            }),
             "primitives": bvh.primitive_count(),
         });
         output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
