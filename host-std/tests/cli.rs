@@ -1,0 +1,136 @@
+//! The `ppis` binary on bad input: one clear error line naming the file or option, exit code 2,
+//! no panic, and no output file written.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn ppis() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ppis"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ppis-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs ppis in `dir` and checks the failure: exit code 2, one stderr line mentioning `needle`,
+/// and no render.* left behind.
+fn fails(dir: &Path, args: &[&str], needle: &str) {
+    let out = ppis().current_dir(dir).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: stderr does not mention {needle:?}: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name())
+        .collect();
+    assert!(
+        leftovers
+            .iter()
+            .all(|f| !f.to_string_lossy().starts_with("render")),
+        "{args:?} left {leftovers:?}"
+    );
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = scratch("bad");
+    fails(&dir, &["render", "missing.json"], "missing.json");
+    fails(&dir, &["render", "--method", "magic"], "magic");
+    fails(&dir, &["render", "--spp", "0"], "--spp");
+    fails(
+        &dir,
+        &["render", "--spp", "6", "--shading-points", "4"],
+        "--shading-points",
+    );
+    fails(&dir, &["render", "--env", "nothere.exr"], "nothere.exr");
+    fails(&dir, &["render", "scene.txt"], "scene.txt");
+
+    // Broken files.
+    std::fs::write(dir.join("bad.json"), "{ \"camera\": 3 }").unwrap();
+    fails(&dir, &["render", "bad.json"], "bad.json");
+    std::fs::write(dir.join("typo.json"), r#"{"camera":{"origin":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov_y_deg":40,"width":8,"height":8},
+        "shapes":[{"type":"sphere","center":[0,0,0],"radius":1,"material":{"type":"diffuse","albdo":[1,1,1]}}]}"#).unwrap();
+    fails(&dir, &["render", "typo.json"], "albdo");
+    std::fs::write(
+        dir.join("truncated.exr"),
+        b"v/1\x01\x02\x00\x00\x00channels",
+    )
+    .unwrap();
+    fails(&dir, &["render", "--env", "truncated.exr"], "truncated.exr");
+    std::fs::write(
+        dir.join("garbage.hdr"),
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n",
+    )
+    .unwrap();
+    fails(&dir, &["render", "--env", "garbage.hdr"], "garbage.hdr");
+    std::fs::write(dir.join("noise.png"), b"\x89PNG\r\n\x1a\nnot really").unwrap();
+    fails(&dir, &["render", "--env", "noise.png"], "noise.png");
+    // A valid image of the wrong shape.
+    exr::prelude::write_rgb_file(dir.join("odd.exr"), 30, 20, |_, _| (1.0f32, 1.0f32, 1.0f32))
+        .unwrap();
+    fails(&dir, &["render", "--env", "odd.exr"], "odd.exr");
+    // An output folder that does not exist.
+    fails(
+        &dir,
+        &["render", "-o", "no/such/folder/out.exr"],
+        "no/such/folder",
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_small_render_writes_exr_png_and_stats() {
+    let dir = scratch("ok");
+    let out = ppis()
+        .current_dir(&dir)
+        .args([
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--spp",
+            "4",
+            "--shading-points",
+            "2",
+            "--stats-json",
+            "stats.json",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("wrote render.exr and render.png"),
+        "{stderr}"
+    );
+    for f in ["render.exr", "render.png", "stats.json"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("stats.json")).unwrap()).unwrap();
+    for key in [
+        "method",
+        "spp",
+        "brdf_samples",
+        "threads",
+        "seed",
+        "load_seconds",
+        "preprocess_seconds",
+        "render_seconds",
+        "shading_points",
+        "shadow_rays",
+    ] {
+        assert!(stats.get(key).is_some(), "stats.json lacks {key}");
+    }
+    assert_eq!(stats["non_finite_pixels"], 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,115 @@
+//! End-to-end properties of the tracer: the image does not depend on the thread count, every
+//! method converges to the analytic white-furnace answer, and nothing non-finite comes out.
+
+use host_std::bvh::Bvh;
+use host_std::default_scene;
+use host_std::environment::{EnvSource, Environment, Placement};
+use host_std::integrator::Method;
+use host_std::render::{Settings, render};
+use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use sampler_core::brdf::Lambert;
+use sampler_core::glam::Vec3;
+
+fn settings(method: Method, spp: usize, p: usize) -> Settings {
+    Settings {
+        method,
+        spp,
+        shading_points: p,
+        brdf_samples: 64,
+        seed: 7,
+        progress: false,
+    }
+}
+
+fn render_with_threads(
+    scene: &Scene,
+    env: &Environment,
+    s: &Settings,
+    threads: usize,
+) -> Vec<[f32; 3]> {
+    let bvh = Bvh::build(scene);
+    let h = env.hierarchy();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| render(scene, &bvh, Some(&h), s)).pixels
+}
+
+#[test]
+fn the_image_is_bit_identical_at_any_thread_count() {
+    let mut scene = default_scene::scene();
+    scene.camera.width = 64;
+    scene.camera.height = 36;
+    let env = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
+    for method in [Method::Product, Method::Mis, Method::Auto] {
+        let s = settings(method, 8, 2);
+        let one = render_with_threads(&scene, &env, &s, 1);
+        for threads in [2, 8] {
+            let other = render_with_threads(&scene, &env, &s, threads);
+            let same = one
+                .iter()
+                .zip(&other)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+            assert!(same, "{method}: 1 and {threads} threads differ");
+        }
+        assert!(
+            one.iter()
+                .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0))
+        );
+    }
+}
+
+#[test]
+fn white_furnace_every_method_converges_to_albedo_times_radiance() {
+    // A Lambert sphere of albedo 0.5 alone under a constant sky of radiance 2: a convex object
+    // does not shadow itself, so every pixel on it converges to 0.5 · 2 = 1.
+    let level = 5;
+    let n = 1usize << level;
+    let dir = std::env::temp_dir().join(format!("ppis-furnace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("white.exr");
+    exr::prelude::write_rgb_file(&path, n, n, |_, _| (2.0f32, 2.0f32, 2.0f32)).unwrap();
+    let env = Environment::build(&EnvSource::File(path), Placement::default()).unwrap();
+    let scene = Scene {
+        name: "furnace".into(),
+        camera: CameraSpec {
+            origin: Vec3::new(0.0, 0.0, 4.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 10.0,
+            width: 8,
+            height: 8,
+            near_clip: 1e-3,
+        },
+        objects: vec![Object {
+            shape: Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            material: 0,
+        }],
+        materials: vec![Material {
+            bsdf: Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))),
+            twosided: false,
+        }],
+        env: None,
+        hide_emitters: true,
+    };
+    for method in Method::ALL {
+        let pixels = render_with_threads(&scene, &env, &settings(method, 256, 4), 2);
+        // The 10° view of a unit sphere from 4 units fills the frame.
+        let mean: f64 = pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64;
+        let var: f64 = pixels
+            .iter()
+            .map(|p| (p[1] as f64 - mean).powi(2))
+            .sum::<f64>()
+            / (pixels.len() - 1) as f64;
+        let se = (var / pixels.len() as f64).sqrt();
+        assert!(
+            (mean - 1.0).abs() < 3.0 * se + 2e-3,
+            "{method}: furnace mean {mean} (SE {se})"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
