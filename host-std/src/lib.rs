@@ -10,6 +10,7 @@ pub mod integrator;
 pub mod mesh;
 pub mod output;
 pub mod render;
+pub mod report;
 pub mod resample;
 pub mod scene;
 pub mod scene_json;

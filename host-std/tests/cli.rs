@@ -134,3 +134,51 @@ fn a_small_render_writes_exr_png_and_stats() {
     assert_eq!(stats["non_finite_pixels"], 0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn report_writes_csv_plots_and_table() {
+    let dir = scratch("report");
+    let out = ppis()
+        .current_dir(&dir)
+        .args([
+            "report",
+            "--width",
+            "24",
+            "--height",
+            "14",
+            "--spp",
+            "2,4",
+            "--reference-spp",
+            "16",
+            "--methods",
+            "product,env,mis",
+            "--out",
+            "rep",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for f in [
+        "error_vs_time.csv",
+        "error_vs_time.svg",
+        "error_vs_time.png",
+        "report.md",
+        "reference.exr",
+    ] {
+        assert!(dir.join("rep").join(f).is_file(), "{f} missing: {stderr}");
+    }
+    let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 3 * 2, "{csv}");
+    let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
+    assert!(
+        md.contains("## Equal time") && md.contains("env relMSE"),
+        "{md}"
+    );
+    fails(
+        &dir,
+        &["report", "--out", "rep2", "--methods", "product,nope"],
+        "nope",
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

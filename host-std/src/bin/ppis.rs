@@ -29,6 +29,46 @@ enum Command {
     Render(RenderArgs),
     /// Print what a scene holds and what a render of it would build.
     Info(InfoArgs),
+    /// Error against run time: render each method at each spp, compare with a reference, write
+    /// DIR/error_vs_time.csv, DIR/error_vs_time.{svg,png} and DIR/report.md.
+    Report(ReportArgs),
+}
+
+#[derive(Args)]
+struct ReportArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Comma-separated methods.
+    #[arg(long, default_value = "product,env,brdf,mis,product-mis,auto", value_delimiter = ',', value_parser = parse_method)]
+    methods: Vec<Method>,
+    /// Comma-separated visibility samples per pixel.
+    #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: Vec<u32>,
+    /// Reference image (linear EXR of the same size); otherwise one is rendered.
+    #[arg(long, conflicts_with = "reference_spp")]
+    reference: Option<PathBuf>,
+    /// Visibility samples per pixel of the rendered reference.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    reference_spp: u32,
+    /// Method of the rendered reference (an independent code path from the product by default).
+    #[arg(long, default_value = "mis", value_parser = parse_method)]
+    reference_method: Method,
+    /// Primary rays per pixel (reduced to a divisor of each spp).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    shading_points: u32,
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
+    brdf_samples: u32,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Args)]
@@ -90,6 +130,7 @@ fn main() {
     let result = match cli.command {
         Command::Render(args) => render_command(args),
         Command::Info(args) => info_command(args),
+        Command::Report(args) => report_command(args),
     };
     if let Err(e) = result {
         eprintln!("ppis: error: {e:#}");
@@ -260,6 +301,128 @@ fn check_writable(path: &Path) -> Result<()> {
     if !dir.is_dir() {
         bail!("{}: the output folder does not exist", path.display());
     }
+    Ok(())
+}
+
+fn report_command(args: ReportArgs) -> Result<()> {
+    use host_std::report;
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(w) = args.width {
+        scene.camera.width = w;
+    }
+    if let Some(h) = args.height {
+        scene.camera.height = h;
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
+    let environment = match &scene.env {
+        Some((source, placement)) => Some(Environment::build(source, *placement)?),
+        None => None,
+    };
+    let bvh = Bvh::build(&scene);
+    let hierarchy = environment.as_ref().map(Environment::hierarchy);
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let base = Settings {
+        method: Method::Product,
+        spp: 1,
+        shading_points: args.shading_points as usize,
+        brdf_samples: args.brdf_samples as usize,
+        seed: args.seed,
+        progress: false,
+    };
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let (reference, note) = match &args.reference {
+        Some(path) => {
+            let image = host_std::env_io::load(path)?;
+            if (image.width, image.height) != (w, h) {
+                bail!(
+                    "{}: the reference is {}×{}, the render {}×{}",
+                    path.display(),
+                    image.width,
+                    image.height,
+                    w,
+                    h
+                );
+            }
+            (image.texels, format!("{}", path.display()))
+        }
+        None => {
+            let spp = args.reference_spp as usize;
+            let settings = Settings {
+                method: args.reference_method,
+                spp,
+                shading_points: report::shading_points_for(spp, 16),
+                seed: args.seed ^ 0x0005_eed0_f4ef,
+                progress: true,
+                ..base
+            };
+            eprintln!(
+                "ppis: rendering the reference ({}, {spp} spp)",
+                args.reference_method
+            );
+            let image =
+                pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+            output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
+            (
+                image.pixels,
+                format!(
+                    "{} at {spp} spp (reference.exr, {:.1} s), independent seed",
+                    args.reference_method, image.render_seconds
+                ),
+            )
+        }
+    };
+    let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
+    let measurements = pool.install(|| {
+        report::sweep(
+            &scene,
+            &bvh,
+            hierarchy.as_ref(),
+            &args.methods,
+            &spps,
+            &base,
+            &reference,
+            |m| {
+                eprintln!(
+                    "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                    m.method.name(),
+                    m.spp,
+                    m.seconds,
+                    m.rmse,
+                    m.relmse
+                );
+            },
+        )
+    });
+    output::write_text(
+        &args.out.join("error_vs_time.csv"),
+        &report::csv(&measurements),
+    )?;
+    output::write_text(
+        &args.out.join("report.md"),
+        &report::markdown(&scene.name, &measurements, threads, &note),
+    )?;
+    report::plot(
+        &args.out.join("error_vs_time.svg"),
+        &args.out.join("error_vs_time.png"),
+        &format!(
+            "{}: relMSE against render time ({threads} threads)",
+            scene.name
+        ),
+        &measurements,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: cannot draw the plot: {e}", args.out.display()))?;
+    eprintln!(
+        "ppis: wrote error_vs_time.csv, error_vs_time.svg, error_vs_time.png and report.md in {}",
+        args.out.display()
+    );
     Ok(())
 }
 
