@@ -24,16 +24,12 @@ pub enum Primitive {
 impl Primitive {
     fn bounds(&self) -> Aabb {
         match *self {
-            Primitive::Sphere { center, radius, .. } => Aabb {
-                min: center - Vec3::splat(radius),
-                max: center + Vec3::splat(radius),
-            },
+            Primitive::Sphere { center, radius, .. } => {
+                Aabb { min: center - Vec3::splat(radius), max: center + Vec3::splat(radius) }
+            }
             Primitive::Triangle { v0, e1, e2, .. } => {
                 let (a, b) = (v0 + e1, v0 + e2);
-                Aabb {
-                    min: v0.min(a).min(b),
-                    max: v0.max(a).max(b),
-                }
+                Aabb { min: v0.min(a).min(b), max: v0.max(a).max(b) }
             }
         }
     }
@@ -97,16 +93,10 @@ struct Aabb {
 }
 
 impl Aabb {
-    const EMPTY: Aabb = Aabb {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
-    };
+    const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
 
     fn union(self, o: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     fn area(&self) -> f32 {
@@ -156,47 +146,24 @@ impl Bvh {
         for o in &scene.objects {
             let material = o.material as u32;
             match &o.shape {
-                Shape::Sphere { center, radius } => prims.push(Primitive::Sphere {
-                    center: *center,
-                    radius: *radius,
-                    material,
-                }),
-                Shape::Rectangle { p0, e1, e2 } => {
-                    prims.push(Primitive::Triangle {
-                        v0: *p0,
-                        e1: *e1,
-                        e2: *e1 + *e2,
-                        material,
-                    });
-                    prims.push(Primitive::Triangle {
-                        v0: *p0,
-                        e1: *e1 + *e2,
-                        e2: *e2,
-                        material,
-                    });
+                Shape::Sphere { center, radius } => {
+                    prims.push(Primitive::Sphere { center: *center, radius: *radius, material })
                 }
-                Shape::Mesh {
-                    positions,
-                    triangles,
-                } => {
+                Shape::Rectangle { p0, e1, e2 } => {
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material });
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material });
+                }
+                Shape::Mesh { positions, triangles } => {
                     for t in triangles {
                         let [a, b, c] = t.map(|i| positions[i as usize]);
                         if (b - a).cross(c - a).length_squared() > 0.0 {
-                            prims.push(Primitive::Triangle {
-                                v0: a,
-                                e1: b - a,
-                                e2: c - a,
-                                material,
-                            });
+                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material });
                         }
                     }
                 }
             }
         }
-        let mut bvh = Bvh {
-            prims,
-            nodes: Vec::new(),
-        };
+        let mut bvh = Bvh { prims, nodes: Vec::new() };
         if !bvh.prims.is_empty() {
             let n = bvh.prims.len();
             let mut centroids: Vec<(Aabb, Vec3)> = bvh
@@ -225,24 +192,13 @@ impl Bvh {
         hi: usize,
         depth: u32,
     ) -> usize {
-        let bounds = order[lo..hi]
-            .iter()
-            .fold(Aabb::EMPTY, |b, &i| b.union(info[i].0));
+        let bounds = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| b.union(info[i].0));
         let index = self.nodes.len();
-        self.nodes.push(Node {
-            bounds,
-            offset: lo as u32,
-            count: (hi - lo) as u32,
-        });
+        self.nodes.push(Node { bounds, offset: lo as u32, count: (hi - lo) as u32 });
         if hi - lo <= 4 {
             return index;
         }
-        let cb = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| {
-            b.union(Aabb {
-                min: info[i].1,
-                max: info[i].1,
-            })
-        });
+        let cb = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| b.union(Aabb { min: info[i].1, max: info[i].1 }));
         let extent = cb.max - cb.min;
         let axis = if extent.x >= extent.y && extent.x >= extent.z {
             0
@@ -255,9 +211,7 @@ impl Bvh {
             return index; // all centroids coincide: keep one leaf
         }
         const BINS: usize = 16;
-        let bin_of = |c: Vec3| {
-            (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1)
-        };
+        let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
         let mut bins = [(Aabb::EMPTY, 0usize); BINS];
         for &i in &order[lo..hi] {
             let b = &mut bins[bin_of(info[i].1)];
@@ -268,12 +222,8 @@ impl Bvh {
         let mut best = (f32::INFINITY, 0);
         for k in 0..BINS - 1 {
             let (l, r) = (&bins[..=k], &bins[k + 1..]);
-            let (lb, ln) = l
-                .iter()
-                .fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
-            let (rb, rn) = r
-                .iter()
-                .fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
+            let (lb, ln) = l.iter().fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
+            let (rb, rn) = r.iter().fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
             if ln == 0 || rn == 0 {
                 continue;
             }
@@ -288,16 +238,10 @@ impl Bvh {
         }
         // Past depth 40, median splits keep the depth logarithmic (≤ 40 + log₂ n), so the stack of 128
         // always suffices (checked in debug builds).
-        let mid = if depth < 40 {
-            lo + partition(&mut order[lo..hi], |&i| bin_of(info[i].1) <= best.1)
-        } else {
-            lo
-        };
+        let mid = if depth < 40 { lo + partition(&mut order[lo..hi], |&i| bin_of(info[i].1) <= best.1) } else { lo };
         let mid = if mid == lo || mid == hi {
             let m = (lo + hi) / 2;
-            order[lo..hi].select_nth_unstable_by(m - lo, |&a, &b| {
-                info[a].1[axis].total_cmp(&info[b].1[axis])
-            });
+            order[lo..hi].select_nth_unstable_by(m - lo, |&a, &b| info[a].1[axis].total_cmp(&info[b].1[axis]));
             m
         } else {
             mid
@@ -328,21 +272,10 @@ impl Bvh {
         let prim = best?;
         let point = o + t_max * d;
         let (normal, material) = match self.prims[prim] {
-            Primitive::Sphere {
-                center,
-                radius,
-                material,
-            } => ((point - center) / radius, material),
-            Primitive::Triangle {
-                e1, e2, material, ..
-            } => (e1.cross(e2), material),
+            Primitive::Sphere { center, radius, material } => ((point - center) / radius, material),
+            Primitive::Triangle { e1, e2, material, .. } => (e1.cross(e2), material),
         };
-        Some(Hit {
-            t: t_max,
-            point,
-            normal: normal.normalize(),
-            material,
-        })
+        Some(Hit { t: t_max, point, normal: normal.normalize(), material })
     }
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).
@@ -359,13 +292,7 @@ impl Bvh {
     /// Visits the primitives of every leaf the ray's box test lets through; `visit` may shrink
     /// `t_max` and returns true to stop.
     #[inline]
-    fn traverse(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t_max: &mut f32,
-        mut visit: impl FnMut(usize, &mut f32) -> bool,
-    ) {
+    fn traverse(&self, o: Vec3, d: Vec3, t_max: &mut f32, mut visit: impl FnMut(usize, &mut f32) -> bool) {
         if self.nodes.is_empty() {
             return;
         }

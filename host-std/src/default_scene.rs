@@ -11,30 +11,16 @@ use sampler_core::glam::Vec3;
 pub const SKY_LEVEL: u32 = 10;
 
 pub fn scene() -> Scene {
-    let material = |bsdf| Material {
-        bsdf,
-        twosided: false,
-    };
+    let material = |bsdf| Material { bsdf, twosided: false };
     let materials = vec![
         material(Bsdf::Diffuse(Lambert::new(Vec3::new(0.8, 0.45, 0.3)))),
-        material(Bsdf::Conductor(RoughConductor::new(
-            0.15,
-            Vec3::new(0.95, 0.8, 0.55),
-        ))),
-        material(Bsdf::Conductor(RoughConductor::new(
-            0.01,
-            Vec3::splat(0.95),
-        ))),
+        material(Bsdf::Conductor(RoughConductor::new(0.15, Vec3::new(0.95, 0.8, 0.55)))),
+        material(Bsdf::Conductor(RoughConductor::new(0.01, Vec3::splat(0.95)))),
         material(Bsdf::CarPaint(CarPaint::default())),
         material(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.45)))),
     ];
-    let sphere = |x: f32, m: usize| Object {
-        shape: Shape::Sphere {
-            center: Vec3::new(x, 0.5, 0.0),
-            radius: 0.5,
-        },
-        material: m,
-    };
+    let sphere =
+        |x: f32, m: usize| Object { shape: Shape::Sphere { center: Vec3::new(x, 0.5, 0.0), radius: 0.5 }, material: m };
     let objects = vec![
         sphere(-1.8, 0),
         sphere(-0.6, 1),

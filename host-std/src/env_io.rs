@@ -17,36 +17,17 @@ pub struct RgbImage {
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
     #[error("{path}: cannot read the file: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: not a readable {format} image: {message}")]
-    Decode {
-        path: PathBuf,
-        format: &'static str,
-        message: String,
-    },
+    Decode { path: PathBuf, format: &'static str, message: String },
     #[error("{path}: the image is empty (zero width or height)")]
     Empty { path: PathBuf },
     #[error("{path}: unsupported image format (expected .exr, .hdr, .png, .jpg or .jpeg)")]
     Unsupported { path: PathBuf },
-    #[error(
-        "{path}: support for {format} images was left out of this build (cargo feature `{feature}`)"
-    )]
-    FeatureDisabled {
-        path: PathBuf,
-        format: &'static str,
-        feature: &'static str,
-    },
-    #[error(
-        "{path}: the image is {width}×{height}, larger than the 32768×16384 this renderer accepts"
-    )]
-    TooLarge {
-        path: PathBuf,
-        width: usize,
-        height: usize,
-    },
+    #[error("{path}: support for {format} images was left out of this build (cargo feature `{feature}`)")]
+    FeatureDisabled { path: PathBuf, format: &'static str, feature: &'static str },
+    #[error("{path}: the image is {width}×{height}, larger than the 32768×16384 this renderer accepts")]
+    TooLarge { path: PathBuf, width: usize, height: usize },
 }
 
 const MAX_WIDTH: usize = 32_768;
@@ -54,24 +35,15 @@ const MAX_HEIGHT: usize = 16_384;
 
 /// Loads an image by its extension.
 pub fn load(path: &Path) -> Result<RgbImage, LoadError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.to_owned(), source })?;
     let image = match ext.as_str() {
         "exr" => load_exr(path, &bytes)?,
         "hdr" => load_with_image(path, &bytes, "Radiance HDR", image_format("hdr", path)?)?,
         "png" => load_with_image(path, &bytes, "PNG", image::ImageFormat::Png)?,
         "jpg" | "jpeg" => load_with_image(path, &bytes, "JPEG", image_format("jpeg", path)?)?,
         _ => {
-            return Err(LoadError::Unsupported {
-                path: path.to_owned(),
-            });
+            return Err(LoadError::Unsupported { path: path.to_owned() });
         }
     };
     Ok(image)
@@ -85,70 +57,39 @@ fn image_format(which: &'static str, path: &Path) -> Result<image::ImageFormat, 
         "jpeg" => Ok(image::ImageFormat::Jpeg),
         _ => Err(LoadError::FeatureDisabled {
             path: path.to_owned(),
-            format: if which == "hdr" {
-                "Radiance HDR"
-            } else {
-                "JPEG"
-            },
+            format: if which == "hdr" { "Radiance HDR" } else { "JPEG" },
             feature: which,
         }),
     }
 }
 
-fn finish(
-    path: &Path,
-    width: usize,
-    height: usize,
-    mut texels: Vec<[f32; 3]>,
-) -> Result<RgbImage, LoadError> {
+fn finish(path: &Path, width: usize, height: usize, mut texels: Vec<[f32; 3]>) -> Result<RgbImage, LoadError> {
     if width == 0 || height == 0 {
-        return Err(LoadError::Empty {
-            path: path.to_owned(),
-        });
+        return Err(LoadError::Empty { path: path.to_owned() });
     }
     let sanitized = sampler_core::env::sanitize_rgb(&mut texels);
-    Ok(RgbImage {
-        width,
-        height,
-        texels,
-        sanitized,
-    })
+    Ok(RgbImage { width, height, texels, sanitized })
 }
 
 fn check_size(path: &Path, width: usize, height: usize) -> Result<(), LoadError> {
     if width == 0 || height == 0 {
-        return Err(LoadError::Empty {
-            path: path.to_owned(),
-        });
+        return Err(LoadError::Empty { path: path.to_owned() });
     }
     if width > MAX_WIDTH || height > MAX_HEIGHT {
-        return Err(LoadError::TooLarge {
-            path: path.to_owned(),
-            width,
-            height,
-        });
+        return Err(LoadError::TooLarge { path: path.to_owned(), width, height });
     }
     Ok(())
 }
 
 fn load_exr(path: &Path, bytes: &[u8]) -> Result<RgbImage, LoadError> {
     use exr::prelude::*;
-    let decode = |message: String| LoadError::Decode {
-        path: path.to_owned(),
-        format: "OpenEXR",
-        message,
-    };
+    let decode = |message: String| LoadError::Decode { path: path.to_owned(), format: "OpenEXR", message };
     // Check the header's size before any pixel storage is allocated from it.
-    let meta = MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
-        .map_err(|e| decode(e.to_string()))?;
-    let header = meta
-        .headers
-        .first()
-        .ok_or_else(|| decode("no image layer".into()))?;
+    let meta = MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(|e| decode(e.to_string()))?;
+    let header = meta.headers.first().ok_or_else(|| decode("no image layer".into()))?;
     let size = header.layer_size;
     check_size(path, size.width(), size.height())?;
-    let image =
-        read_first_rgba_layer_from_file_bytes(bytes, size).map_err(|e| decode(e.to_string()))?;
+    let image = read_first_rgba_layer_from_file_bytes(bytes, size).map_err(|e| decode(e.to_string()))?;
     let (width, height) = (size.width(), size.height());
     finish(path, width, height, image)
 }
@@ -182,11 +123,7 @@ fn load_with_image(
     name: &'static str,
     format: image::ImageFormat,
 ) -> Result<RgbImage, LoadError> {
-    let decode = |message: String| LoadError::Decode {
-        path: path.to_owned(),
-        format: name,
-        message,
-    };
+    let decode = |message: String| LoadError::Decode { path: path.to_owned(), format: name, message };
     let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     // Refuse allocations a header could request beyond what a real map needs.
     let mut limits = image::Limits::default();
@@ -194,9 +131,7 @@ fn load_with_image(
     limits.max_image_height = Some(MAX_HEIGHT as u32);
     limits.max_alloc = Some(8 * 1024 * 1024 * 1024);
     reader.limits(limits);
-    let (w, h) = reader
-        .into_dimensions()
-        .map_err(|e| decode(e.to_string()))?;
+    let (w, h) = reader.into_dimensions().map_err(|e| decode(e.to_string()))?;
     check_size(path, w as usize, h as usize)?;
     let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     reader.limits({
@@ -207,35 +142,24 @@ fn load_with_image(
     });
     let decoded = reader.decode().map_err(|e| decode(e.to_string()))?;
     let srgb = !matches!(format, image::ImageFormat::Hdr)
-        && !matches!(
-            decoded,
-            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-        );
+        && !matches!(decoded, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
     let rgb = decoded.into_rgb32f();
     let (width, height) = (rgb.width() as usize, rgb.height() as usize);
     // 8- and 16-bit images are sRGB-encoded: decode to linear radiance.
-    let texels = rgb
-        .pixels()
-        .map(|p| {
-            if srgb {
-                [
-                    srgb_to_linear(p[0]),
-                    srgb_to_linear(p[1]),
-                    srgb_to_linear(p[2]),
-                ]
-            } else {
-                [p[0], p[1], p[2]]
-            }
-        })
-        .collect();
+    let texels =
+        rgb.pixels()
+            .map(|p| {
+                if srgb {
+                    [srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])]
+                } else {
+                    [p[0], p[1], p[2]]
+                }
+            })
+            .collect();
     finish(path, width, height, texels)
 }
 
 /// The sRGB transfer function, inverted.
 pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }

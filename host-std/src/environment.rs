@@ -28,10 +28,7 @@ pub struct Placement {
 
 impl Default for Placement {
     fn default() -> Self {
-        Self {
-            scale: 1.0,
-            rotate_y_deg: 0.0,
-        }
+        Self { scale: 1.0, rotate_y_deg: 0.0 }
     }
 }
 
@@ -66,14 +63,8 @@ pub struct Environment {
 pub enum EnvError {
     #[error(transparent)]
     Load(#[from] LoadError),
-    #[error(
-        "{path}: a {width}×{height} image is neither a 2:1 lat-long map nor a square power-of-two equal-area map"
-    )]
-    Layout {
-        path: PathBuf,
-        width: usize,
-        height: usize,
-    },
+    #[error("{path}: a {width}×{height} image is neither a 2:1 lat-long map nor a square power-of-two equal-area map")]
+    Layout { path: PathBuf, width: usize, height: usize },
     #[error("{0}")]
     Core(#[from] sampler_core::env::EnvError),
 }
@@ -126,13 +117,7 @@ impl Environment {
         stats.build_seconds = t0.elapsed().as_secs_f64() - stats.load_seconds;
         stats.bytes = rgb.len() * 12 + pyramid.len() * 4;
         let map_to_world = Mat3::from_rotation_y(placement.rotate_y_deg.to_radians());
-        Ok(Self {
-            level,
-            rgb,
-            pyramid,
-            map_to_world,
-            stats,
-        })
+        Ok(Self { level, rgb, pyramid, map_to_world, stats })
     }
 
     /// The equal-area texels, their level, and the source's mean radiance.
@@ -142,18 +127,11 @@ impl Environment {
             let level = resample::equal_area_level(w, h);
             let rgb = resample::latlong_to_equal_area(image, level, 2);
             Ok((rgb, level, resample::latlong_mean(image)))
-        } else if w == h
-            && w.is_power_of_two()
-            && w.trailing_zeros() <= sampler_core::env::MAX_LEVEL
-        {
+        } else if w == h && w.is_power_of_two() && w.trailing_zeros() <= sampler_core::env::MAX_LEVEL {
             let mean = resample::equal_area_mean(&image.texels);
             Ok((image.texels.clone(), w.trailing_zeros(), mean))
         } else {
-            Err(EnvError::Layout {
-                path: path.to_owned(),
-                width: w,
-                height: h,
-            })
+            Err(EnvError::Layout { path: path.to_owned(), width: w, height: h })
         }
     }
 

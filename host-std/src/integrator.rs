@@ -34,15 +34,8 @@ pub enum Method {
 }
 
 impl Method {
-    pub const ALL: [Method; 7] = [
-        Method::Product,
-        Method::Wavelet,
-        Method::Env,
-        Method::Brdf,
-        Method::Mis,
-        Method::ProductMis,
-        Method::Auto,
-    ];
+    pub const ALL: [Method; 7] =
+        [Method::Product, Method::Wavelet, Method::Env, Method::Brdf, Method::Mis, Method::ProductMis, Method::Auto];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -58,10 +51,7 @@ impl Method {
 
     /// True when the method builds a product sampler per shading point.
     pub fn uses_product(self) -> bool {
-        matches!(
-            self,
-            Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto
-        )
+        matches!(self, Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto)
     }
 
     /// `auto`: BRDF sampling for needle-sharp lobes (where it is nearly exact under smooth
@@ -90,16 +80,10 @@ impl fmt::Display for Method {
 impl FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
-                format!(
-                    "unknown method \"{s}\" (expected one of: {})",
-                    names.join(", ")
-                )
-            })
+        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown method \"{s}\" (expected one of: {})", names.join(", "))
+        })
     }
 }
 
@@ -131,38 +115,16 @@ pub fn shade<B: Brdf + ?Sized>(
 ) -> Vec3 {
     let budget = budget.max(1);
     let pairs = (budget / 2).max(1);
-    let n = if matches!(method, Method::Mis | Method::ProductMis) {
-        pairs
-    } else {
-        budget
-    };
+    let n = if matches!(method, Method::Mis | Method::ProductMis) { pairs } else { budget };
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
     let mut sum = Vec3::ZERO;
-    let kind = if method == Method::Wavelet {
-        ProductKind::Wavelet
-    } else {
-        ProductKind::Quadtree
-    };
-    let params = ProductParams {
-        brdf_samples,
-        kind,
-        ..ProductParams::default()
-    };
-    let product = if matches!(
-        method,
-        Method::Product | Method::Wavelet | Method::ProductMis
-    ) {
+    let kind = if method == Method::Wavelet { ProductKind::Wavelet } else { ProductKind::Quadtree };
+    let params = ProductParams { brdf_samples, kind, ..ProductParams::default() };
+    let product = if matches!(method, Method::Product | Method::Wavelet | Method::ProductMis) {
         // The arena exists only once a method needs it (36 KB per worker).
         let arena = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
-        Some(arena.build(
-            env,
-            sp.brdf,
-            &sp.frame,
-            sp.wo,
-            &params,
-            hash_combine(seed, 0xb5df),
-        ))
+        Some(arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, hash_combine(seed, 0xb5df)))
     } else {
         None
     };
@@ -175,9 +137,7 @@ pub fn shade<B: Brdf + ?Sized>(
         for k in 0..m {
             let u = points[k];
             sum += match (method, &product) {
-                (Method::Product | Method::Wavelet, Some(p)) => {
-                    estimator::product(p, sp, u, vis).value
-                }
+                (Method::Product | Method::Wavelet, Some(p)) => estimator::product(p, sp, u, vis).value,
                 (Method::ProductMis, Some(p)) => {
                     let [a, b] = estimator::product_mis(p, sp, u, others[k].as_vec2(), vis);
                     a.value + b.value

@@ -11,38 +11,24 @@ pub enum WriteError {
 }
 
 fn temp_path(path: &Path) -> PathBuf {
-    let mut name = path
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
+    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
     name.push(".partial");
     path.with_file_name(name)
 }
 
 /// Writes with `write` to a temporary file, then renames it over `path`.
-fn atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), WriteError> {
+fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), WriteError> {
     let tmp = temp_path(path);
     let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
     if let Err(message) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(WriteError::Write {
-            path: path.to_owned(),
-            message,
-        });
+        return Err(WriteError::Write { path: path.to_owned(), message });
     }
     Ok(())
 }
 
 /// Linear RGB as 32-bit float OpenEXR.
-pub fn write_exr(
-    path: &Path,
-    width: usize,
-    height: usize,
-    pixels: &[[f32; 3]],
-) -> Result<(), WriteError> {
+pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[[f32; 3]]) -> Result<(), WriteError> {
     atomically(path, |tmp| {
         exr::prelude::write_rgb_file(tmp, width, height, |x, y| {
             let p = pixels[y * width + x];
@@ -53,16 +39,9 @@ pub fn write_exr(
 }
 
 /// Tone-mapped (extended Reinhard per channel, white point 4) sRGB PNG.
-pub fn write_png(
-    path: &Path,
-    width: usize,
-    height: usize,
-    pixels: &[[f32; 3]],
-) -> Result<(), WriteError> {
-    let bytes: Vec<u8> = pixels
-        .iter()
-        .flat_map(|p| p.map(|c| (linear_to_srgb(tone_map(c)) * 255.0 + 0.5) as u8))
-        .collect();
+pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[[f32; 3]]) -> Result<(), WriteError> {
+    let bytes: Vec<u8> =
+        pixels.iter().flat_map(|p| p.map(|c| (linear_to_srgb(tone_map(c)) * 255.0 + 0.5) as u8)).collect();
     atomically(path, |tmp| {
         image::save_buffer_with_format(
             tmp,
@@ -86,16 +65,10 @@ pub fn tone_map(c: f32) -> f32 {
 /// The sRGB transfer function.
 pub fn linear_to_srgb(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
+    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
 }
 
 /// Writes `text` atomically (stats files, reports).
 pub fn write_text(path: &Path, text: &str) -> Result<(), WriteError> {
-    atomically(path, |tmp| {
-        std::fs::write(tmp, text).map_err(|e| e.to_string())
-    })
+    atomically(path, |tmp| std::fs::write(tmp, text).map_err(|e| e.to_string()))
 }

@@ -51,27 +51,15 @@ pub struct Rendered {
 const TILE: usize = 16;
 
 /// Renders the scene. `env` is `None` when the scene has no environment light.
-pub fn render(
-    scene: &Scene,
-    bvh: &Bvh,
-    env: Option<&EnvHierarchy<'_>>,
-    settings: &Settings,
-) -> Rendered {
+pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Rendered {
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
-        .collect();
-    let counters = [
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-        AtomicU64::new(0),
-    ];
+    let tiles: Vec<(usize, usize)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
+    let counters = [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)];
     let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
     bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% ETA {eta}")
-            .expect("valid template"),
+        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% ETA {eta}").expect("valid template"),
     );
     let start = Instant::now();
     let shown = std::sync::atomic::AtomicBool::new(false);
@@ -83,18 +71,13 @@ pub fn render(
             let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(
-                        scene, bvh, env, &camera, settings, x, y, &mut arena, &mut local,
-                    ));
+                    out.push(pixel(scene, bvh, env, &camera, settings, x, y, &mut arena, &mut local));
                 }
             }
             for (c, l) in counters.iter().zip(local) {
                 c.fetch_add(l, Ordering::Relaxed);
             }
-            if settings.progress
-                && start.elapsed().as_secs_f64() > 1.0
-                && !shown.swap(true, Ordering::Relaxed)
-            {
+            if settings.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
             }
             bar.inc(1);
@@ -114,16 +97,7 @@ pub fn render(
         }
     }
     let [shading_points, shadow_rays, camera_rays, non_finite] = counters.map(|c| c.into_inner());
-    Rendered {
-        width: w,
-        height: h,
-        pixels,
-        render_seconds,
-        shading_points,
-        shadow_rays,
-        camera_rays,
-        non_finite,
-    }
+    Rendered { width: w, height: h, pixels, render_seconds, shading_points, shadow_rays, camera_rays, non_finite }
 }
 
 /// One pixel: the mean over its shading points. `stats` counts shading points, shadow rays,
@@ -172,29 +146,14 @@ fn pixel(
                         continue;
                     };
                     stats[0] += 1;
-                    let sp = ShadingPoint {
-                        frame: Frame::from_normal(n),
-                        wo,
-                        brdf: material.bsdf.as_brdf(),
-                    };
+                    let sp = ShadingPoint { frame: Frame::from_normal(n), wo, brdf: material.bsdf.as_brdf() };
                     let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
                     let origin = hit.point + n * eps;
-                    let mut vis = CountingVisibility {
-                        test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY),
-                        rays: 0,
-                    };
+                    let mut vis =
+                        CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
                     let method = s.method.for_material(&material.bsdf);
                     let sp_seed = hash_combine(seed, (done + k + 1) as u64);
-                    let v = integrator::shade(
-                        method,
-                        env,
-                        &sp,
-                        budget,
-                        s.brdf_samples,
-                        sp_seed,
-                        arena,
-                        &mut vis,
-                    );
+                    let v = integrator::shade(method, env, &sp, budget, s.brdf_samples, sp_seed, arena, &mut vis);
                     stats[1] += vis.rays;
                     v
                 }

@@ -62,21 +62,11 @@ pub fn sweep(
     let mut out = Vec::new();
     for &method in methods {
         for &spp in spps {
-            let settings = Settings {
-                method,
-                spp,
-                shading_points: shading_points_for(spp, base.shading_points),
-                ..*base
-            };
+            let settings =
+                Settings { method, spp, shading_points: shading_points_for(spp, base.shading_points), ..*base };
             let image = render::render(scene, bvh, env, &settings);
             let (rmse, relmse) = errors(&image.pixels, reference);
-            let m = Measurement {
-                method,
-                spp,
-                seconds: image.render_seconds,
-                rmse,
-                relmse,
-            };
+            let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse };
             progress(&m);
             out.push(m);
         }
@@ -102,17 +92,10 @@ pub fn relmse_at(measurements: &[Measurement], method: Method, t: f64) -> Option
         return Some(((e0 - (t.ln() - t0)).exp(), (t.ln() - t0).abs() > 1e-9));
     }
     let x = t.ln();
-    let k = pts
-        .windows(2)
-        .position(|w| x <= w[1].0)
-        .unwrap_or(pts.len() - 2);
+    let k = pts.windows(2).position(|w| x <= w[1].0).unwrap_or(pts.len() - 2);
     let ((x0, y0), (x1, y1)) = (pts[k], pts[k + 1]);
     let outside = x < pts[0].0 || x > pts[pts.len() - 1].0;
-    let y = if x1 > x0 {
-        y0 + (y1 - y0) * (x - x0) / (x1 - x0)
-    } else {
-        y0
-    };
+    let y = if x1 > x0 { y0 + (y1 - y0) * (x - x0) / (x1 - x0) } else { y0 };
     Some((y.exp(), outside))
 }
 
@@ -120,47 +103,25 @@ pub fn relmse_at(measurements: &[Measurement], method: Method, t: f64) -> Option
 pub fn csv(measurements: &[Measurement]) -> String {
     let mut s = String::from("method,spp,seconds,rmse,relmse\n");
     for m in measurements {
-        let _ = writeln!(
-            s,
-            "{},{},{:.6},{:.6e},{:.6e}",
-            m.method, m.spp, m.seconds, m.rmse, m.relmse
-        );
+        let _ = writeln!(s, "{},{},{:.6},{:.6e},{:.6e}", m.method, m.spp, m.seconds, m.rmse, m.relmse);
     }
     s
 }
 
 /// `report.md`: the measurements and the equal-time table against `product`.
-pub fn markdown(
-    scene: &str,
-    measurements: &[Measurement],
-    threads: usize,
-    reference_note: &str,
-) -> String {
-    let mut s = format!(
-        "# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n"
-    );
+pub fn markdown(scene: &str, measurements: &[Measurement], threads: usize, reference_note: &str) -> String {
+    let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
     s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render.\n\n");
     s.push_str("| method | spp | seconds | RMSE | relMSE |\n|---|---|---|---|---|\n");
     for m in measurements {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.3} | {:.4e} | {:.4e} |",
-            m.method, m.spp, m.seconds, m.rmse, m.relmse
-        );
+        let _ = writeln!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.method, m.spp, m.seconds, m.rmse, m.relmse);
     }
     let others: Vec<Method> = {
-        let mut v: Vec<Method> = measurements
-            .iter()
-            .map(|m| m.method)
-            .filter(|&m| m != Method::Product)
-            .collect();
+        let mut v: Vec<Method> = measurements.iter().map(|m| m.method).filter(|&m| m != Method::Product).collect();
         v.dedup();
         v
     };
-    let product: Vec<&Measurement> = measurements
-        .iter()
-        .filter(|m| m.method == Method::Product)
-        .collect();
+    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == Method::Product).collect();
     if !product.is_empty() && !others.is_empty() {
         s.push_str("\n## Equal time\n\nFor the time product sampling takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to product's (> 1: product is better).\n\n");
         s.push_str("| product spp | seconds | product relMSE |");
@@ -177,13 +138,7 @@ pub fn markdown(
             for &o in &others {
                 match relmse_at(measurements, o, p.seconds) {
                     Some((e, outside)) => {
-                        let _ = write!(
-                            s,
-                            " {:.4e}{} | {:.2} |",
-                            e,
-                            if outside { "*" } else { "" },
-                            e / p.relmse
-                        );
+                        let _ = write!(s, " {:.4e}{} | {:.2} |", e, if outside { "*" } else { "" }, e / p.relmse);
                     }
                     None => s.push_str(" – | – |"),
                 }
@@ -197,25 +152,12 @@ pub fn markdown(
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// The log-log plot of relMSE against time, one line per method, as SVG and PNG.
-pub fn plot(
-    path_svg: &Path,
-    path_png: &Path,
-    title: &str,
-    measurements: &[Measurement],
-) -> Result<(), String> {
+pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measurement]) -> Result<(), String> {
     use plotters::prelude::*;
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     let (mut t0, mut t1, mut e0, mut e1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for m in measurements
-        .iter()
-        .filter(|m| m.seconds > 0.0 && m.relmse > 0.0)
-    {
-        (t0, t1, e0, e1) = (
-            t0.min(m.seconds),
-            t1.max(m.seconds),
-            e0.min(m.relmse),
-            e1.max(m.relmse),
-        );
+    for m in measurements.iter().filter(|m| m.seconds > 0.0 && m.relmse > 0.0) {
+        (t0, t1, e0, e1) = (t0.min(m.seconds), t1.max(m.seconds), e0.min(m.relmse), e1.max(m.relmse));
     }
     if !(t0 < t1 && e0 < e1) {
         (t0, t1, e0, e1) = (t0.min(1e-3), t1.max(1.0), e0.min(1e-6), e1.max(1.0));
@@ -242,10 +184,7 @@ pub fn plot(
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(70)
-            .build_cartesian_2d(
-                (t0 / 1.3..t1 * 1.3).log_scale(),
-                (e0 / 1.5..e1 * 1.5).log_scale(),
-            )
+            .build_cartesian_2d((t0 / 1.3..t1 * 1.3).log_scale(), (e0 / 1.5..e1 * 1.5).log_scale())
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
@@ -268,12 +207,8 @@ pub fn plot(
                 .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(method.name())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                .map_err(|e| e.to_string())?;
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled()))).map_err(|e| e.to_string())?;
         }
         chart
             .configure_series_labels()
@@ -285,20 +220,8 @@ pub fn plot(
         root.present().map_err(|e| e.to_string())
     }
     let ranges = (t0, t1, e0, e1);
-    draw(
-        SVGBackend::new(path_svg, (900, 600)).into_drawing_area(),
-        title,
-        ranges,
-        &methods,
-        measurements,
-    )?;
-    draw(
-        BitMapBackend::new(path_png, (900, 600)).into_drawing_area(),
-        title,
-        ranges,
-        &methods,
-        measurements,
-    )?;
+    draw(SVGBackend::new(path_svg, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
+    draw(BitMapBackend::new(path_png, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
     Ok(())
 }
 
@@ -307,31 +230,18 @@ mod tests {
     use super::*;
 
     fn m(method: Method, spp: usize, seconds: f64, relmse: f64) -> Measurement {
-        Measurement {
-            method,
-            spp,
-            seconds,
-            rmse: relmse.sqrt(),
-            relmse,
-        }
+        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse }
     }
 
     #[test]
     fn equal_time_interpolates_log_log() {
-        let ms = [
-            m(Method::Env, 4, 1.0, 0.4),
-            m(Method::Env, 16, 4.0, 0.1),
-            m(Method::Product, 4, 2.0, 0.05),
-        ];
+        let ms = [m(Method::Env, 4, 1.0, 0.4), m(Method::Env, 16, 4.0, 0.1), m(Method::Product, 4, 2.0, 0.05)];
         let (e, outside) = relmse_at(&ms, Method::Env, 2.0).unwrap();
         assert!((e - 0.2).abs() < 1e-9 && !outside); // error ∝ 1/t between the points
         let (e, outside) = relmse_at(&ms, Method::Env, 8.0).unwrap();
         assert!((e - 0.05).abs() < 1e-9 && outside);
         let md = markdown("t", &ms, 2, "test");
-        assert!(
-            md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"),
-            "{md}"
-        );
+        assert!(md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"), "{md}");
     }
 
     #[test]
@@ -340,9 +250,7 @@ mod tests {
         assert_eq!(errors(&r, &r), (0.0, 0.0));
         let x = vec![[2.0f32, 0.5, 0.0]; 4];
         let (rmse, rel) = errors(&x, &r);
-        assert!(
-            (rmse - (1.0f64 / 3.0).sqrt()).abs() < 1e-9 && (rel - 1.0 / 1.01 / 3.0).abs() < 1e-9
-        );
+        assert!((rmse - (1.0f64 / 3.0).sqrt()).abs() < 1e-9 && (rel - 1.0 / 1.01 / 3.0).abs() < 1e-9);
     }
 
     #[test]

@@ -30,23 +30,15 @@ pub fn direction_to_latlong_uv(d: Vec3) -> (f64, f64) {
 #[inline]
 pub fn direction_to_latlong(d: Vec3, width: usize, height: usize) -> (usize, usize) {
     let (u, v) = direction_to_latlong_uv(d);
-    (
-        ((u * width as f64) as usize).min(width - 1),
-        ((v * height as f64) as usize).min(height - 1),
-    )
+    (((u * width as f64) as usize).min(width - 1), ((v * height as f64) as usize).min(height - 1))
 }
 
 /// Smallest power-of-two level whose texels are no larger than the source's texels at the
 /// equator (the largest ones): 4π/N² ≤ 2π²/(W·H), i.e. N ≥ √(2WH/π). 1024×512 → 1024²,
 /// 4096×2048 → 4096².
 pub fn equal_area_level(width: usize, height: usize) -> u32 {
-    let n = (2.0 * width as f64 * height as f64 / PI)
-        .sqrt()
-        .ceil()
-        .max(1.0) as u64;
-    n.next_power_of_two()
-        .trailing_zeros()
-        .min(sampler_core::env::MAX_LEVEL)
+    let n = (2.0 * width as f64 * height as f64 / PI).sqrt().ceil().max(1.0) as u64;
+    n.next_power_of_two().trailing_zeros().min(sampler_core::env::MAX_LEVEL)
 }
 
 /// Mean radiance over the sphere of a lat-long image, each row weighted by its solid angle.
@@ -96,28 +88,18 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     // The part of a texel's radiance up to the threshold (same chromaticity).
     let clamped = |t: [f32; 3]| {
         let l = lum(t);
-        if l > threshold && threshold > 0.0 {
-            t.map(|c| (c as f64 * threshold / l) as f32)
-        } else {
-            t
-        }
+        if l > threshold && threshold > 0.0 { t.map(|c| (c as f64 * threshold / l) as f32) } else { t }
     };
     let lookup = |s: f64, t: f64| {
-        let (i, j) = direction_to_latlong(
-            square_to_sphere(Vec2::new(s as f32, t as f32)),
-            image.width,
-            image.height,
-        );
+        let (i, j) = direction_to_latlong(square_to_sphere(Vec2::new(s as f32, t as f32)), image.width, image.height);
         clamped(image.texels[j * image.width + i])
     };
     let average = |x: usize, y: usize, k: usize| -> [f64; 3] {
         let mut acc = [0.0f64; 3];
         for sy in 0..k {
             for sx in 0..k {
-                let t = lookup(
-                    ((x * k + sx) as f64 + 0.5) / (n * k) as f64,
-                    ((y * k + sy) as f64 + 0.5) / (n * k) as f64,
-                );
+                let t =
+                    lookup(((x * k + sx) as f64 + 0.5) / (n * k) as f64, ((y * k + sy) as f64 + 0.5) / (n * k) as f64);
                 for c in 0..3 {
                     acc[c] += t[c] as f64;
                 }
@@ -132,21 +114,10 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
             // Contrast across the texel: its points' mean against its inset corners.
             let m = lum(mean.map(|c| c as f32));
             let inset = 1e-3;
-            let corners = [
-                (inset, inset),
-                (1.0 - inset, inset),
-                (inset, 1.0 - inset),
-                (1.0 - inset, 1.0 - inset),
-            ]
-            .map(|(a, b)| lum(lookup((x as f64 + a) / n as f64, (y as f64 + b) / n as f64)));
-            let (lo, hi) = corners
-                .iter()
-                .fold((m, m), |(lo, hi), &c| (lo.min(c), hi.max(c)));
-            let mean = if hi > 1.25 * lo && ss < 4 {
-                average(x, y, 4)
-            } else {
-                mean
-            };
+            let corners = [(inset, inset), (1.0 - inset, inset), (inset, 1.0 - inset), (1.0 - inset, 1.0 - inset)]
+                .map(|(a, b)| lum(lookup((x as f64 + a) / n as f64, (y as f64 + b) / n as f64)));
+            let (lo, hi) = corners.iter().fold((m, m), |(lo, hi), &c| (lo.min(c), hi.max(c)));
+            let mean = if hi > 1.25 * lo && ss < 4 { average(x, y, 4) } else { mean };
             *texel = mean.map(|a| a as f32);
         }
     });
@@ -156,10 +127,7 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     let (w, h) = (image.width, image.height);
     let mut energy = vec![[0.0f64; 3]; 0];
     for j in 0..h {
-        let (c0, c1) = (
-            (PI * j as f64 / h as f64).cos(),
-            (PI * (j + 1) as f64 / h as f64).cos(),
-        );
+        let (c0, c1) = ((PI * j as f64 / h as f64).cos(), (PI * (j + 1) as f64 / h as f64).cos());
         let pixel_solid_angle = 2.0 * PI / w as f64 * (c0 - c1);
         for i in 0..w {
             let t = image.texels[j * w + i];
@@ -170,8 +138,7 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
             if energy.is_empty() {
                 energy = vec![[0.0f64; 3]; n * n];
             }
-            let excess = [0, 1, 2]
-                .map(|k| (t[k] - c[k]) as f64 * pixel_solid_angle / (SPLAT * SPLAT) as f64);
+            let excess = [0, 1, 2].map(|k| (t[k] - c[k]) as f64 * pixel_solid_angle / (SPLAT * SPLAT) as f64);
             for b in 0..SPLAT {
                 // Uniform in solid angle: cos θ uniform over the row.
                 let cos_t = c0 + (c1 - c0) * (b as f64 + 0.5) / SPLAT as f64;
@@ -179,15 +146,8 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
                 for a in 0..SPLAT {
                     let phi = 2.0 * PI * (i as f64 + (a as f64 + 0.5) / SPLAT as f64) / w as f64;
                     // Inverse of direction_to_latlong_uv: u = atan2(x, −z)/2π, v = θ/π.
-                    let d = Vec3::new(
-                        (sin_t * phi.sin()) as f32,
-                        cos_t as f32,
-                        (-sin_t * phi.cos()) as f32,
-                    );
-                    let (x, y) = sampler_core::mapping::texel_of(
-                        sampler_core::mapping::sphere_to_square(d),
-                        n as u32,
-                    );
+                    let d = Vec3::new((sin_t * phi.sin()) as f32, cos_t as f32, (-sin_t * phi.cos()) as f32);
+                    let (x, y) = sampler_core::mapping::texel_of(sampler_core::mapping::sphere_to_square(d), n as u32);
                     let e = &mut energy[y as usize * n + x as usize];
                     for k in 0..3 {
                         e[k] += excess[k];
@@ -213,19 +173,14 @@ mod tests {
     #[test]
     fn orientation_matches_the_scene_format() {
         let uv = |d: Vec3| direction_to_latlong_uv(d.normalize());
-        let close = |(u, v): (f64, f64), (eu, ev): (f64, f64)| {
-            (u - eu).abs() < 1e-7 && (v - ev).abs() < 1e-7
-        };
+        let close = |(u, v): (f64, f64), (eu, ev): (f64, f64)| (u - eu).abs() < 1e-7 && (v - ev).abs() < 1e-7;
         assert!(close(uv(Vec3::NEG_Z), (0.0, 0.5))); // u = 0 on the equator
         assert!(close(uv(Vec3::X), (0.25, 0.5)));
         assert!(close(uv(Vec3::Z), (0.5, 0.5)));
         assert!(close(uv(Vec3::NEG_X), (0.75, 0.5)));
         assert!(uv(Vec3::Y).1 < 1e-7); // top row is +Y
         assert!((uv(Vec3::NEG_Y).1 - 1.0).abs() < 1e-7);
-        assert_eq!(
-            direction_to_latlong(Vec3::new(0.1, 0.2, -1.0).normalize(), 400, 200).0,
-            6
-        );
+        assert_eq!(direction_to_latlong(Vec3::new(0.1, 0.2, -1.0).normalize(), 400, 200).0, 6);
     }
 
     #[test]
@@ -242,28 +197,16 @@ mod tests {
         for case in 0..4 {
             let mut texels = vec![[0.1f32, 0.2, 0.3]; w * h];
             match case {
-                1 => {
-                    (20..30).for_each(|j| (0..w).for_each(|i| texels[j * w + i] = [2.0, 1.0, 0.5]))
-                }
+                1 => (20..30).for_each(|j| (0..w).for_each(|i| texels[j * w + i] = [2.0, 1.0, 0.5])),
                 2 => texels[64 * w + 77] = [5000.0, 4000.0, 3000.0],
                 3 => texels[2 * w + 77] = [5000.0, 4000.0, 3000.0],
                 _ => {}
             }
-            let image = RgbImage {
-                width: w,
-                height: h,
-                texels,
-                sanitized: 0,
-            };
+            let image = RgbImage { width: w, height: h, texels, sanitized: 0 };
             let ea = latlong_to_equal_area(&image, equal_area_level(w, h), 2);
             let (a, b) = (latlong_mean(&image), equal_area_mean(&ea));
             for c in 0..3 {
-                assert!(
-                    (b[c] / a[c] - 1.0).abs() < 5e-4,
-                    "case {case}, channel {c}: {} vs {}",
-                    a[c],
-                    b[c]
-                );
+                assert!((b[c] / a[c] - 1.0).abs() < 5e-4, "case {case}, channel {c}: {} vs {}", a[c], b[c]);
             }
         }
     }

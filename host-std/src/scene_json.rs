@@ -14,10 +14,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     #[error("{path}: cannot read the scene: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: invalid scene JSON: {message}")]
     Json { path: PathBuf, message: String },
     #[error("{path}: {message}")]
@@ -150,47 +147,31 @@ fn white() -> [f32; 3] {
 
 /// Reads a scene file; relative paths inside it are relative to the file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
     parse(&text, path)
 }
 
 /// Parses scene JSON; `path` names the file in errors and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let json: JsonScene = serde_json::from_str(text).map_err(|e| SceneError::Json {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
-    let invalid = |message: String| SceneError::Invalid {
-        path: path.to_owned(),
-        message,
-    };
+    let json: JsonScene =
+        serde_json::from_str(text).map_err(|e| SceneError::Json { path: path.to_owned(), message: e.to_string() })?;
+    let invalid = |message: String| SceneError::Invalid { path: path.to_owned(), message };
     let dir = path.parent().unwrap_or(Path::new("."));
     let v = |a: [f32; 3]| Vec3::from_array(a);
     let c = &json.camera;
     let finite = |xs: &[f32]| xs.iter().all(|x| x.is_finite());
     if c.width == 0 || c.height == 0 || c.width > 16_384 || c.height > 16_384 {
-        return Err(invalid(format!(
-            "camera: width and height must be in 1..=16384, got {}×{}",
-            c.width, c.height
-        )));
+        return Err(invalid(format!("camera: width and height must be in 1..=16384, got {}×{}", c.width, c.height)));
     }
     if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-        return Err(invalid(format!(
-            "camera: fov_y_deg must be in (0, 180), got {}",
-            c.fov_y_deg
-        )));
+        return Err(invalid(format!("camera: fov_y_deg must be in (0, 180), got {}", c.fov_y_deg)));
     }
     let forward = v(c.target) - v(c.origin);
     if !finite(&[c.origin, c.target, c.up].concat())
         || forward.length() == 0.0
         || forward.cross(v(c.up)).length() == 0.0
     {
-        return Err(invalid(
-            "camera: origin, target and up must be finite, distinct and not collinear".into(),
-        ));
+        return Err(invalid("camera: origin, target and up must be finite, distinct and not collinear".into()));
     }
     let camera = CameraSpec {
         origin: v(c.origin),
@@ -205,102 +186,41 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let mut objects = Vec::new();
     for (k, shape) in json.shapes.into_iter().enumerate() {
         let (shape, material) = match shape {
-            JsonShape::Sphere {
-                center,
-                radius,
-                material,
-            } => {
+            JsonShape::Sphere { center, radius, material } => {
                 if !(radius > 0.0 && radius.is_finite() && finite(&center)) {
-                    return Err(invalid(format!(
-                        "shapes[{k}]: sphere needs a finite center and a radius > 0"
-                    )));
+                    return Err(invalid(format!("shapes[{k}]: sphere needs a finite center and a radius > 0")));
                 }
-                (
-                    Shape::Sphere {
-                        center: v(center),
-                        radius,
-                    },
-                    material,
-                )
+                (Shape::Sphere { center: v(center), radius }, material)
             }
-            JsonShape::Rectangle {
-                p0,
-                e1,
-                e2,
-                material,
-            } => {
+            JsonShape::Rectangle { p0, e1, e2, material } => {
                 if !finite(&[p0, e1, e2].concat()) || v(e1).cross(v(e2)).length() == 0.0 {
-                    return Err(invalid(format!(
-                        "shapes[{k}]: rectangle needs finite, non-parallel edges"
-                    )));
+                    return Err(invalid(format!("shapes[{k}]: rectangle needs finite, non-parallel edges")));
                 }
-                (
-                    Shape::Rectangle {
-                        p0: v(p0),
-                        e1: v(e1),
-                        e2: v(e2),
-                    },
-                    material,
-                )
+                (Shape::Rectangle { p0: v(p0), e1: v(e1), e2: v(e2) }, material)
             }
-            JsonShape::Mesh {
-                file,
-                to_world,
-                face_normals,
-                material,
-            } => {
+            JsonShape::Mesh { file, to_world, face_normals, material } => {
                 if !face_normals {
-                    return Err(invalid(format!(
-                        "shapes[{k}]: only face normals are supported (face_normals: true)"
-                    )));
+                    return Err(invalid(format!("shapes[{k}]: only face normals are supported (face_normals: true)")));
                 }
                 let file = dir.join(file);
                 let (mut positions, triangles) = mesh::load(&file)?;
                 if let Some(m) = to_world {
                     // Row-major in the file; glam is column-major.
                     let m = Mat4::from_cols_array_2d(&m).transpose();
-                    positions
-                        .iter_mut()
-                        .for_each(|p| *p = m.transform_point3(*p));
+                    positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
                 }
-                (
-                    Shape::Mesh {
-                        positions,
-                        triangles,
-                    },
-                    material,
-                )
+                (Shape::Mesh { positions, triangles }, material)
             }
         };
-        materials.push(
-            material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?,
-        );
-        objects.push(Object {
-            shape,
-            material: materials.len() - 1,
-        });
+        materials.push(material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?);
+        objects.push(Object { shape, material: materials.len() - 1 });
     }
-    let env = json.envmap.map(|e| {
-        (
-            EnvSource::File(dir.join(e.file)),
-            Placement {
-                scale: e.scale,
-                rotate_y_deg: e.rotate_y_deg,
-            },
-        )
-    });
-    let name = json.name.unwrap_or_else(|| {
-        path.file_stem()
-            .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
-    });
-    Ok(Scene {
-        name,
-        camera,
-        objects,
-        materials,
-        env,
-        hide_emitters: json.hide_emitters,
-    })
+    let env = json
+        .envmap
+        .map(|e| (EnvSource::File(dir.join(e.file)), Placement { scale: e.scale, rotate_y_deg: e.rotate_y_deg }));
+    let name =
+        json.name.unwrap_or_else(|| path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()));
+    Ok(Scene { name, camera, objects, materials, env, hide_emitters: json.hide_emitters })
 }
 
 fn material_of(m: JsonMaterial) -> Result<Material, String> {
@@ -313,68 +233,34 @@ fn material_of(m: JsonMaterial) -> Result<Material, String> {
         }
     };
     Ok(match m {
-        JsonMaterial::Diffuse { albedo, twosided } => Material {
-            bsdf: Bsdf::Diffuse(Lambert::new(colour("albedo", albedo)?)),
-            twosided,
-        },
-        JsonMaterial::Roughconductor {
-            distribution,
-            alpha,
-            specular,
-            twosided,
-        } => {
+        JsonMaterial::Diffuse { albedo, twosided } => {
+            Material { bsdf: Bsdf::Diffuse(Lambert::new(colour("albedo", albedo)?)), twosided }
+        }
+        JsonMaterial::Roughconductor { distribution, alpha, specular, twosided } => {
             if distribution != "ggx" {
-                return Err(format!(
-                    "distribution \"{distribution}\" is not supported (only \"ggx\")"
-                ));
+                return Err(format!("distribution \"{distribution}\" is not supported (only \"ggx\")"));
             }
             if !(alpha > 0.0 && alpha.is_finite()) {
                 return Err(format!("alpha must be > 0, got {alpha}"));
             }
-            Material {
-                bsdf: Bsdf::Conductor(RoughConductor::new(alpha, colour("specular", specular)?)),
-                twosided,
-            }
+            Material { bsdf: Bsdf::Conductor(RoughConductor::new(alpha, colour("specular", specular)?)), twosided }
         }
-        JsonMaterial::Phong {
-            exponent,
-            kd,
-            ks,
-            twosided,
-        } => {
+        JsonMaterial::Phong { exponent, kd, ks, twosided } => {
             if !(exponent >= 0.0 && exponent.is_finite()) {
                 return Err(format!("exponent must be ≥ 0, got {exponent}"));
             }
-            Material {
-                bsdf: Bsdf::Phong(Phong::new(colour("kd", kd)?, colour("ks", ks)?, exponent)),
-                twosided,
-            }
+            Material { bsdf: Bsdf::Phong(Phong::new(colour("kd", kd)?, colour("ks", ks)?, exponent)), twosided }
         }
-        JsonMaterial::Carpaint {
-            base,
-            flake,
-            flake_alpha,
-            coat,
-            coat_alpha,
-            twosided,
-        } => {
+        JsonMaterial::Carpaint { base, flake, flake_alpha, coat, coat_alpha, twosided } => {
             let d = CarPaint::default();
             let p = CarPaint::new(
-                base.map(|b| colour("base", b))
-                    .transpose()?
-                    .unwrap_or(d.base),
-                flake
-                    .map(|b| colour("flake", b))
-                    .transpose()?
-                    .unwrap_or(d.flake),
+                base.map(|b| colour("base", b)).transpose()?.unwrap_or(d.base),
+                flake.map(|b| colour("flake", b)).transpose()?.unwrap_or(d.flake),
                 flake_alpha.unwrap_or(d.flake_ggx.alpha()),
                 coat.unwrap_or(d.coat).max(0.0),
                 coat_alpha.unwrap_or(d.coat_ggx.alpha()),
             );
-            Material {
-                bsdf: Bsdf::CarPaint(p),
-                twosided,
-            }
+            Material { bsdf: Bsdf::CarPaint(p), twosided }
         }
     })
 }

@@ -26,11 +26,7 @@ impl Default for Sky {
     fn default() -> Self {
         let elevation = 35f32.to_radians();
         let azimuth = 40f32.to_radians();
-        let sun = Vec3::new(
-            elevation.cos() * azimuth.sin(),
-            elevation.sin(),
-            -elevation.cos() * azimuth.cos(),
-        );
+        let sun = Vec3::new(elevation.cos() * azimuth.sin(), elevation.sin(), -elevation.cos() * azimuth.cos());
         Self {
             sun,
             sun_radius: 0.265f32.to_radians(),
@@ -60,10 +56,7 @@ impl Sky {
         let mut out = vec![[0.0f32; 3]; n * n];
         out.par_chunks_mut(n).enumerate().for_each(|(y, row)| {
             for (x, texel) in row.iter_mut().enumerate() {
-                let centre = square_to_sphere(Vec2::new(
-                    (x as f32 + 0.5) / n as f32,
-                    (y as f32 + 0.5) / n as f32,
-                ));
+                let centre = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
                 let mut radiance = self.sky(centre);
                 // Only texels near the sun need the coverage samples.
                 if centre.dot(self.sun) > (self.sun_radius * 4.0 + 8.0 / n as f32).cos() {

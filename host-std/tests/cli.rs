@@ -21,22 +21,10 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
     let out = ppis().current_dir(dir).args(args).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-    assert!(
-        stderr.contains(needle),
-        "{args:?}: stderr does not mention {needle:?}: {stderr}"
-    );
+    assert!(stderr.contains(needle), "{args:?}: stderr does not mention {needle:?}: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    let leftovers: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name())
-        .collect();
-    assert!(
-        leftovers
-            .iter()
-            .all(|f| !f.to_string_lossy().starts_with("render")),
-        "{args:?} left {leftovers:?}"
-    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert!(leftovers.iter().all(|f| !f.to_string_lossy().starts_with("render")), "{args:?} left {leftovers:?}");
 }
 
 #[test]
@@ -45,44 +33,31 @@ fn bad_input_fails_cleanly() {
     fails(&dir, &["render", "missing.json"], "missing.json");
     fails(&dir, &["render", "--method", "magic"], "magic");
     fails(&dir, &["render", "--spp", "0"], "--spp");
-    fails(
-        &dir,
-        &["render", "--spp", "6", "--shading-points", "4"],
-        "--shading-points",
-    );
+    fails(&dir, &["render", "--spp", "6", "--shading-points", "4"], "--shading-points");
     fails(&dir, &["render", "--env", "nothere.exr"], "nothere.exr");
     fails(&dir, &["render", "scene.txt"], "scene.txt");
 
     // Broken files.
     std::fs::write(dir.join("bad.json"), "{ \"camera\": 3 }").unwrap();
     fails(&dir, &["render", "bad.json"], "bad.json");
-    std::fs::write(dir.join("typo.json"), r#"{"camera":{"origin":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov_y_deg":40,"width":8,"height":8},
-        "shapes":[{"type":"sphere","center":[0,0,0],"radius":1,"material":{"type":"diffuse","albdo":[1,1,1]}}]}"#).unwrap();
+    std::fs::write(
+        dir.join("typo.json"),
+        r#"{"camera":{"origin":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov_y_deg":40,"width":8,"height":8},
+        "shapes":[{"type":"sphere","center":[0,0,0],"radius":1,"material":{"type":"diffuse","albdo":[1,1,1]}}]}"#,
+    )
+    .unwrap();
     fails(&dir, &["render", "typo.json"], "albdo");
-    std::fs::write(
-        dir.join("truncated.exr"),
-        b"v/1\x01\x02\x00\x00\x00channels",
-    )
-    .unwrap();
+    std::fs::write(dir.join("truncated.exr"), b"v/1\x01\x02\x00\x00\x00channels").unwrap();
     fails(&dir, &["render", "--env", "truncated.exr"], "truncated.exr");
-    std::fs::write(
-        dir.join("garbage.hdr"),
-        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n",
-    )
-    .unwrap();
+    std::fs::write(dir.join("garbage.hdr"), b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n").unwrap();
     fails(&dir, &["render", "--env", "garbage.hdr"], "garbage.hdr");
     std::fs::write(dir.join("noise.png"), b"\x89PNG\r\n\x1a\nnot really").unwrap();
     fails(&dir, &["render", "--env", "noise.png"], "noise.png");
     // A valid image of the wrong shape.
-    exr::prelude::write_rgb_file(dir.join("odd.exr"), 30, 20, |_, _| (1.0f32, 1.0f32, 1.0f32))
-        .unwrap();
+    exr::prelude::write_rgb_file(dir.join("odd.exr"), 30, 20, |_, _| (1.0f32, 1.0f32, 1.0f32)).unwrap();
     fails(&dir, &["render", "--env", "odd.exr"], "odd.exr");
     // An output folder that does not exist.
-    fails(
-        &dir,
-        &["render", "-o", "no/such/folder/out.exr"],
-        "no/such/folder",
-    );
+    fails(&dir, &["render", "-o", "no/such/folder/out.exr"], "no/such/folder");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -108,10 +83,7 @@ fn a_small_render_writes_exr_png_and_stats() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    assert!(
-        stderr.contains("wrote render.exr and render.png"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("wrote render.exr and render.png"), "{stderr}");
     for f in ["render.exr", "render.png", "stats.json"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
@@ -159,26 +131,13 @@ fn report_writes_csv_plots_and_table() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    for f in [
-        "error_vs_time.csv",
-        "error_vs_time.svg",
-        "error_vs_time.png",
-        "report.md",
-        "reference.exr",
-    ] {
+    for f in ["error_vs_time.csv", "error_vs_time.svg", "error_vs_time.png", "report.md", "reference.exr"] {
         assert!(dir.join("rep").join(f).is_file(), "{f} missing: {stderr}");
     }
     let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3 * 2, "{csv}");
     let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
-    assert!(
-        md.contains("## Equal time") && md.contains("env relMSE"),
-        "{md}"
-    );
-    fails(
-        &dir,
-        &["report", "--out", "rep2", "--methods", "product,nope"],
-        "nope",
-    );
+    assert!(md.contains("## Equal time") && md.contains("env relMSE"), "{md}");
+    fails(&dir, &["report", "--out", "rep2", "--methods", "product,nope"], "nope");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -11,28 +11,13 @@ use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, p: usize) -> Settings {
-    Settings {
-        method,
-        spp,
-        shading_points: p,
-        brdf_samples: 64,
-        seed: 7,
-        progress: false,
-    }
+    Settings { method, spp, shading_points: p, brdf_samples: 64, seed: 7, progress: false }
 }
 
-fn render_with_threads(
-    scene: &Scene,
-    env: &Environment,
-    s: &Settings,
-    threads: usize,
-) -> Vec<[f32; 3]> {
+fn render_with_threads(scene: &Scene, env: &Environment, s: &Settings, threads: usize) -> Vec<[f32; 3]> {
     let bvh = Bvh::build(scene);
     let h = env.hierarchy();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| render(scene, &bvh, Some(&h), s)).pixels
 }
 
@@ -47,16 +32,10 @@ fn the_image_is_bit_identical_at_any_thread_count() {
         let one = render_with_threads(&scene, &env, &s, 1);
         for threads in [2, 8] {
             let other = render_with_threads(&scene, &env, &s, threads);
-            let same = one
-                .iter()
-                .zip(&other)
-                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+            let same = one.iter().zip(&other).all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
             assert!(same, "{method}: 1 and {threads} threads differ");
         }
-        assert!(
-            one.iter()
-                .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0))
-        );
+        assert!(one.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
     }
 }
 
@@ -82,17 +61,8 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
             height: 8,
             near_clip: 1e-3,
         },
-        objects: vec![Object {
-            shape: Shape::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            material: 0,
-        }],
-        materials: vec![Material {
-            bsdf: Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))),
-            twosided: false,
-        }],
+        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
+        materials: vec![Material { bsdf: Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), twosided: false }],
         env: None,
         hide_emitters: true,
     };
@@ -100,16 +70,9 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
         let pixels = render_with_threads(&scene, &env, &settings(method, 256, 4), 2);
         // The 10° view of a unit sphere from 4 units fills the frame.
         let mean: f64 = pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64;
-        let var: f64 = pixels
-            .iter()
-            .map(|p| (p[1] as f64 - mean).powi(2))
-            .sum::<f64>()
-            / (pixels.len() - 1) as f64;
+        let var: f64 = pixels.iter().map(|p| (p[1] as f64 - mean).powi(2)).sum::<f64>() / (pixels.len() - 1) as f64;
         let se = (var / pixels.len() as f64).sqrt();
-        assert!(
-            (mean - 1.0).abs() < 3.0 * se + 2e-3,
-            "{method}: furnace mean {mean} (SE {se})"
-        );
+        assert!((mean - 1.0).abs() < 3.0 * se + 2e-3, "{method}: furnace mean {mean} (SE {se})");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,9 +7,7 @@ use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::frame::Frame;
-use sampler_core::mapping::{
-    sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch,
-};
+use sampler_core::mapping::{sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch};
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::Pcg32;
@@ -21,9 +19,7 @@ const BATCH: usize = 1024;
 
 fn mapping(c: &mut Criterion) {
     let mut rng = Pcg32::new(1, 2);
-    let pts: Vec<Vec2> = (0..BATCH)
-        .map(|_| Vec2::new(rng.next_f32(), rng.next_f32()))
-        .collect();
+    let pts: Vec<Vec2> = (0..BATCH).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
     let dirs: Vec<Vec3> = pts.iter().map(|p| square_to_sphere(*p)).collect();
     let mut g = c.benchmark_group("mapping");
     g.throughput(Throughput::Elements(BATCH as u64));
@@ -75,10 +71,7 @@ fn sunny_map(level: u32) -> Map {
     let sun = Vec3::new(0.4, 0.5, 0.75).normalize();
     for y in 0..n {
         for x in 0..n {
-            let d = square_to_sphere(Vec2::new(
-                (x as f32 + 0.5) / n as f32,
-                (y as f32 + 0.5) / n as f32,
-            ));
+            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
             let sky = 0.3 + 0.7 * d.z.max(0.0);
             let s = if d.dot(sun) > 0.99998 { 1e5 } else { 0.0 };
             rgb[y * n + x] = [0.4 * sky + s, 0.6 * sky + s, sky + s];
@@ -86,20 +79,13 @@ fn sunny_map(level: u32) -> Map {
     }
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
-    Map {
-        level,
-        rgb,
-        pyramid,
-    }
+    Map { level, rgb, pyramid }
 }
 
 fn shading_points(c: &mut Criterion) {
     let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
-        (
-            "phong n=1e3",
-            Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),
-        ),
+        ("phong n=1e3", Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3))),
         ("ggx a=0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
         ("carpaint", Box::new(CarPaint::default())),
     ];
@@ -110,10 +96,7 @@ fn shading_points(c: &mut Criterion) {
         .map(|_| {
             let n = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
             let f = Frame::from_normal(n);
-            (
-                f,
-                f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()),
-            )
+            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
         })
         .collect();
     for level in [10u32, 12] {
@@ -127,10 +110,7 @@ fn shading_points(c: &mut Criterion) {
                     if kind == ProductKind::Wavelet && (warps != 16 || level != 12) {
                         continue;
                     }
-                    let params = ProductParams {
-                        kind,
-                        ..ProductParams::default()
-                    };
+                    let params = ProductParams { kind, ..ProductParams::default() };
                     let id = BenchmarkId::new(format!("{name} {kind:?}"), format!("{warps} warps"));
                     let mut i = 0u64;
                     g.bench_function(id, |b| {
@@ -168,23 +148,13 @@ fn shading_points(c: &mut Criterion) {
             b.iter(|| {
                 i += 1;
                 let (frame, wo) = &points[(i % 100) as usize];
-                let s = arena.build(
-                    &env,
-                    brdfs[2].1.as_ref(),
-                    frame,
-                    *wo,
-                    &ProductParams::default(),
-                    i,
-                );
+                let s = arena.build(&env, brdfs[2].1.as_ref(), frame, *wo, &ProductParams::default(), i);
                 black_box(s.node_count())
             })
         });
         g.finish();
     }
-    eprintln!(
-        "arena: ProductArena<256, 2048> = {} bytes",
-        std::mem::size_of::<ProductArena>()
-    );
+    eprintln!("arena: ProductArena<256, 2048> = {} bytes", std::mem::size_of::<ProductArena>());
 }
 
 criterion_group! {

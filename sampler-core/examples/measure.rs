@@ -25,10 +25,7 @@ fn main() {
         worst = worst.max(e);
         sum += e as f64;
     }
-    println!(
-        "mapping round trip over {n} directions: max {worst:.2e} rad, mean {:.2e} rad",
-        sum / n as f64
-    );
+    println!("mapping round trip over {n} directions: max {worst:.2e} rad, mean {:.2e} rad", sum / n as f64);
 
     // Defensive mixture cost: per-sample variance with ε = 0.05 relative to ε = 0, on cases
     // where ε = 0 is unbiased (B̃ > 0 wherever B > 0).
@@ -38,10 +35,7 @@ fn main() {
     let sun = Vec3::new(0.3, 0.4, 0.87).normalize();
     for y in 0..m {
         for x in 0..m {
-            let d = square_to_sphere(Vec2::new(
-                (x as f32 + 0.5) / m as f32,
-                (y as f32 + 0.5) / m as f32,
-            ));
+            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / m as f32, (y as f32 + 0.5) / m as f32));
             let s = if d.dot(sun) > 0.9995 { 5e3 } else { 0.0 };
             let sky = 0.2 + d.z.max(0.0);
             rgb[y * m + x] = [0.5 * sky + s, 0.7 * sky + s, sky + s];
@@ -59,25 +53,17 @@ fn main() {
     for (name, brdf) in &brdfs {
         let frame = Frame::from_normal(Vec3::new(0.1, 0.2, 1.0).normalize());
         let wo = frame.to_world(Vec3::new(-0.3, -0.4, 0.87).normalize());
-        let sp = ShadingPoint {
-            frame,
-            wo,
-            brdf: brdf.as_ref(),
-        };
+        let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
         let mut var = [0.0f64; 3];
         for (k, eps) in [0.0f32, 0.02, 0.05].iter().enumerate() {
-            let params = ProductParams {
-                defensive: *eps,
-                ..ProductParams::default()
-            };
+            let params = ProductParams { defensive: *eps, ..ProductParams::default() };
             let (mut s1, mut s2, mut cnt) = (0.0f64, 0.0f64, 0.0f64);
             for seed in 0..2000u64 {
                 let sampler = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed);
                 let mut pts = [DVec2::ZERO; 64];
                 sobol02(seed + 77, 0, &mut pts);
                 for u in pts {
-                    let v =
-                        luminance(estimator::product(&sampler, &sp, u, &mut |_| true).value) as f64;
+                    let v = luminance(estimator::product(&sampler, &sp, u, &mut |_| true).value) as f64;
                     s1 += v;
                     s2 += v * v;
                     cnt += 1.0;
@@ -85,15 +71,8 @@ fn main() {
             }
             let mean = s1 / cnt;
             var[k] = s2 / cnt - mean * mean;
-            println!(
-                "{name:9} ε = {eps:<4}: mean {mean:.5}, per-sample variance {:.4e}",
-                var[k]
-            );
+            println!("{name:9} ε = {eps:<4}: mean {mean:.5}, per-sample variance {:.4e}", var[k]);
         }
-        println!(
-            "{name:9} variance ratio vs ε=0: ε=0.02 {:.3}, ε=0.05 {:.3}",
-            var[1] / var[0],
-            var[2] / var[0]
-        );
+        println!("{name:9} variance ratio vs ε=0: ε=0.02 {:.3}, ε=0.05 {:.3}", var[1] / var[0], var[2] / var[0]);
     }
 }

@@ -21,10 +21,7 @@ fn main() {
         ("ggx 0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
         ("ggx 1e-3", Box::new(RoughConductor::new(1e-3, Vec3::ONE))),
         ("ggx 1e-4", Box::new(RoughConductor::new(1e-4, Vec3::ONE))),
-        (
-            "phong 1e5",
-            Box::new(Phong::new(Vec3::ZERO, Vec3::ONE, 1e5)),
-        ),
+        ("phong 1e5", Box::new(Phong::new(Vec3::ZERO, Vec3::ONE, 1e5))),
         ("carpaint", Box::new(CarPaint::default())),
     ];
     let mut rng = Pcg32::new(5, 5);
@@ -35,14 +32,7 @@ fn main() {
             let frame = Frame::from_normal(normal);
             let c = rng.next_f32();
             let wo = frame.to_world(Vec3::new((1.0 - c * c).sqrt(), 0.0, c));
-            let s = arena.build(
-                &env,
-                brdf.as_ref(),
-                &frame,
-                wo,
-                &ProductParams::default(),
-                i,
-            );
+            let s = arena.build(&env, brdf.as_ref(), &frame, wo, &ProductParams::default(), i);
             sum += s.node_count();
             max = max.max(s.node_count());
         }

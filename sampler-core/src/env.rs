@@ -66,11 +66,7 @@ pub enum EnvError {
     /// The finest level is larger than [`MAX_LEVEL`].
     TooLarge { finest: u32 },
     /// A buffer does not have the length its finest level implies.
-    WrongLength {
-        buffer: &'static str,
-        expected: usize,
-        found: usize,
-    },
+    WrongLength { buffer: &'static str, expected: usize, found: usize },
     /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
     NotSanitized,
 }
@@ -79,20 +75,10 @@ impl core::fmt::Display for EnvError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::TooLarge { finest } => {
-                write!(
-                    f,
-                    "environment level {finest} exceeds the maximum {MAX_LEVEL} (16384²)"
-                )
+                write!(f, "environment level {finest} exceeds the maximum {MAX_LEVEL} (16384²)")
             }
-            Self::WrongLength {
-                buffer,
-                expected,
-                found,
-            } => {
-                write!(
-                    f,
-                    "{buffer} buffer holds {found} values, expected {expected}"
-                )
+            Self::WrongLength { buffer, expected, found } => {
+                write!(f, "{buffer} buffer holds {found} values, expected {expected}")
             }
             Self::NotSanitized => write!(f, "environment holds NaN, infinite or negative values"),
         }
@@ -123,8 +109,7 @@ pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Resu
     check_lengths(finest, rgb.len(), pyramid.len())?;
     let n = 1usize << finest;
     for (i, c) in rgb.iter().enumerate() {
-        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] =
-            luminance(Vec3::from_array(*c));
+        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = luminance(Vec3::from_array(*c));
     }
     fill_pyramid(finest, pyramid);
     Ok(())
@@ -132,11 +117,7 @@ pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Resu
 
 /// Like [`build_pyramid`] from a row-major scalar importance of the finest level (any
 /// non-negative finite weight that is > 0 wherever the radiance is).
-pub fn build_pyramid_from_importance(
-    finest: u32,
-    importance: &[f32],
-    pyramid: &mut [f32],
-) -> Result<(), EnvError> {
+pub fn build_pyramid_from_importance(finest: u32, importance: &[f32], pyramid: &mut [f32]) -> Result<(), EnvError> {
     check_lengths(finest, importance.len(), pyramid.len())?;
     let n = 1usize << finest;
     for (i, v) in importance.iter().enumerate() {
@@ -166,18 +147,10 @@ fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError
     }
     let texels = 1usize << (2 * finest);
     if rgb != texels {
-        return Err(EnvError::WrongLength {
-            buffer: "radiance",
-            expected: texels,
-            found: rgb,
-        });
+        return Err(EnvError::WrongLength { buffer: "radiance", expected: texels, found: rgb });
     }
     if pyramid != pyramid_len(finest) {
-        return Err(EnvError::WrongLength {
-            buffer: "pyramid",
-            expected: pyramid_len(finest),
-            found: pyramid,
-        });
+        return Err(EnvError::WrongLength { buffer: "pyramid", expected: pyramid_len(finest), found: pyramid });
     }
     Ok(())
 }
@@ -208,11 +181,7 @@ pub struct EnvHierarchy<'a> {
 
 impl<'a> EnvHierarchy<'a> {
     /// A view over `pyramid` (filled by [`build_pyramid`]) and the finest-level `radiance`.
-    pub fn new(
-        finest: u32,
-        pyramid: &'a [f32],
-        radiance: &'a [[f32; 3]],
-    ) -> Result<Self, EnvError> {
+    pub fn new(finest: u32, pyramid: &'a [f32], radiance: &'a [[f32; 3]]) -> Result<Self, EnvError> {
         check_lengths(finest, radiance.len(), pyramid.len())?;
         let mean = pyramid[0];
         if !mean.is_finite() || mean < 0.0 {
@@ -397,11 +366,7 @@ impl<'a> EnvHierarchy<'a> {
         let (x, y) = self.warp_down(0, 0, 0, &mut xi)?;
         let uv = point_in_cell(x, y, self.finest, xi);
         let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
-        Some(EnvSample {
-            dir: self.dir_of(uv),
-            uv,
-            pdf,
-        })
+        Some(EnvSample { dir: self.dir_of(uv), uv, pdf })
     }
 }
 
@@ -416,9 +381,7 @@ mod tests {
         assert_eq!(pyramid_len(2), 21);
         assert_eq!(level_offset(2), 5);
         let mut p = [0.0f32; 21];
-        let fine = [
-            1.0, 2.0, 0.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0, 8.0, 8.0, 0.0, 0.0, 8.0, 8.0,
-        ];
+        let fine = [1.0, 2.0, 0.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0, 8.0, 8.0, 0.0, 0.0, 8.0, 8.0];
         p[5..].copy_from_slice(&fine);
         build_pyramid_from_importance(2, &fine, &mut p).unwrap();
         assert_eq!(&p[1..5], &[2.5, 0.0, 0.0, 8.0]);
@@ -446,10 +409,7 @@ mod tests {
             }
         }
         // The finest level reads back the row-major input.
-        assert_eq!(
-            e.node_relative(3, 5, 2) / e.inv_mean,
-            luminance(Vec3::from_array(rgb[2 * 8 + 5]))
-        );
+        assert_eq!(e.node_relative(3, 5, 2) / e.inv_mean, luminance(Vec3::from_array(rgb[2 * 8 + 5])));
     }
 
     #[test]
@@ -464,12 +424,7 @@ mod tests {
 
     #[test]
     fn sanitize_counts_bad_texels() {
-        let mut t = [
-            [1.0, f32::NAN, 0.0],
-            [f32::INFINITY, 0.0, 0.0],
-            [-1.0, 2.0, 3.0],
-            [1.0, 2.0, 3.0],
-        ];
+        let mut t = [[1.0, f32::NAN, 0.0], [f32::INFINITY, 0.0, 0.0], [-1.0, 2.0, 3.0], [1.0, 2.0, 3.0]];
         assert_eq!(sanitize_rgb(&mut t), 3);
         assert_eq!(t[0], [1.0, 0.0, 0.0]);
         assert_eq!(t[2], [0.0, 2.0, 3.0]);
@@ -490,14 +445,8 @@ mod tests {
     fn wrong_lengths_are_errors() {
         let rgb = [[0.0f32; 3]; 4];
         let p = [0.0f32; 4];
-        assert!(matches!(
-            EnvHierarchy::new(1, &p, &rgb),
-            Err(EnvError::WrongLength { .. })
-        ));
+        assert!(matches!(EnvHierarchy::new(1, &p, &rgb), Err(EnvError::WrongLength { .. })));
         let p = [f32::NAN; 5];
-        assert_eq!(
-            EnvHierarchy::new(1, &p, &rgb).unwrap_err(),
-            EnvError::NotSanitized
-        );
+        assert_eq!(EnvHierarchy::new(1, &p, &rgb).unwrap_err(), EnvError::NotSanitized);
     }
 }

@@ -35,16 +35,14 @@ impl<B: Brdf + ?Sized> ShadingPoint<'_, B> {
     #[inline]
     #[must_use]
     pub fn eval(&self, dir: Vec3) -> Vec3 {
-        self.brdf
-            .eval(self.frame.to_local(self.wo), self.frame.to_local(dir))
+        self.brdf.eval(self.frame.to_local(self.wo), self.frame.to_local(dir))
     }
 
     /// The BRDF's own sampling density for a world direction.
     #[inline]
     #[must_use]
     pub fn brdf_pdf(&self, dir: Vec3) -> f32 {
-        self.brdf
-            .pdf(self.frame.to_local(self.wo), self.frame.to_local(dir))
+        self.brdf.pdf(self.frame.to_local(self.wo), self.frame.to_local(dir))
     }
 }
 
@@ -63,11 +61,7 @@ pub struct Contribution {
 
 #[inline]
 fn weighted(f: Vec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> Vec3 {
-    if pdf > 0.0 && f.cmpgt(Vec3::ZERO).any() && vis.visible(dir) {
-        f / pdf
-    } else {
-        Vec3::ZERO
-    }
+    if pdf > 0.0 && f.cmpgt(Vec3::ZERO).any() && vis.visible(dir) { f / pdf } else { Vec3::ZERO }
 }
 
 /// Product importance sampling: one direction from the shading point's [`ProductSampler`].
@@ -81,12 +75,7 @@ pub fn product<B: Brdf + ?Sized>(
         return Contribution::default();
     };
     let f = sampler.env().radiance(s.dir) * sp.eval(s.dir);
-    Contribution {
-        dir: s.dir,
-        value: weighted(f, s.pdf, vis, s.dir),
-        pdf: s.pdf,
-        other_pdf: 0.0,
-    }
+    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
 /// Environment-only sampling through the same hierarchy.
@@ -100,12 +89,7 @@ pub fn env<B: Brdf + ?Sized>(
         return Contribution::default();
     };
     let f = env.radiance(s.dir) * sp.eval(s.dir);
-    Contribution {
-        dir: s.dir,
-        value: weighted(f, s.pdf, vis, s.dir),
-        pdf: s.pdf,
-        other_pdf: 0.0,
-    }
+    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
 /// BRDF-only sampling.
@@ -120,12 +104,7 @@ pub fn brdf<B: Brdf + ?Sized>(
     };
     let dir = sp.frame.to_world(s.wi);
     let f = env.radiance(dir) * s.value;
-    Contribution {
-        dir,
-        value: weighted(f, s.pdf, vis, dir),
-        pdf: s.pdf,
-        other_pdf: 0.0,
-    }
+    Contribution { dir, value: weighted(f, s.pdf, vis, dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
 /// Multiple importance sampling, balance heuristic, one environment and one BRDF sample
@@ -171,23 +150,13 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
     if let Some((dir, p)) = drawn {
         let p_brdf = sp.brdf_pdf(dir);
         let f = env_h.radiance(dir) * sp.eval(dir);
-        out[0] = Contribution {
-            dir,
-            value: weighted(f, p + p_brdf, vis, dir),
-            pdf: p,
-            other_pdf: p_brdf,
-        };
+        out[0] = Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf };
     }
     if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
         let dir = sp.frame.to_world(s.wi);
         let p_other = pdf(dir);
         let f = env_h.radiance(dir) * s.value;
-        out[1] = Contribution {
-            dir,
-            value: weighted(f, s.pdf + p_other, vis, dir),
-            pdf: s.pdf,
-            other_pdf: p_other,
-        };
+        out[1] = Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other };
     }
     out
 }

@@ -57,9 +57,7 @@ mod tests {
         ] {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-6 && (f.t.length() - 1.0).abs() < 1e-6);
-            assert!(
-                f.s.dot(f.t).abs() < 1e-6 && f.s.dot(n).abs() < 1e-6 && f.t.dot(n).abs() < 1e-6
-            );
+            assert!(f.s.dot(f.t).abs() < 1e-6 && f.s.dot(n).abs() < 1e-6 && f.t.dot(n).abs() < 1e-6);
             assert!((f.s.cross(f.t) - n).length() < 1e-6, "{n:?}");
             let v = Vec3::new(0.3, -0.4, 0.5);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);

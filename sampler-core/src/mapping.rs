@@ -56,14 +56,9 @@ fn atan_unit4(x: Vec4) -> Vec4 {
 #[inline(always)]
 fn sin_cos_quarter(w: f32) -> (f32, f32) {
     let w2 = w * w;
-    let s = w
-        * (1.0
-            + w2 * (-1.0 / 6.0
-                + w2 * (1.0 / 120.0 + w2 * (-1.0 / 5040.0 + w2 * (1.0 / 362_880.0)))));
-    let c = 1.0
-        + w2 * (-0.5
-            + w2 * (1.0 / 24.0
-                + w2 * (-1.0 / 720.0 + w2 * (1.0 / 40_320.0 + w2 * (-1.0 / 3_628_800.0)))));
+    let s = w * (1.0 + w2 * (-1.0 / 6.0 + w2 * (1.0 / 120.0 + w2 * (-1.0 / 5040.0 + w2 * (1.0 / 362_880.0)))));
+    let c =
+        1.0 + w2 * (-0.5 + w2 * (1.0 / 24.0 + w2 * (-1.0 / 720.0 + w2 * (1.0 / 40_320.0 + w2 * (-1.0 / 3_628_800.0)))));
     (s, c)
 }
 
@@ -73,13 +68,11 @@ fn sin_cos_quarter4(w: Vec4) -> (Vec4, Vec4) {
     let sp = |c: f32| Vec4::splat(c);
     let s = w
         * (sp(1.0)
-            + w2 * (sp(-1.0 / 6.0)
-                + w2 * (sp(1.0 / 120.0) + w2 * (sp(-1.0 / 5040.0) + w2 * sp(1.0 / 362_880.0)))));
+            + w2 * (sp(-1.0 / 6.0) + w2 * (sp(1.0 / 120.0) + w2 * (sp(-1.0 / 5040.0) + w2 * sp(1.0 / 362_880.0)))));
     let c = sp(1.0)
         + w2 * (sp(-0.5)
             + w2 * (sp(1.0 / 24.0)
-                + w2 * (sp(-1.0 / 720.0)
-                    + w2 * (sp(1.0 / 40_320.0) + w2 * sp(-1.0 / 3_628_800.0)))));
+                + w2 * (sp(-1.0 / 720.0) + w2 * (sp(1.0 / 40_320.0) + w2 * sp(-1.0 / 3_628_800.0)))));
     (s, c)
 }
 
@@ -114,11 +107,7 @@ pub fn square_to_sphere(p: Vec2) -> Vec3 {
     let cos_phi = (cw - sw) * FRAC_1_SQRT_2;
     let sin_phi = (cw + sw) * FRAC_1_SQRT_2;
     let rs = r * (2.0 - r * r).max(0.0).sqrt_core();
-    Vec3::new(
-        (cos_phi * rs).copysign(s),
-        (sin_phi * rs).copysign(t),
-        (1.0 - r * r).copysign(sd),
-    )
+    Vec3::new((cos_phi * rs).copysign(s), (sin_phi * rs).copysign(t), (1.0 - r * r).copysign(sd))
 }
 
 /// Maps a direction (any length > 0; the zero vector goes to +z) to the unit square.
@@ -161,11 +150,7 @@ pub fn square_to_sphere_x4(u: Vec4, v: Vec4) -> [Vec4; 3] {
     let cos_phi = (cw - sw) * Vec4::splat(FRAC_1_SQRT_2);
     let sin_phi = (cw + sw) * Vec4::splat(FRAC_1_SQRT_2);
     let rs = r * sqrt4((Vec4::splat(2.0) - r * r).max(Vec4::ZERO));
-    [
-        (cos_phi * rs).copysign(s),
-        (sin_phi * rs).copysign(t),
-        (one - r * r).copysign(sd),
-    ]
+    [(cos_phi * rs).copysign(s), (sin_phi * rs).copysign(t), (one - r * r).copysign(sd)]
 }
 
 /// Four directions at a time (structure of arrays): `(x, y, z)` → `[u, v]`.
@@ -187,10 +172,7 @@ pub fn sphere_to_square_x4(x: Vec4, y: Vec4, z: Vec4) -> [Vec4; 2] {
     let tp = phi * r;
     let sp = r - tp;
     let lower = z.cmplt(Vec4::ZERO);
-    let (sp, tp) = (
-        Vec4::select(lower, one - tp, sp),
-        Vec4::select(lower, one - sp, tp),
-    );
+    let (sp, tp) = (Vec4::select(lower, one - tp, sp), Vec4::select(lower, one - sp, tp));
     let half = Vec4::splat(0.5);
     [half * sp.copysign(x) + half, half * tp.copysign(y) + half]
 }
@@ -315,30 +297,16 @@ mod tests {
     #[test]
     fn poles_and_corners() {
         assert_eq!(square_to_sphere(Vec2::new(0.5, 0.5)), Vec3::Z);
-        for c in [
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(0.0, 1.0),
-            Vec2::new(1.0, 1.0),
-        ] {
+        for c in [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)] {
             let d = square_to_sphere(c);
             assert!((d.z + 1.0).abs() < 1e-7, "{c:?} -> {d:?}");
         }
         let c = sphere_to_square(Vec3::Z);
         assert_eq!(c, Vec2::new(0.5, 0.5));
         // −z with ±0 in x, y goes to the matching corner (sign bit, not sign()).
-        assert_eq!(
-            sphere_to_square(Vec3::new(0.0, 0.0, -1.0)),
-            Vec2::new(1.0, 1.0)
-        );
-        assert_eq!(
-            sphere_to_square(Vec3::new(-0.0, -0.0, -1.0)),
-            Vec2::new(0.0, 0.0)
-        );
-        assert_eq!(
-            sphere_to_square(Vec3::new(-0.0, 0.0, -1.0)),
-            Vec2::new(0.0, 1.0)
-        );
+        assert_eq!(sphere_to_square(Vec3::new(0.0, 0.0, -1.0)), Vec2::new(1.0, 1.0));
+        assert_eq!(sphere_to_square(Vec3::new(-0.0, -0.0, -1.0)), Vec2::new(0.0, 0.0));
+        assert_eq!(sphere_to_square(Vec3::new(-0.0, 0.0, -1.0)), Vec2::new(0.0, 1.0));
         assert_eq!(sphere_to_square(Vec3::ZERO), Vec2::new(0.5, 0.5));
     }
 

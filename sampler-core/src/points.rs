@@ -37,10 +37,7 @@ pub fn best_candidate(rng: &mut Pcg32, candidates: usize, out: &mut [DVec2]) {
         let mut best = DVec2::ZERO;
         let mut best_d = -1.0;
         for _ in 0..candidates * (k + 1) {
-            let c = DVec2::new(
-                rng.next_u32() as f64 * INV_2_32,
-                rng.next_u32() as f64 * INV_2_32,
-            );
+            let c = DVec2::new(rng.next_u32() as f64 * INV_2_32, rng.next_u32() as f64 * INV_2_32);
             let mut d_min = f64::INFINITY;
             for q in &out[..k] {
                 let mut d = (c - *q).abs();
@@ -159,10 +156,7 @@ pub fn sobol02_shifted(seed: u64, first: u32, out: &mut [Vec2]) {
     let (s0, s1) = (h as u32, (h >> 32) as u32);
     for (k, p) in out.iter_mut().enumerate() {
         let i = first.wrapping_add(k as u32);
-        *p = Vec2::new(
-            ((sobol_dim0(i) ^ s0) >> 8) as f32 * INV_2_24,
-            ((sobol_dim1(i) ^ s1) >> 8) as f32 * INV_2_24,
-        );
+        *p = Vec2::new(((sobol_dim0(i) ^ s0) >> 8) as f32 * INV_2_24, ((sobol_dim1(i) ^ s1) >> 8) as f32 * INV_2_24);
     }
 }
 

@@ -131,22 +131,10 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
     /// the stack and copying it back costs a failed store-forward per node.
     /// `env` is the environment's relative mean over the cell (fetched by the parent).
     #[allow(clippy::too_many_arguments)]
-    fn node(
-        &mut self,
-        index: usize,
-        depth: u32,
-        x: u32,
-        y: u32,
-        env: f32,
-        lo: usize,
-        hi: usize,
-    ) -> (f32, f32) {
+    fn node(&mut self, index: usize, depth: u32, x: u32, y: u32, env: f32, lo: usize, hi: usize) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || depth >= self.max_depth || !room {
-            let sum: f32 = self.keys[lo..hi]
-                .iter()
-                .map(|k| self.values[(k & 0xFFFF) as usize])
-                .sum();
+            let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
             let b = sum / (hi - lo) as f32;
             let product = b * env;
             set(&mut self.nodes[index], 0, b, product);
@@ -170,11 +158,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         let bounds = [lo, lo + below1, lo + below2, lo + below3, hi];
         // The environment over the four children: one 2×2 block of the pyramid (or the texel
         // containing them, below the finest level).
-        let l = if depth < self.env.finest_level() {
-            self.env.children_relative(depth, x, y)
-        } else {
-            [env; 4]
-        };
+        let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
@@ -182,8 +166,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
             if bounds[c + 1] > bounds[c] {
                 let (dx, dy) = child_offset(c);
                 let (cx, cy) = (2 * x + dx, 2 * y + dy);
-                (b[c], p[c]) =
-                    self.node(first + c, depth + 1, cx, cy, l[c], bounds[c], bounds[c + 1]);
+                (b[c], p[c]) = self.node(first + c, depth + 1, cx, cy, l[c], bounds[c], bounds[c + 1]);
                 sum_b += b[c];
                 filled += 1;
             }
@@ -229,21 +212,14 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         let inv = 1.0 / (1u64 << depth) as f32;
         let at = |s: f32, t: f32| Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv);
         let read = |v: f32| {
-            if v.is_nan() {
-                f32::INFINITY
-            } else {
-                v.max(0.0)
-            }
+            if v.is_nan() { f32::INFINITY } else { v.max(0.0) }
         };
         let centre = read((self.eval)(at(0.5, 0.5)));
         if centre > 0.0 {
             return centre;
         }
         let (a, b) = (1.0 / 64.0, 63.0 / 64.0);
-        [at(a, a), at(b, a), at(a, b), at(b, b)]
-            .into_iter()
-            .map(|p| read((self.eval)(p)))
-            .fold(0.0, f32::max)
+        [at(a, a), at(b, a), at(a, b), at(b, b)].into_iter().map(|p| read((self.eval)(p))).fold(0.0, f32::max)
     }
 }
 

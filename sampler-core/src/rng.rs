@@ -14,10 +14,7 @@ impl Pcg32 {
     /// A generator on stream `stream` seeded with `seed`.
     #[must_use]
     pub fn new(seed: u64, stream: u64) -> Self {
-        let mut r = Self {
-            state: 0,
-            inc: (stream << 1) | 1,
-        };
+        let mut r = Self { state: 0, inc: (stream << 1) | 1 };
         r.next_u32();
         r.state = r.state.wrapping_add(seed);
         r.next_u32();
@@ -73,14 +70,7 @@ mod tests {
     fn reference_sequence() {
         // pcg32 reference output for seed 42, stream 54 (pcg-c's pcg32-demo).
         let mut r = Pcg32::new(42, 54);
-        let expect = [
-            0xa15c02b7u32,
-            0x7b47f409,
-            0xba1d3330,
-            0x83d2f293,
-            0xbfa4784b,
-            0xcbed606e,
-        ];
+        let expect = [0xa15c02b7u32, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e];
         for e in expect {
             assert_eq!(r.next_u32(), e);
         }

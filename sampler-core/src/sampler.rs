@@ -44,12 +44,7 @@ pub struct ProductParams {
 
 impl Default for ProductParams {
     fn default() -> Self {
-        Self {
-            brdf_samples: 256,
-            max_depth: 20,
-            defensive: 0.02,
-            kind: ProductKind::Quadtree,
-        }
+        Self { brdf_samples: 256, max_depth: 20, defensive: 0.02, kind: ProductKind::Quadtree }
     }
 }
 
@@ -86,10 +81,7 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
         let () = Self::CAPACITY_OK;
         Self {
             points: [Vec2::ZERO; K],
-            draws: [BrdfDraw {
-                wi: Vec3::ZERO,
-                value: 0.0,
-            }; K],
+            draws: [BrdfDraw { wi: Vec3::ZERO, value: 0.0 }; K],
             dirs: [Vec3::ZERO; K],
             values: [0.0; K],
             keys: Vec::new(),
@@ -134,8 +126,7 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
             self.keys.sort_unstable();
         }
         // B·cos at a point of the square, for the empty cells that need it.
-        let map_to_local =
-            (env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n)).transpose();
+        let map_to_local = (env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n)).transpose();
         let eval = |uv: Vec2| luminance(brdf.eval(wo_local, map_to_local * square_to_sphere(uv)));
         let mut builder = TreeBuilder {
             keys: &self.keys,
@@ -149,17 +140,8 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
         builder.build();
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
-        let defensive = if has_product {
-            params.defensive.clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        ProductSampler {
-            env,
-            nodes: &self.nodes,
-            defensive,
-            brdf_samples: count,
-        }
+        let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
+        ProductSampler { env, nodes: &self.nodes, defensive, brdf_samples: count }
     }
 }
 
@@ -228,20 +210,9 @@ impl<'e> ProductSampler<'_, 'e> {
             xi.x = ((xi.x - eps) / (1.0 - eps)).clamp(0.0, ONE_MINUS_EPSILON);
             let (uv, btilde, texel) = self.warp_product(&mut xi)?;
             // The warp knows the leaf and the texel: no second descent for the pdf.
-            (
-                uv,
-                self.mixture(
-                    btilde,
-                    self.env
-                        .node_relative(self.env.finest_level(), texel.0, texel.1),
-                ),
-            )
+            (uv, self.mixture(btilde, self.env.node_relative(self.env.finest_level(), texel.0, texel.1)))
         };
-        Some(DirectionSample {
-            dir: self.env.dir_of(uv),
-            uv,
-            pdf: pdf_square / SPHERE_AREA,
-        })
+        Some(DirectionSample { dir: self.env.dir_of(uv), uv, pdf: pdf_square / SPHERE_AREA })
     }
 
     /// Warps through the product tree, then below the leaf through the environment's levels.

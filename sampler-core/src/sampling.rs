@@ -13,11 +13,7 @@ pub fn square_to_uniform_disk_concentric(u: Vec2) -> Vec2 {
         return Vec2::ZERO;
     }
     // φ/2π ∈ [−⅛, ⅜]: the polynomial sincos needs a non-negative turn.
-    let (r, turn) = if a.abs() > b.abs() {
-        (a, 0.125 * (b / a))
-    } else {
-        (b, 0.25 - 0.125 * (a / b))
-    };
+    let (r, turn) = if a.abs() > b.abs() { (a, 0.125 * (b / a)) } else { (b, 0.25 - 0.125 * (a / b)) };
     let (s, c) = sin_cos_2pi(if turn < 0.0 { turn + 1.0 } else { turn });
     Vec2::new(r * c, r * s)
 }
@@ -32,10 +28,7 @@ mod sincos_tests {
             let u = i as f32 / 100_000.0;
             let (s, c) = sin_cos_2pi(u);
             let a = 2.0 * core::f64::consts::PI * u as f64;
-            assert!(
-                (s as f64 - libm::sin(a)).abs() < 3e-7 && (c as f64 - libm::cos(a)).abs() < 3e-7,
-                "{u}"
-            );
+            assert!((s as f64 - libm::sin(a)).abs() < 3e-7 && (c as f64 - libm::cos(a)).abs() < 3e-7, "{u}");
         }
     }
 }
@@ -83,10 +76,7 @@ pub fn sin_cos_2pi(u: f32) -> (f32, f32) {
     let q = (x + 0.5) as i32; // round to nearest quarter (u ≥ 0)
     let w = (x - q as f32) * (0.5 * PI);
     let w2 = w * w;
-    let s = w
-        * (1.0
-            + w2 * (-1.0 / 6.0
-                + w2 * (1.0 / 120.0 + w2 * (-1.0 / 5040.0 + w2 * (1.0 / 362_880.0)))));
+    let s = w * (1.0 + w2 * (-1.0 / 6.0 + w2 * (1.0 / 120.0 + w2 * (-1.0 / 5040.0 + w2 * (1.0 / 362_880.0)))));
     let c = 1.0 + w2 * (-0.5 + w2 * (1.0 / 24.0 + w2 * (-1.0 / 720.0 + w2 * (1.0 / 40_320.0))));
     match q & 3 {
         0 => (s, c),

@@ -63,11 +63,7 @@ pub fn point_in_cell(x: u32, y: u32, level: u32, xi: DVec2) -> glam::Vec2 {
         let lo = (i as f64 * inv) as f32; // exact: dyadic
         let hi = ((i + 1) as f64 * inv) as f32;
         let c = ((i as f64 + f) * inv) as f32;
-        if c >= hi {
-            next_down(hi).max(lo)
-        } else {
-            c.max(lo)
-        }
+        if c >= hi { next_down(hi).max(lo) } else { c.max(lo) }
     };
     glam::Vec2::new(coord(x, xi.x), coord(y, xi.y))
 }
@@ -75,11 +71,7 @@ pub fn point_in_cell(x: u32, y: u32, level: u32, xi: DVec2) -> glam::Vec2 {
 /// The largest f32 below a positive finite `x`.
 #[inline]
 fn next_down(x: f32) -> f32 {
-    if x <= 0.0 {
-        x
-    } else {
-        f32::from_bits(x.to_bits() - 1)
-    }
+    if x <= 0.0 { x } else { f32::from_bits(x.to_bits() - 1) }
 }
 
 #[cfg(test)]

@@ -15,19 +15,14 @@
 //! at the leaves of the BRDF tree. The environment's coefficients come from its mip pyramid
 //! (the pyramid *is* the scaling part of its Haar transform).
 
-const PSI: [[f32; 4]; 3] = [
-    [1.0, -1.0, 1.0, -1.0],
-    [1.0, 1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0, 1.0],
-];
+const PSI: [[f32; 4]; 3] = [[1.0, -1.0, 1.0, -1.0], [1.0, 1.0, -1.0, -1.0], [1.0, -1.0, -1.0, 1.0]];
 
 /// Haar coefficients (scaling, three wavelets) of four child means.
 #[inline]
 #[must_use]
 pub fn haar_coefficients(f: [f32; 4]) -> (f32, [f32; 3]) {
     let mean = 0.25 * ((f[0] + f[1]) + (f[2] + f[3]));
-    let w =
-        PSI.map(|psi| 0.25 * ((f[0] * psi[0] + f[1] * psi[1]) + (f[2] * psi[2] + f[3] * psi[3])));
+    let w = PSI.map(|psi| 0.25 * ((f[0] * psi[0] + f[1] * psi[1]) + (f[2] * psi[2] + f[3] * psi[3])));
     (mean, w)
 }
 
@@ -38,9 +33,7 @@ pub fn haar_coefficients(f: [f32; 4]) -> (f32, [f32; 3]) {
 pub fn haar_product_mean(b: [f32; 4], l: [f32; 4], p: [f32; 4]) -> f32 {
     let (ab, wb) = haar_coefficients(b);
     let (al, wl) = haar_coefficients(l);
-    let detail = 0.25
-        * (((p[0] - b[0] * l[0]) + (p[1] - b[1] * l[1]))
-            + ((p[2] - b[2] * l[2]) + (p[3] - b[3] * l[3])));
+    let detail = 0.25 * (((p[0] - b[0] * l[0]) + (p[1] - b[1] * l[1])) + ((p[2] - b[2] * l[2]) + (p[3] - b[3] * l[3])));
     let p = ab * al + (wb[0] * wl[0] + wb[1] * wl[1] + wb[2] * wl[2]) + detail;
     p.max(0.0)
 }

@@ -16,14 +16,9 @@ fn batched_samples_match_single_samples() {
         Box::new(CarPaint::default()),
     ];
     let mut rng = Pcg32::new(3, 3);
-    let u: Vec<Vec2> = (0..256)
-        .map(|_| Vec2::new(rng.next_f32(), rng.next_f32()))
-        .collect();
+    let u: Vec<Vec2> = (0..256).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
     for brdf in &brdfs {
-        for wo in [
-            Vec3::new(0.3, -0.2, 0.9).normalize(),
-            Vec3::new(0.999, 0.0, 0.04).normalize(),
-        ] {
+        for wo in [Vec3::new(0.3, -0.2, 0.9).normalize(), Vec3::new(0.999, 0.0, 0.04).normalize()] {
             let mut out = vec![BrdfDraw::default(); u.len()];
             let n = brdf.sample_batch(wo, &u, &mut out);
             let single: Vec<_> = u.iter().filter_map(|p| brdf.sample(wo, *p)).collect();
@@ -33,11 +28,7 @@ fn batched_samples_match_single_samples() {
             for d in &out[..n] {
                 if k < single.len() && (single[k].wi - d.wi).length() < 1e-5 {
                     let value = luminance(single[k].value);
-                    assert!(
-                        (value - d.value).abs() <= 1e-3 * value.max(d.value).max(1e-6),
-                        "{value} vs {}",
-                        d.value
-                    );
+                    assert!((value - d.value).abs() <= 1e-3 * value.max(d.value).max(1e-6), "{value} vs {}", d.value);
                     k += 1;
                 }
             }

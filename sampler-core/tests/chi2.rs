@@ -17,41 +17,13 @@ const SAMPLES: usize = 100_000;
 fn brdfs() -> Vec<(&'static str, Box<dyn Brdf>, Option<f64>)> {
     vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.8))), None),
-        (
-            "phong n=10",
-            Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.6), 10.0)),
-            None,
-        ),
-        (
-            "phong n=1e3",
-            Box::new(Phong::new(Vec3::ZERO, Vec3::splat(0.9), 1e3)),
-            Some(2.0 / 1e3f64.sqrt()),
-        ),
-        (
-            "phong n=1e5",
-            Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.9), 1e5)),
-            Some(2.0 / 1e5f64.sqrt()),
-        ),
-        (
-            "ggx a=1",
-            Box::new(RoughConductor::new(1.0, Vec3::ONE)),
-            None,
-        ),
-        (
-            "ggx a=0.3",
-            Box::new(RoughConductor::new(0.3, Vec3::ONE)),
-            None,
-        ),
-        (
-            "ggx a=0.05",
-            Box::new(RoughConductor::new(0.05, Vec3::ONE)),
-            Some(0.1),
-        ),
-        (
-            "ggx a=1e-3",
-            Box::new(RoughConductor::new(1e-3, Vec3::ONE)),
-            Some(2e-3),
-        ),
+        ("phong n=10", Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.6), 10.0)), None),
+        ("phong n=1e3", Box::new(Phong::new(Vec3::ZERO, Vec3::splat(0.9), 1e3)), Some(2.0 / 1e3f64.sqrt())),
+        ("phong n=1e5", Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.9), 1e5)), Some(2.0 / 1e5f64.sqrt())),
+        ("ggx a=1", Box::new(RoughConductor::new(1.0, Vec3::ONE)), None),
+        ("ggx a=0.3", Box::new(RoughConductor::new(0.3, Vec3::ONE)), None),
+        ("ggx a=0.05", Box::new(RoughConductor::new(0.05, Vec3::ONE)), Some(0.1)),
+        ("ggx a=1e-3", Box::new(RoughConductor::new(1e-3, Vec3::ONE)), Some(2e-3)),
         ("carpaint", Box::new(CarPaint::default()), Some(0.01)),
     ]
 }
@@ -62,11 +34,7 @@ fn views() -> Vec<(&'static str, Vec3, Vec3)> {
     vec![
         ("normal +z, 20°", Vec3::Z, tilt(20f32.to_radians().cos())),
         ("normal -x, grazing", Vec3::NEG_X, tilt(0.05)),
-        (
-            "normal oblique, 60°",
-            Vec3::new(0.3, -0.5, 0.8).normalize(),
-            tilt(0.5),
-        ),
+        ("normal oblique, 60°", Vec3::new(0.3, -0.5, 0.8).normalize(), tilt(0.5)),
     ]
 }
 
@@ -80,10 +48,7 @@ fn brdf_samplers_match_their_pdf() {
             let axis = Vec3::new(-wo.x, -wo.y, wo.z);
             let chart = match width {
                 Some(w) => Chart::Polar { axis, scale: w },
-                None => Chart::Polar {
-                    axis: Vec3::Z,
-                    scale: 1.0,
-                },
+                None => Chart::Polar { axis: Vec3::Z, scale: 1.0 },
             };
             let r = chi_square(
                 chart,
@@ -99,11 +64,7 @@ fn brdf_samplers_match_their_pdf() {
             }
         }
     }
-    assert!(
-        failures.is_empty(),
-        "α = {alpha:.2e}\n{}",
-        failures.join("\n")
-    );
+    assert!(failures.is_empty(), "α = {alpha:.2e}\n{}", failures.join("\n"));
 }
 
 #[test]
@@ -114,10 +75,7 @@ fn env_sampler_matches_its_pdf() {
         ("sun on the pole", TestEnv::sun(7, (64, 64), 1e7)),
         ("sun in a corner", TestEnv::sun(7, (0, 127), 1e7)),
         ("1x1", TestEnv::constant(0, 2.0)),
-        (
-            "2x2",
-            TestEnv::new(1, vec![[1.0; 3], [0.0; 3], [5.0; 3], [0.5; 3]]),
-        ),
+        ("2x2", TestEnv::new(1, vec![[1.0; 3], [0.0; 3], [5.0; 3], [0.5; 3]])),
     ];
     let alpha = sidak(envs.len());
     for (name, env) in &envs {
@@ -135,9 +93,7 @@ fn env_sampler_matches_its_pdf() {
         let mut mismatch = 0;
         let mut rng = sampler_core::rng::Pcg32::new(5, 5);
         for _ in 0..10_000 {
-            let s = e
-                .sample(DVec2::new(rng.next_f64(), rng.next_f64()))
-                .unwrap();
+            let s = e.sample(DVec2::new(rng.next_f64(), rng.next_f64())).unwrap();
             mismatch += usize::from((e.pdf(s.dir) - s.pdf).abs() > 1e-4 * s.pdf);
         }
         assert!(mismatch <= 10, "{name}: {mismatch} of 10000 pdfs differ");
@@ -145,15 +101,9 @@ fn env_sampler_matches_its_pdf() {
 }
 
 fn product_cases(kind: ProductKind) -> Vec<String> {
-    let envs = [
-        ("smooth", TestEnv::random_smooth(6, 2)),
-        ("sun 1e6", TestEnv::sun(7, (90, 40), 1e6)),
-    ];
+    let envs = [("smooth", TestEnv::random_smooth(6, 2)), ("sun 1e6", TestEnv::sun(7, (90, 40), 1e6))];
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let params = ProductParams {
-        kind,
-        ..ProductParams::default()
-    };
+    let params = ProductParams { kind, ..ProductParams::default() };
     let cases = envs.len() * brdfs().len() * views().len();
     let alpha = sidak(cases);
     let mut failures = Vec::new();
@@ -177,9 +127,7 @@ fn product_cases(kind: ProductKind) -> Vec<String> {
                 let mut mismatch = 0;
                 let mut rng = sampler_core::rng::Pcg32::new(9, seed as u64);
                 for _ in 0..10_000 {
-                    let s = sampler
-                        .sample(DVec2::new(rng.next_f64(), rng.next_f64()))
-                        .unwrap();
+                    let s = sampler.sample(DVec2::new(rng.next_f64(), rng.next_f64())).unwrap();
                     assert!(s.dir.is_finite() && s.pdf.is_finite() && s.pdf > 0.0);
                     mismatch += usize::from((sampler.pdf(s.dir) - s.pdf).abs() > 1e-4 * s.pdf);
                 }
@@ -227,8 +175,5 @@ fn product_sampler_directions_match_pdf_on_a_sphere_grid() {
         |u| sampler.sample(u).map(|s| (s.dir, s.pdf)),
         |d| sampler.pdf(d),
     );
-    assert!(
-        r.p_value > 0.01 && r.impossible == 0 && r.pdf_mismatch < 1e-3,
-        "{r:?}"
-    );
+    assert!(r.p_value > 0.01 && r.impossible == 0 && r.pdf_mismatch < 1e-3, "{r:?}");
 }

@@ -33,27 +33,12 @@ fn variance(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 #[test]
 fn product_sampling_beats_env_and_brdf_sampling() {
-    let envs = [
-        ("smooth", TestEnv::random_smooth(7, 21)),
-        ("sun", TestEnv::sun(8, (150, 90), 1e4)),
-    ];
+    let envs = [("smooth", TestEnv::random_smooth(7, 21)), ("sun", TestEnv::sun(8, (150, 90), 1e4))];
     let brdfs: Vec<(&str, Box<dyn Brdf>, bool)> = vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.6))), false),
-        (
-            "phong n=1e4",
-            Box::new(Phong::new(Vec3::ZERO, Vec3::splat(0.9), 1e4)),
-            true,
-        ),
-        (
-            "ggx a=0.2",
-            Box::new(RoughConductor::new(0.2, Vec3::ONE)),
-            false,
-        ),
-        (
-            "ggx a=1e-3",
-            Box::new(RoughConductor::new(1e-3, Vec3::ONE)),
-            true,
-        ),
+        ("phong n=1e4", Box::new(Phong::new(Vec3::ZERO, Vec3::splat(0.9), 1e4)), true),
+        ("ggx a=0.2", Box::new(RoughConductor::new(0.2, Vec3::ONE)), false),
+        ("ggx a=1e-3", Box::new(RoughConductor::new(1e-3, Vec3::ONE)), true),
         ("carpaint", Box::new(CarPaint::default()), false),
     ];
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
@@ -64,24 +49,17 @@ fn product_sampling_beats_env_and_brdf_sampling() {
         for (name, brdf, needle) in &brdfs {
             let frame = Frame::from_normal(Vec3::new(0.3, 0.2, 0.9).normalize());
             let wo = frame.to_world(Vec3::new(0.4, -0.2, 0.89).normalize());
-            let sp = ShadingPoint {
-                frame,
-                wo,
-                brdf: brdf.as_ref(),
-            };
+            let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
             let mut vis = |_: Vec3| true;
             let lum = |v: Vec3| luminance(v) as f64;
             let (mut a, mut b) = (Pcg32::new(1, 2), Pcg32::new(3, 4));
             let n = 100_000;
-            let (_, v_env) = variance((0..n).map(|_| {
-                lum(estimator::env(&e, &sp, DVec2::new(a.next_f64(), a.next_f64()), &mut vis).value)
-            }));
-            let (_, v_brdf) = variance((0..n).map(|_| {
-                lum(
-                    estimator::brdf(&e, &sp, DVec2::new(b.next_f64(), b.next_f64()), &mut vis)
-                        .value,
-                )
-            }));
+            let (_, v_env) = variance(
+                (0..n).map(|_| lum(estimator::env(&e, &sp, DVec2::new(a.next_f64(), a.next_f64()), &mut vis).value)),
+            );
+            let (_, v_brdf) = variance(
+                (0..n).map(|_| lum(estimator::brdf(&e, &sp, DVec2::new(b.next_f64(), b.next_f64()), &mut vis).value)),
+            );
             let params = ProductParams::default();
             let (_, v_prod) = variance((0..n as u64 / 16).flat_map(|seed| {
                 let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed);
@@ -98,8 +76,7 @@ fn product_sampling_beats_env_and_brdf_sampling() {
                 sobol02(seed + 8, 0, &mut qts);
                 let mut out = [0.0; 16];
                 for k in 0..16 {
-                    let [a, b] =
-                        estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
+                    let [a, b] = estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
                     out[k] = lum(a.value + b.value);
                 }
                 out
@@ -111,11 +88,7 @@ fn product_sampling_beats_env_and_brdf_sampling() {
                 v_prod / best,
                 v_mis / best
             ));
-            let ok = if *needle {
-                v_mis * 3.0 <= v_prod
-            } else {
-                v_prod <= 0.5 * best
-            };
+            let ok = if *needle { v_mis * 3.0 <= v_prod } else { v_prod <= 0.5 * best };
             if !ok {
                 failures.push(report.last().unwrap().clone());
             }

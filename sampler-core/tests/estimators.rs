@@ -27,48 +27,21 @@ type MakeBrdf = fn() -> Box<dyn Brdf>;
 
 fn cases() -> Vec<Case> {
     let brdfs: Vec<(&str, MakeBrdf, f64)> = vec![
-        (
-            "lambert",
-            || Box::new(Lambert::new(Vec3::new(0.8, 0.6, 0.4))),
-            1.0,
-        ),
-        (
-            "phong n=1e5",
-            || Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e5)),
-            6e-3,
-        ),
-        (
-            "ggx a=1",
-            || Box::new(RoughConductor::new(1.0, Vec3::ONE)),
-            1.0,
-        ),
-        (
-            "ggx a=0.1",
-            || Box::new(RoughConductor::new(0.1, Vec3::ONE)),
-            0.2,
-        ),
-        (
-            "ggx a=1e-3",
-            || Box::new(RoughConductor::new(1e-3, Vec3::new(0.9, 0.7, 0.5))),
-            2e-3,
-        ),
+        ("lambert", || Box::new(Lambert::new(Vec3::new(0.8, 0.6, 0.4))), 1.0),
+        ("phong n=1e5", || Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e5)), 6e-3),
+        ("ggx a=1", || Box::new(RoughConductor::new(1.0, Vec3::ONE)), 1.0),
+        ("ggx a=0.1", || Box::new(RoughConductor::new(0.1, Vec3::ONE)), 0.2),
+        ("ggx a=1e-3", || Box::new(RoughConductor::new(1e-3, Vec3::new(0.9, 0.7, 0.5))), 2e-3),
         ("carpaint", || Box::new(CarPaint::default()), 0.01),
     ];
     let mut out = Vec::new();
     for (name, make, width) in brdfs {
-        for (view, normal, cos) in [
-            ("20°", Vec3::new(0.2, 0.9, 0.3), 0.94f32),
-            ("grazing", Vec3::new(-0.6, 0.3, 0.7), 0.02),
-        ] {
+        for (view, normal, cos) in
+            [("20°", Vec3::new(0.2, 0.9, 0.3), 0.94f32), ("grazing", Vec3::new(-0.6, 0.3, 0.7), 0.02)]
+        {
             let frame = Frame::from_normal(normal.normalize());
             let wo = frame.to_world(Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos));
-            out.push(Case {
-                name: format!("{name} / {view}"),
-                brdf: make(),
-                width,
-                frame,
-                wo,
-            });
+            out.push(Case { name: format!("{name} / {view}"), brdf: make(), width, frame, wo });
         }
     }
     out
@@ -88,21 +61,13 @@ fn visible(d: Vec3) -> bool {
 }
 
 fn reference(env: &EnvHierarchy<'_>, case: &Case) -> f64 {
-    let sp = ShadingPoint {
-        frame: case.frame,
-        wo: case.wo,
-        brdf: case.brdf.as_ref(),
-    };
+    let sp = ShadingPoint { frame: case.frame, wo: case.wo, brdf: case.brdf.as_ref() };
     let n = case.frame.n;
     let wo_l = case.frame.to_local(case.wo);
     let axis = case.frame.to_world(Vec3::new(-wo_l.x, -wo_l.y, wo_l.z));
     let _ = n;
     integrate_lobe(axis, case.width, 1200, |d| {
-        if visible(d) {
-            luminance(env.radiance(d) * sp.eval(d)) as f64
-        } else {
-            0.0
-        }
+        if visible(d) { luminance(env.radiance(d) * sp.eval(d)) as f64 } else { 0.0 }
     })
 }
 
@@ -137,15 +102,10 @@ impl FromIterator<f64> for Stats {
 
 fn check(label: &str, reference: f64, stats: &Stats, failures: &mut Vec<String>) {
     let (mean, se) = (stats.mean, stats.standard_error());
-    assert!(
-        mean.is_finite() && se.is_finite(),
-        "{label}: non-finite estimate"
-    );
+    assert!(mean.is_finite() && se.is_finite(), "{label}: non-finite estimate");
     let tol = 3.0 * se + 1e-4 * reference.abs();
     if (mean - reference).abs() > tol {
-        failures.push(format!(
-            "{label}: mean {mean:.6e} vs quadrature {reference:.6e}, SE {se:.2e}"
-        ));
+        failures.push(format!("{label}: mean {mean:.6e} vs quadrature {reference:.6e}, SE {se:.2e}"));
     }
 }
 
@@ -156,11 +116,7 @@ fn run(estimator: &str) {
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     for case in cases() {
         let reference = reference(&e, &case);
-        let sp = ShadingPoint {
-            frame: case.frame,
-            wo: case.wo,
-            brdf: case.brdf.as_ref(),
-        };
+        let sp = ShadingPoint { frame: case.frame, wo: case.wo, brdf: case.brdf.as_ref() };
         let mut vis = visible;
         let mut rng = Pcg32::new(17, 3);
         let mut u = || DVec2::new(rng.next_f64(), rng.next_f64());
@@ -169,31 +125,14 @@ fn run(estimator: &str) {
             "product" | "wavelet" => {
                 // Each unit: a fresh B̃ (new BRDF samples) and 32 warped points: the whole
                 // estimator, including the randomness of the product itself.
-                let kind = if estimator == "product" {
-                    ProductKind::Quadtree
-                } else {
-                    ProductKind::Wavelet
-                };
-                let params = ProductParams {
-                    kind,
-                    ..ProductParams::default()
-                };
+                let kind = if estimator == "product" { ProductKind::Quadtree } else { ProductKind::Wavelet };
+                let params = ProductParams { kind, ..ProductParams::default() };
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(
-                            &e,
-                            case.brdf.as_ref(),
-                            &case.frame,
-                            case.wo,
-                            &params,
-                            seed,
-                        );
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
                         let mut pts = [DVec2::ZERO; 32];
                         sobol02(seed ^ 0xabc, 0, &mut pts);
-                        pts.iter()
-                            .map(|p| lum(estimator::product(&s, &sp, *p, &mut vis).value))
-                            .sum::<f64>()
-                            / 32.0
+                        pts.iter().map(|p| lum(estimator::product(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0
                     })
                     .collect()
             }
@@ -208,34 +147,19 @@ fn run(estimator: &str) {
                 } else {
                     200_000
                 };
-                (0..n)
-                    .map(|_| lum(estimator::env(&e, &sp, u(), &mut vis).value))
-                    .collect()
+                (0..n).map(|_| lum(estimator::env(&e, &sp, u(), &mut vis).value)).collect()
             }
             "product-mis" => {
                 let params = ProductParams::default();
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(
-                            &e,
-                            case.brdf.as_ref(),
-                            &case.frame,
-                            case.wo,
-                            &params,
-                            seed,
-                        );
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts);
                         sobol02(seed ^ 0x123, 0, &mut qts);
                         (0..32)
                             .map(|k| {
-                                let [a, b] = estimator::product_mis(
-                                    &s,
-                                    &sp,
-                                    pts[k],
-                                    qts[k].as_vec2(),
-                                    &mut vis,
-                                );
+                                let [a, b] = estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
                                 lum(a.value + b.value)
                             })
                             .sum::<f64>()
@@ -243,9 +167,7 @@ fn run(estimator: &str) {
                     })
                     .collect()
             }
-            "brdf" => (0..200_000)
-                .map(|_| lum(estimator::brdf(&e, &sp, u(), &mut vis).value))
-                .collect(),
+            "brdf" => (0..200_000).map(|_| lum(estimator::brdf(&e, &sp, u(), &mut vis).value)).collect(),
             "mis" => (0..200_000)
                 .map(|_| {
                     let [a, b] = estimator::mis(&e, &sp, u(), u().as_vec2(), &mut vis);
@@ -254,12 +176,7 @@ fn run(estimator: &str) {
                 .collect(),
             _ => unreachable!(),
         };
-        check(
-            &format!("{estimator} / {}", case.name),
-            reference,
-            &values,
-            &mut failures,
-        );
+        check(&format!("{estimator} / {}", case.name), reference, &values, &mut failures);
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

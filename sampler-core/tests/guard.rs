@@ -25,11 +25,7 @@ struct HalfBlind;
 
 impl Brdf for HalfBlind {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wo.z > 0.0 && wi.z > 0.0 {
-            Vec3::splat(0.5 / PI * wi.z)
-        } else {
-            Vec3::ZERO
-        }
+        if wo.z > 0.0 && wi.z > 0.0 { Vec3::splat(0.5 / PI * wi.z) } else { Vec3::ZERO }
     }
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = if u.x < 0.5 {
@@ -42,11 +38,7 @@ impl Brdf for HalfBlind {
             Vec3::new(r * (2.0 * PI * u.y).cos(), r * (2.0 * PI * u.y).sin(), z)
         };
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf,
-        })
+        (pdf > 0.0).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
     }
     fn pdf(&self, _wo: Vec3, wi: Vec3) -> f32 {
         if wi.z > 0.0 && wi.x < 0.0 {
@@ -62,11 +54,7 @@ impl Brdf for HalfBlind {
 fn estimate(params: &ProductParams, env: &TestEnv, frame: &Frame, wo: Vec3) -> (f64, f64) {
     let e = env.view();
     let brdf = HalfBlind;
-    let sp = ShadingPoint {
-        frame: *frame,
-        wo,
-        brdf: &brdf,
-    };
+    let sp = ShadingPoint { frame: *frame, wo, brdf: &brdf };
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let mut vis = |_: Vec3| true;
     let (mut sum, mut sum2, n) = (0.0f64, 0.0f64, 400);
@@ -74,11 +62,8 @@ fn estimate(params: &ProductParams, env: &TestEnv, frame: &Frame, wo: Vec3) -> (
         let s = arena.build(&e, &brdf, frame, wo, params, seed);
         let mut pts = [DVec2::ZERO; 32];
         sobol02(seed + 1000, 0, &mut pts);
-        let v = pts
-            .iter()
-            .map(|p| luminance(estimator::product(&s, &sp, *p, &mut vis).value) as f64)
-            .sum::<f64>()
-            / 32.0;
+        let v =
+            pts.iter().map(|p| luminance(estimator::product(&s, &sp, *p, &mut vis).value) as f64).sum::<f64>() / 32.0;
         sum += v;
         sum2 += v * v;
     }
@@ -99,10 +84,7 @@ fn zero_btilde_where_b_is_positive_is_guarded() {
     });
 
     // The trap is real: a pure product sampler (ε = 0) loses the unsampled half.
-    let unguarded = ProductParams {
-        defensive: 0.0,
-        ..ProductParams::default()
-    };
+    let unguarded = ProductParams { defensive: 0.0, ..ProductParams::default() };
     let (mean, se) = estimate(&unguarded, &env, &frame, wo);
     assert!(
         reference - mean > 10.0 * se && mean < 0.9 * reference,
@@ -111,10 +93,7 @@ fn zero_btilde_where_b_is_positive_is_guarded() {
 
     // The guard (default ε) makes it unbiased.
     let (mean, se) = estimate(&ProductParams::default(), &env, &frame, wo);
-    assert!(
-        (mean - reference).abs() < 3.0 * se + 1e-4 * reference,
-        "guarded: {mean} vs {reference} (SE {se})"
-    );
+    assert!((mean - reference).abs() < 3.0 * se + 1e-4 * reference, "guarded: {mean} vs {reference} (SE {se})");
 }
 
 /// A BRDF whose sampler returns the same direction every time (value `value`).
@@ -124,19 +103,11 @@ struct Coincident {
 
 impl Brdf for Coincident {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wo.z > 0.0 && wi.z > 0.0 {
-            Vec3::splat(self.value * wi.z)
-        } else {
-            Vec3::ZERO
-        }
+        if wo.z > 0.0 && wi.z > 0.0 { Vec3::splat(self.value * wi.z) } else { Vec3::ZERO }
     }
     fn sample(&self, wo: Vec3, _u: Vec2) -> Option<BrdfSample> {
         let wi = Vec3::new(0.3, 0.1, 0.9).normalize();
-        Some(BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf: 1.0,
-        })
+        Some(BrdfSample { wi, value: self.eval(wo, wi), pdf: 1.0 })
     }
     fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
         0.0
@@ -169,10 +140,7 @@ fn check_distribution<const K: usize, const N: usize>(
 fn coincident_samples_stop_at_the_depth_cap() {
     let env = TestEnv::sun(6, (10, 50), 1e5);
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let params = ProductParams {
-        max_depth: 12,
-        ..ProductParams::default()
-    };
+    let params = ProductParams { max_depth: 12, ..ProductParams::default() };
     let nodes = check_distribution(&mut arena, &Coincident { value: 1.0 }, &params, &env);
     // One chain of 12 splits, 4 nodes each, plus the root.
     assert_eq!(nodes, 1 + 4 * 12);
@@ -184,21 +152,9 @@ fn all_zero_samples_fall_back_to_the_environment() {
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let e = env.view();
     let frame = Frame::from_normal(Vec3::Z);
-    let s = arena.build(
-        &e,
-        &Coincident { value: 0.0 },
-        &frame,
-        Vec3::Z,
-        &ProductParams::default(),
-        1,
-    );
+    let s = arena.build(&e, &Coincident { value: 0.0 }, &frame, Vec3::Z, &ProductParams::default(), 1);
     assert_eq!(s.defensive(), 1.0);
-    check_distribution(
-        &mut arena,
-        &Coincident { value: 0.0 },
-        &ProductParams::default(),
-        &env,
-    );
+    check_distribution(&mut arena, &Coincident { value: 0.0 }, &ProductParams::default(), &env);
 }
 
 #[test]

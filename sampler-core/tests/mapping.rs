@@ -11,12 +11,7 @@ const SPECIAL: [f32; 9] = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-30, 0.5, -0.5, 1e-7]
 
 fn direction() -> impl Strategy<Value = Vec3> {
     let coord = prop_oneof![3 => -1.0f32..1.0, 1 => proptest::sample::select(SPECIAL.to_vec())];
-    (
-        coord.clone(),
-        coord.clone(),
-        coord,
-        prop_oneof![Just(1.0f32), Just(1e-20), Just(1e20), 0.01f32..100.0],
-    )
+    (coord.clone(), coord.clone(), coord, prop_oneof![Just(1.0f32), Just(1e-20), Just(1e20), 0.01f32..100.0])
         .prop_filter("non-zero", |(x, y, z, _)| x * x + y * y + z * z > 1e-20)
         .prop_map(|(x, y, z, s)| Vec3::new(x, y, z) * s)
 }
@@ -83,9 +78,7 @@ proptest! {
 
 /// Solid angle of the spherical triangle (a, b, c) (Van Oosterom & Strackee).
 fn triangle_solid_angle(a: glam::DVec3, b: glam::DVec3, c: glam::DVec3) -> f64 {
-    2.0 * a
-        .dot(b.cross(c))
-        .atan2(1.0 + a.dot(b) + b.dot(c) + c.dot(a))
+    2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + b.dot(c) + c.dot(a))
 }
 
 #[test]
@@ -102,9 +95,7 @@ fn every_grid_cell_has_equal_solid_angle() {
                     // A hair inside the cell, so that edge points map through this cell.
                     let u = (i as f64 + s.clamp(1e-6, 1.0 - 1e-6)) / n as f64;
                     let v = (j as f64 + t.clamp(1e-6, 1.0 - 1e-6)) / n as f64;
-                    square_to_sphere(Vec2::new(u as f32, v as f32))
-                        .as_dvec3()
-                        .normalize()
+                    square_to_sphere(Vec2::new(u as f32, v as f32)).as_dvec3().normalize()
                 };
                 let centre = at(0.5, 0.5);
                 let mut boundary = Vec::with_capacity(4 * m);
@@ -130,22 +121,14 @@ fn every_grid_cell_has_equal_solid_angle() {
             }
         }
         assert!(worst < 2e-3, "level {k}: cell solid angle off by {worst}");
-        assert!(
-            (total / (4.0 * std::f64::consts::PI) - 1.0).abs() < 1e-4,
-            "level {k}: total {total}"
-        );
+        assert!((total / (4.0 * std::f64::consts::PI) - 1.0).abs() < 1e-4, "level {k}: total {total}");
     }
 }
 
 #[test]
 fn texel_wrap_lands_next_door_on_the_sphere() {
     let n = 16u32;
-    let centre = |i: u32, j: u32| {
-        square_to_sphere(Vec2::new(
-            (i as f32 + 0.5) / n as f32,
-            (j as f32 + 0.5) / n as f32,
-        ))
-    };
+    let centre = |i: u32, j: u32| square_to_sphere(Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32));
     let texel_angle = (4.0 * std::f32::consts::PI / (n * n) as f32).sqrt();
     for j in 0..n as i32 {
         for (i, inside) in [(-1, 0), (n as i32, n as i32 - 1)] {

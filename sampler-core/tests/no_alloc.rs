@@ -68,15 +68,8 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let frame = Frame::from_normal(normal);
         let wo = frame.to_world(Vec3::new(0.3, 0.1, 0.9).normalize());
         let brdf = brdfs[(i % 4) as usize];
-        let kind = if i % 2 == 0 {
-            ProductKind::Quadtree
-        } else {
-            ProductKind::Wavelet
-        };
-        let params = ProductParams {
-            kind,
-            ..ProductParams::default()
-        };
+        let kind = if i % 2 == 0 { ProductKind::Quadtree } else { ProductKind::Wavelet };
+        let params = ProductParams { kind, ..ProductParams::default() };
         let sampler = arena.build(&env, brdf, &frame, wo, &params, i);
         let mut points = [DVec2::ZERO; 4];
         sobol02(i, 0, &mut points);

@@ -143,18 +143,11 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
     let mut scene = match &args.scene {
         None => default_scene::scene(),
         Some(path) => {
-            let ext = path
-                .extension()
-                .and_then(|e| e.to_str())
-                .unwrap_or_default()
-                .to_ascii_lowercase();
+            let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
             match ext.as_str() {
                 "json" => scene_json::load(path)?,
                 "usd" | "usda" | "usdc" | "usdz" => {
-                    bail!(
-                        "{}: USD scenes are not supported yet (host-usd issue)",
-                        path.display()
-                    )
+                    bail!("{}: USD scenes are not supported yet (host-usd issue)", path.display())
                 }
                 _ => bail!("{}: unknown scene format (expected .json)", path.display()),
             }
@@ -171,16 +164,9 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 
 fn render_command(args: RenderArgs) -> Result<()> {
     if !args.spp.is_multiple_of(args.shading_points) {
-        bail!(
-            "--shading-points {} must divide --spp {}",
-            args.shading_points,
-            args.spp
-        );
+        bail!("--shading-points {} must divide --spp {}", args.shading_points, args.spp);
     }
-    let exr_path = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("render.exr"));
+    let exr_path = args.output.clone().unwrap_or_else(|| PathBuf::from("render.exr"));
     let png_path = exr_path.with_extension("png");
     check_writable(&exr_path)?;
 
@@ -211,14 +197,10 @@ fn render_command(args: RenderArgs) -> Result<()> {
         );
     }
 
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
+    let threads =
+        args.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let settings = Settings {
         method: args.method,
         spp: args.spp as usize,
@@ -284,20 +266,14 @@ fn render_command(args: RenderArgs) -> Result<()> {
         png_path.display()
     );
     if image.non_finite > 0 {
-        eprintln!(
-            "ppis: warning: {} pixels were not finite and were written as 0",
-            image.non_finite
-        );
+        eprintln!("ppis: warning: {} pixels were not finite and were written as 0", image.non_finite);
     }
     Ok(())
 }
 
 /// Fails early (before any work) when the output folder does not exist.
 fn check_writable(path: &Path) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         bail!("{}: the output folder does not exist", path.display());
     }
@@ -321,14 +297,10 @@ fn report_command(args: ReportArgs) -> Result<()> {
     };
     let bvh = Bvh::build(&scene);
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
+    let threads =
+        args.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let base = Settings {
         method: Method::Product,
         spp: 1,
@@ -342,14 +314,7 @@ fn report_command(args: ReportArgs) -> Result<()> {
         Some(path) => {
             let image = host_std::env_io::load(path)?;
             if (image.width, image.height) != (w, h) {
-                bail!(
-                    "{}: the reference is {}×{}, the render {}×{}",
-                    path.display(),
-                    image.width,
-                    image.height,
-                    w,
-                    h
-                );
+                bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
             }
             (image.texels, format!("{}", path.display()))
         }
@@ -363,12 +328,8 @@ fn report_command(args: ReportArgs) -> Result<()> {
                 progress: true,
                 ..base
             };
-            eprintln!(
-                "ppis: rendering the reference ({}, {spp} spp)",
-                args.reference_method
-            );
-            let image =
-                pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+            eprintln!("ppis: rendering the reference ({}, {spp} spp)", args.reference_method);
+            let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
             output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
             (
                 image.pixels,
@@ -381,41 +342,23 @@ fn report_command(args: ReportArgs) -> Result<()> {
     };
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
     let measurements = pool.install(|| {
-        report::sweep(
-            &scene,
-            &bvh,
-            hierarchy.as_ref(),
-            &args.methods,
-            &spps,
-            &base,
-            &reference,
-            |m| {
-                eprintln!(
-                    "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
-                    m.method.name(),
-                    m.spp,
-                    m.seconds,
-                    m.rmse,
-                    m.relmse
-                );
-            },
-        )
+        report::sweep(&scene, &bvh, hierarchy.as_ref(), &args.methods, &spps, &base, &reference, |m| {
+            eprintln!(
+                "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                m.method.name(),
+                m.spp,
+                m.seconds,
+                m.rmse,
+                m.relmse
+            );
+        })
     });
-    output::write_text(
-        &args.out.join("error_vs_time.csv"),
-        &report::csv(&measurements),
-    )?;
-    output::write_text(
-        &args.out.join("report.md"),
-        &report::markdown(&scene.name, &measurements, threads, &note),
-    )?;
+    output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(&measurements))?;
+    output::write_text(&args.out.join("report.md"), &report::markdown(&scene.name, &measurements, threads, &note))?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
         &args.out.join("error_vs_time.png"),
-        &format!(
-            "{}: relMSE against render time ({threads} threads)",
-            scene.name
-        ),
+        &format!("{}: relMSE against render time ({threads} threads)", scene.name),
         &measurements,
     )
     .map_err(|e| anyhow::anyhow!("{}: cannot draw the plot: {e}", args.out.display()))?;
@@ -438,28 +381,14 @@ fn info_command(args: InfoArgs) -> Result<()> {
         c.origin.to_array(),
         c.target.to_array()
     );
-    println!(
-        "objects: {} ({} triangles)",
-        scene.objects.len(),
-        scene.triangle_count()
-    );
+    println!("objects: {} ({} triangles)", scene.objects.len(), scene.triangle_count());
     for (i, m) in scene.materials.iter().enumerate() {
-        println!(
-            "  material {i}: {}{}",
-            m.bsdf.kind(),
-            if m.twosided { ", two-sided" } else { "" }
-        );
+        println!("  material {i}: {}{}", m.bsdf.kind(), if m.twosided { ", two-sided" } else { "" });
     }
     match &scene.env {
-        None => println!(
-            "environment: none — a render builds no env hierarchy and is black except for hits"
-        ),
+        None => println!("environment: none — a render builds no env hierarchy and is black except for hits"),
         Some((EnvSource::Sky { level }, _)) => {
-            println!(
-                "environment: built-in sky, equal-area {}² (pyramid {} MB)",
-                1u32 << level,
-                pyramid_mb(*level)
-            )
+            println!("environment: built-in sky, equal-area {}² (pyramid {} MB)", 1u32 << level, pyramid_mb(*level))
         }
         Some((EnvSource::File(path), p)) => println!(
             "environment: {} (scale {}, rotate_y {}°), resampled to a power-of-two equal-area square",
@@ -471,11 +400,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
     println!(
         "a render builds: {} BVH primitives{}; per shading point a product sampler for methods product, wavelet, product-mis (auto: non-diffuse, non-needle materials)",
         Bvh::build(&scene).primitive_count(),
-        if scene.env.is_some() {
-            ", the env hierarchy"
-        } else {
-            ""
-        }
+        if scene.env.is_some() { ", the env hierarchy" } else { "" }
     );
     Ok(())
 }

@@ -24,27 +24,14 @@ impl Default for CarPaint {
     /// A deep blue metallic paint: base (0.01, 0.03, 0.15), flakes (0.1, 0.2, 0.5) at α = 0.25,
     /// coat weight 1 at α = 0.005.
     fn default() -> Self {
-        Self::new(
-            Vec3::new(0.01, 0.03, 0.15),
-            Vec3::new(0.1, 0.2, 0.5),
-            0.25,
-            1.0,
-            0.005,
-        )
+        Self::new(Vec3::new(0.01, 0.03, 0.15), Vec3::new(0.1, 0.2, 0.5), 0.25, 1.0, 0.005)
     }
 }
 
 impl CarPaint {
     #[must_use]
     pub fn new(base: Vec3, flake: Vec3, flake_alpha: f32, coat: f32, coat_alpha: f32) -> Self {
-        Self {
-            base,
-            flake,
-            flake_ggx: Ggx::new(flake_alpha),
-            coat,
-            coat_ggx: Ggx::new(coat_alpha),
-            coat_f0: 0.04,
-        }
+        Self { base, flake, flake_ggx: Ggx::new(flake_alpha), coat, coat_ggx: Ggx::new(coat_alpha), coat_f0: 0.04 }
     }
 
     /// Sampling weights of (coat, flake, base). The coat gets a share well above its energy
@@ -87,23 +74,16 @@ impl Brdf for CarPaint {
             return Vec3::ZERO;
         };
         let (c, f) = (&self.coat_ggx, &self.flake_ggx);
-        let coat =
-            self.coat * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi) * c.g1(wo)
-                / (4.0 * wo.z);
+        let coat = self.coat * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi) * c.g1(wo) / (4.0 * wo.z);
         let flake = f.d(h) * f.g1(wi) * f.g1(wo) / (4.0 * wo.z);
-        let transmit = (1.0 - fresnel_schlick(self.coat_f0, wo.z))
-            * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
+        let transmit = (1.0 - fresnel_schlick(self.coat_f0, wo.z)) * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
         Vec3::splat(coat) + transmit * (self.flake * flake + self.base * (FRAC_1_PI * wi.z))
     }
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf,
-        })
+        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
@@ -124,23 +104,13 @@ impl Brdf for CarPaint {
             let wi = if p.x < p0 {
                 reflect(wo, c.sample_visible_stretched(wc, Vec2::new(p.x / p0, p.y)))
             } else if p.x < p1 {
-                reflect(
-                    wo,
-                    f.sample_visible_stretched(wf, Vec2::new((p.x - p0) / (p1 - p0), p.y)),
-                )
+                reflect(wo, f.sample_visible_stretched(wf, Vec2::new((p.x - p0) / (p1 - p0), p.y)))
             } else {
-                square_to_cosine_hemisphere(Vec2::new(
-                    ((p.x - p1) / (1.0 - p1)).min(1.0 - f32::EPSILON / 2.0),
-                    p.y,
-                ))
+                square_to_cosine_hemisphere(Vec2::new(((p.x - p1) / (1.0 - p1)).min(1.0 - f32::EPSILON / 2.0), p.y))
             };
             let value = match half_vector(wo, wi) {
                 Some(h) if wi.z > 0.0 => {
-                    let coat = self.coat
-                        * gc
-                        * fresnel_schlick(self.coat_f0, wo.dot(h))
-                        * c.d(h)
-                        * c.g1(wi);
+                    let coat = self.coat * gc * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi);
                     let transmit = transmit_o * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
                     coat + transmit * (flake * gf * f.d(h) * f.g1(wi) + base * wi.z)
                 }
@@ -161,10 +131,7 @@ impl Brdf for CarPaint {
             return 0.0;
         }
         let (coat, flake) = match half_vector(wo, wi) {
-            Some(h) => (
-                self.coat_ggx.pdf_reflected(wo, h),
-                self.flake_ggx.pdf_reflected(wo, h),
-            ),
+            Some(h) => (self.coat_ggx.pdf_reflected(wo, h), self.flake_ggx.pdf_reflected(wo, h)),
             None => (0.0, 0.0),
         };
         (w[0] * coat + w[1] * flake + w[2] * square_to_cosine_hemisphere_pdf(wi)) / total

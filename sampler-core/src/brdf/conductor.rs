@@ -17,10 +17,7 @@ impl RoughConductor {
     /// α is the GGX roughness (not squared), clamped to ≥ 1e-4.
     #[must_use]
     pub fn new(alpha: f32, specular: Vec3) -> Self {
-        Self {
-            ggx: Ggx::new(alpha),
-            specular,
-        }
+        Self { ggx: Ggx::new(alpha), specular }
     }
 }
 
@@ -39,11 +36,7 @@ impl Brdf for RoughConductor {
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf,
-        })
+        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -66,10 +59,7 @@ impl Brdf for RoughConductor {
             let m = g.sample_visible_stretched(w, *p);
             let wi = reflect(wo, m);
             // m is the half vector of (wo, wi) by construction: no need to recompute it.
-            *o = BrdfDraw {
-                wi,
-                value: g.d(m) * g.g1(wi) * k,
-            };
+            *o = BrdfDraw { wi, value: g.d(m) * g.g1(wi) * k };
         }
         u.len().min(out.len())
     }

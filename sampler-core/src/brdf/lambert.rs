@@ -33,19 +33,11 @@ impl Brdf for Lambert {
         }
         let wi = square_to_cosine_hemisphere(u);
         let pdf = square_to_cosine_hemisphere_pdf(wi);
-        (pdf > 0.0).then(|| BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf,
-        })
+        (pdf > 0.0).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 {
-            0.0
-        } else {
-            square_to_cosine_hemisphere_pdf(wi)
-        }
+        if wo.z <= 0.0 { 0.0 } else { square_to_cosine_hemisphere_pdf(wi) }
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
@@ -55,10 +47,7 @@ impl Brdf for Lambert {
         let albedo = luminance(self.albedo);
         for (p, o) in u.iter().zip(out.iter_mut()) {
             let wi = square_to_cosine_hemisphere(*p);
-            *o = BrdfDraw {
-                wi,
-                value: albedo * FRAC_1_PI * wi.z.max(0.0),
-            };
+            *o = BrdfDraw { wi, value: albedo * FRAC_1_PI * wi.z.max(0.0) };
         }
         u.len().min(out.len())
     }

@@ -19,11 +19,7 @@ impl Ggx {
     /// α is clamped to [`MIN_ALPHA`, 1e3]; NaN becomes [`MIN_ALPHA`].
     #[must_use]
     pub fn new(alpha: f32) -> Self {
-        let alpha = if alpha.is_nan() {
-            MIN_ALPHA
-        } else {
-            alpha.clamp(MIN_ALPHA, 1e3)
-        };
+        let alpha = if alpha.is_nan() { MIN_ALPHA } else { alpha.clamp(MIN_ALPHA, 1e3) };
         Self { alpha }
     }
 
@@ -87,11 +83,7 @@ impl Ggx {
         let h = c + w;
         let m = Vec3::new(h.x * a, h.y * a, h.z.max(0.0));
         let len2 = m.length_squared();
-        if len2 > 0.0 && len2.is_finite() {
-            m / libm::sqrtf(len2)
-        } else {
-            Vec3::Z
-        }
+        if len2 > 0.0 && len2.is_finite() { m / libm::sqrtf(len2) } else { Vec3::Z }
     }
 
     /// Density of the reflected direction `wi = reflect(wo, m)` when m is drawn by
@@ -113,11 +105,7 @@ impl Ggx {
 pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
     let h = wo + wi;
     let len2 = h.length_squared();
-    if len2 > 1e-24 && len2.is_finite() {
-        Some(h / libm::sqrtf(len2))
-    } else {
-        None
-    }
+    if len2 > 1e-24 && len2.is_finite() { Some(h / libm::sqrtf(len2)) } else { None }
 }
 
 /// Schlick's Fresnel approximation.
@@ -145,15 +133,9 @@ mod tests {
                 let psi = (i as f64 + 0.5) / n as f64 * core::f64::consts::FRAC_PI_2;
                 let dpsi = core::f64::consts::FRAC_PI_2 / n as f64;
                 let theta = (alpha as f64 * psi.tan()).atan();
-                let dtheta =
-                    alpha as f64 / (psi.cos().powi(2) + (alpha as f64 * psi.sin()).powi(2)) * dpsi;
+                let dtheta = alpha as f64 / (psi.cos().powi(2) + (alpha as f64 * psi.sin()).powi(2)) * dpsi;
                 let m = Vec3::new(theta.sin() as f32, 0.0, theta.cos() as f32);
-                sum += g.d(m) as f64
-                    * theta.cos()
-                    * theta.sin()
-                    * dtheta
-                    * 2.0
-                    * core::f64::consts::PI;
+                sum += g.d(m) as f64 * theta.cos() * theta.sin() * dtheta * 2.0 * core::f64::consts::PI;
             }
             assert!((sum - 1.0).abs() < 1e-3, "alpha {alpha}: {sum}");
         }

@@ -60,10 +60,7 @@ pub trait Brdf {
         let mut n = 0;
         for p in u {
             if let Some(s) = self.sample(wo, *p) {
-                out[n] = BrdfDraw {
-                    wi: s.wi,
-                    value: luminance(s.value),
-                };
+                out[n] = BrdfDraw { wi: s.wi, value: luminance(s.value) };
                 n += 1;
             }
         }

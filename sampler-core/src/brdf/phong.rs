@@ -5,8 +5,7 @@
 use super::{Brdf, BrdfDraw, BrdfSample, pick_lobe};
 use crate::env::luminance;
 use crate::sampling::{
-    TWO_PI, basis_around, reflect_z, sin_cos_2pi, square_to_cosine_hemisphere,
-    square_to_cosine_hemisphere_pdf,
+    TWO_PI, basis_around, reflect_z, sin_cos_2pi, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf,
 };
 use core::f32::consts::FRAC_1_PI;
 
@@ -26,11 +25,7 @@ impl Phong {
     /// A Phong BRDF; the exponent is clamped to [0, 1e7].
     #[must_use]
     pub fn new(kd: Vec3, ks: Vec3, exponent: f32) -> Self {
-        let exponent = if exponent.is_nan() {
-            0.0
-        } else {
-            exponent.clamp(0.0, 1e7)
-        };
+        let exponent = if exponent.is_nan() { 0.0 } else { exponent.clamp(0.0, 1e7) };
         Self { kd, ks, exponent }
     }
 
@@ -59,8 +54,7 @@ impl Phong {
             return Some(square_to_cosine_hemisphere(Vec2::new(ux, u.y)));
         }
         // 1 − cos α = −expm1(ln(1−u)/(n+1)), exact for huge n.
-        let one_minus_cos =
-            (-libm::expm1f(libm::logf(1.0 - ux) / (self.exponent + 1.0))).clamp(0.0, 2.0);
+        let one_minus_cos = (-libm::expm1f(libm::logf(1.0 - ux) / (self.exponent + 1.0))).clamp(0.0, 2.0);
         let cos_a = 1.0 - one_minus_cos;
         let sin_a = libm::sqrtf((one_minus_cos * (2.0 - one_minus_cos)).max(0.0));
         let (sin_phi, cos_phi) = sin_cos_2pi(u.y);
@@ -82,11 +76,7 @@ impl Brdf for Phong {
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BrdfSample {
-            wi,
-            value: self.eval(wo, wi),
-            pdf,
-        })
+        (pdf > 0.0).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
@@ -104,8 +94,7 @@ impl Brdf for Phong {
         let inv_n1 = 1.0 / (self.exponent + 1.0);
         for (p, o) in u.iter().zip(out.iter_mut()) {
             let (wi, lobe) = if p.x < p_diffuse {
-                let wi =
-                    square_to_cosine_hemisphere(Vec2::new((p.x / p_diffuse).min(ONE_BELOW), p.y));
+                let wi = square_to_cosine_hemisphere(Vec2::new((p.x / p_diffuse).min(ONE_BELOW), p.y));
                 (wi, self.lobe(r, wi))
             } else {
                 let ux = ((p.x - p_diffuse) / (1.0 - p_diffuse)).clamp(0.0, ONE_BELOW);
@@ -116,17 +105,10 @@ impl Brdf for Phong {
                 let (sin_phi, cos_phi) = sin_cos_2pi(p.y);
                 let wi = (s * (sin_a * cos_phi) + t * (sin_a * sin_phi) + r * cos_a).normalize();
                 // cosⁿα = (1 − u)^(n/(n+1)): no need to evaluate the lobe again.
-                let lobe = if cos_a > 0.0 {
-                    libm::expf(ln * self.exponent * inv_n1)
-                } else {
-                    0.0
-                };
+                let lobe = if cos_a > 0.0 { libm::expf(ln * self.exponent * inv_n1) } else { 0.0 };
                 (wi, lobe)
             };
-            *o = BrdfDraw {
-                wi,
-                value: (kd + ks * lobe) * wi.z.max(0.0),
-            };
+            *o = BrdfDraw { wi, value: (kd + ks * lobe) * wi.z.max(0.0) };
         }
         u.len().min(out.len())
     }

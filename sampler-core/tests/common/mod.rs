@@ -28,15 +28,11 @@ impl Chart {
                 let a = 0.5 * PI * c.x;
                 let ta = a.tan();
                 let theta = 2.0 * (scale * ta).atan();
-                let dtheta =
-                    2.0 * scale * 0.5 * PI / (a.cos().powi(2) * (1.0 + scale * scale * ta * ta));
+                let dtheta = 2.0 * scale * 0.5 * PI / (a.cos().powi(2) * (1.0 + scale * scale * ta * ta));
                 let phi = 2.0 * PI * c.y;
                 let f = Frame::from_normal(axis);
-                let local = Vec3::new(
-                    (theta.sin() * phi.cos()) as f32,
-                    (theta.sin() * phi.sin()) as f32,
-                    theta.cos() as f32,
-                );
+                let local =
+                    Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
                 (f.to_world(local), theta.sin() * dtheta * 2.0 * PI)
             }
         }
@@ -176,10 +172,7 @@ pub fn chi_square(
         let u = DVec2::new(rng.next_f64(), rng.next_f64());
         match sample(u) {
             Some((d, p)) => {
-                assert!(
-                    d.is_finite() && p.is_finite() && p > 0.0,
-                    "bad sample {d:?} pdf {p}"
-                );
+                assert!(d.is_finite() && p.is_finite() && p > 0.0, "bad sample {d:?} pdf {p}");
                 let q = pdf(d);
                 if (q - p).abs() > 1e-4 * p.max(q) {
                     mismatch += 1;
@@ -198,8 +191,7 @@ pub fn chi_square(
         for i in 0..m {
             let c = DVec2::new((i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64);
             let (d, jac) = chart.dir_jacobian(c);
-            expected[(j / sub) * res + i / sub] +=
-                pdf(d) as f64 * jac / (m * m) as f64 * samples as f64;
+            expected[(j / sub) * res + i / sub] += pdf(d) as f64 * jac / (m * m) as f64 * samples as f64;
         }
     }
     let total_expected: f64 = expected.iter().sum();
@@ -250,11 +242,7 @@ impl TestEnv {
     pub fn new(level: u32, rgb: Vec<[f32; 3]>) -> Self {
         let mut pyramid = vec![0.0; pyramid_len(level)];
         build_pyramid(level, &rgb, &mut pyramid).unwrap();
-        Self {
-            level,
-            rgb,
-            pyramid,
-        }
+        Self { level, rgb, pyramid }
     }
 
     pub fn view(&self) -> EnvHierarchy<'_> {
@@ -274,10 +262,7 @@ impl TestEnv {
         let mut rgb = vec![[0.0; 3]; n * n];
         for y in 0..n {
             for x in 0..n {
-                let d = square_to_sphere(Vec2::new(
-                    (x as f32 + 0.5) / n as f32,
-                    (y as f32 + 0.5) / n as f32,
-                ));
+                let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
                 let mut v = 0.05;
                 for (axis, sharp, w) in &lobes {
                     v += w * (sharp * (d.dot(*axis) - 1.0)).exp();
@@ -334,18 +319,7 @@ pub fn chi_square_dyadic(
         if depth_at(c) <= d || d >= 24 {
             return pdf(c) as f64 / (1u64 << (2 * d)) as f64;
         }
-        (0..4)
-            .map(|k| {
-                mass(
-                    d + 1,
-                    2 * x + (k & 1),
-                    2 * y + (k >> 1),
-                    centre,
-                    depth_at,
-                    pdf,
-                )
-            })
-            .sum()
+        (0..4).map(|k| mass(d + 1, 2 * x + (k & 1), 2 * y + (k >> 1), centre, depth_at, pdf)).sum()
     }
     let mut bins: HashMap<(u32, u64, u64), (f64, f64)> = HashMap::new();
     let mut stack = vec![(0u32, 0u64, 0u64)];
@@ -370,9 +344,7 @@ pub fn chi_square_dyadic(
         };
         let q = |v: f32| ((v as f64 * (1u64 << 24) as f64) as u64).min((1 << 24) - 1);
         let (qx, qy) = (q(uv.x), q(uv.y));
-        let key = (0..=24u32)
-            .map(|d| (d, qx >> (24 - d), qy >> (24 - d)))
-            .find(|k| bins.contains_key(k));
+        let key = (0..=24u32).map(|d| (d, qx >> (24 - d), qy >> (24 - d))).find(|k| bins.contains_key(k));
         match key.and_then(|k| bins.get_mut(&k)) {
             Some(b) if b.1 > 0.0 => b.0 += 1.0,
             _ => impossible += 1,
@@ -431,11 +403,7 @@ pub fn integrate_lobe(axis: Vec3, width: f64, n: usize, f: impl Fn(Vec3) -> f64)
             let theta = cone * t * t;
             let dtheta = 2.0 * cone * t;
             let phi = 2.0 * PI * s;
-            let local = glam::DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos(),
-            );
+            let local = glam::DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
             let d = frame.to_world(local.as_vec3());
             inner += f(d) * theta.sin() * dtheta * 2.0 * PI;
         }
@@ -444,13 +412,7 @@ pub fn integrate_lobe(axis: Vec3, width: f64, n: usize, f: impl Fn(Vec3) -> f64)
     let outer = if cone >= PI {
         0.0
     } else {
-        integrate(Chart::EqualArea, n, |d| {
-            if d.as_dvec3().normalize().dot(axis_d) < cos_cone {
-                f(d)
-            } else {
-                0.0
-            }
-        })
+        integrate(Chart::EqualArea, n, |d| if d.as_dvec3().normalize().dot(axis_d) < cos_cone { f(d) } else { 0.0 })
     };
     inner + outer
 }
