@@ -13,7 +13,7 @@ use sampler_core::env::EnvHierarchy;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One render of the sweep.
+/// One render of the sweep: errors over all pixels (`rmse`, `relmse`) and per region.
 #[derive(Clone, Debug)]
 pub struct Measurement {
     pub method: Method,
@@ -21,6 +21,71 @@ pub struct Measurement {
     pub seconds: f64,
     pub rmse: f64,
     pub relmse: f64,
+    /// (region, RMSE, relMSE) for each region of `Regions`.
+    pub regions: Vec<(String, f64, f64)>,
+}
+
+impl Measurement {
+    /// relMSE over `region` ("all" for the whole image).
+    pub fn relmse_in(&self, region: &str) -> Option<f64> {
+        if region == "all" {
+            return Some(self.relmse);
+        }
+        self.regions.iter().find(|r| r.0 == region).map(|r| r.2)
+    }
+}
+
+/// Pixels grouped by the kind of material their centre ray hits ("diffuse", "roughconductor",
+/// "phong", "carpaint"); misses belong to no region.
+pub struct Regions {
+    pub names: Vec<String>,
+    /// Per pixel, the index into `names`, or `None`.
+    pub of_pixel: Vec<Option<usize>>,
+}
+
+impl Regions {
+    pub fn of(scene: &Scene, bvh: &Bvh) -> Self {
+        let camera = crate::camera::Camera::new(&scene.camera);
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        let mut names: Vec<String> = Vec::new();
+        let mut of_pixel = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
+                of_pixel.push(bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY).map(|hit| {
+                    let kind = scene.materials[hit.material as usize].bsdf.kind();
+                    names.iter().position(|n| n == kind).unwrap_or_else(|| {
+                        names.push(kind.to_string());
+                        names.len() - 1
+                    })
+                }));
+            }
+        }
+        Self { names, of_pixel }
+    }
+
+    /// RMSE and relMSE of each region.
+    pub fn errors(&self, image: &[[f32; 3]], reference: &[[f32; 3]]) -> Vec<(String, f64, f64)> {
+        self.names
+            .iter()
+            .enumerate()
+            .map(|(k, name)| {
+                let (mut se, mut rel, mut n) = (0.0f64, 0.0f64, 0usize);
+                for ((p, r), region) in image.iter().zip(reference).zip(&self.of_pixel) {
+                    if *region == Some(k) {
+                        for c in 0..3 {
+                            let d = p[c] as f64 - r[c] as f64;
+                            se += d * d;
+                            rel += d * d / (r[c] as f64 * r[c] as f64 + 0.01);
+                        }
+                        n += 3;
+                    }
+                }
+                let n = n.max(1) as f64;
+                (name.clone(), (se / n).sqrt(), rel / n)
+            })
+            .collect()
+    }
 }
 
 /// RMSE and relMSE of `image` against `reference` (same size).
@@ -59,6 +124,7 @@ pub fn sweep(
     reference: &[[f32; 3]],
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
+    let regions = Regions::of(scene, bvh);
     let mut out = Vec::new();
     for &method in methods {
         for &spp in spps {
@@ -66,7 +132,8 @@ pub fn sweep(
                 Settings { method, spp, shading_points: shading_points_for(spp, base.shading_points), ..*base };
             let image = render::render(scene, bvh, env, &settings);
             let (rmse, relmse) = errors(&image.pixels, reference);
-            let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse };
+            let regions = regions.errors(&image.pixels, reference);
+            let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions };
             progress(&m);
             out.push(m);
         }
@@ -74,13 +141,13 @@ pub fn sweep(
     out
 }
 
-/// relMSE of `method` at time `t`, interpolated log-log between its measurements (outside
-/// their range: extended along the nearest segment; flagged).
-pub fn relmse_at(measurements: &[Measurement], method: Method, t: f64) -> Option<(f64, bool)> {
+/// relMSE over `region` of `method` at time `t`, interpolated log-log between its
+/// measurements (outside their range: extended along the nearest segment; flagged).
+pub fn relmse_at(measurements: &[Measurement], method: Method, region: &str, t: f64) -> Option<(f64, bool)> {
     let mut pts: Vec<(f64, f64)> = measurements
         .iter()
-        .filter(|m| m.method == method && m.seconds > 0.0 && m.relmse > 0.0)
-        .map(|m| (m.seconds.ln(), m.relmse.ln()))
+        .filter(|m| m.method == method && m.seconds > 0.0)
+        .filter_map(|m| m.relmse_in(region).filter(|e| *e > 0.0).map(|e| (m.seconds.ln(), e.ln())))
         .collect();
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     if pts.is_empty() {
@@ -99,46 +166,69 @@ pub fn relmse_at(measurements: &[Measurement], method: Method, t: f64) -> Option
     Some((y.exp(), outside))
 }
 
-/// `error_vs_time.csv`.
+/// `error_vs_time.csv`: one row per render and region ("all" is the whole image).
 pub fn csv(measurements: &[Measurement]) -> String {
-    let mut s = String::from("method,spp,seconds,rmse,relmse\n");
+    let mut s = String::from("method,spp,seconds,region,rmse,relmse\n");
     for m in measurements {
-        let _ = writeln!(s, "{},{},{:.6},{:.6e},{:.6e}", m.method, m.spp, m.seconds, m.rmse, m.relmse);
+        let _ = writeln!(s, "{},{},{:.6},all,{:.6e},{:.6e}", m.method, m.spp, m.seconds, m.rmse, m.relmse);
+        for (region, rmse, relmse) in &m.regions {
+            let _ = writeln!(s, "{},{},{:.6},{region},{rmse:.6e},{relmse:.6e}", m.method, m.spp, m.seconds);
+        }
     }
     s
 }
 
-/// `report.md`: the measurements and the equal-time table against `product`.
+/// `report.md`: the measurements, then equal-time tables against `product` for the whole
+/// image and for each region.
 pub fn markdown(scene: &str, measurements: &[Measurement], threads: usize, reference_note: &str) -> String {
     let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
-    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render.\n\n");
-    s.push_str("| method | spp | seconds | RMSE | relMSE |\n|---|---|---|---|---|\n");
-    for m in measurements {
-        let _ = writeln!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.method, m.spp, m.seconds, m.rmse, m.relmse);
+    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind.\n\n");
+    let regions: Vec<String> =
+        measurements.first().map(|m| m.regions.iter().map(|r| r.0.clone()).collect()).unwrap_or_default();
+    s.push_str("| method | spp | seconds | RMSE | relMSE |");
+    for r in &regions {
+        let _ = write!(s, " relMSE {r} |");
     }
-    let others: Vec<Method> = {
-        let mut v: Vec<Method> = measurements.iter().map(|m| m.method).filter(|&m| m != Method::Product).collect();
-        v.dedup();
-        v
-    };
+    s.push_str("\n|---|---|---|---|---|");
+    s.push_str(&"---|".repeat(regions.len()));
+    s.push('\n');
+    for m in measurements {
+        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.method, m.spp, m.seconds, m.rmse, m.relmse);
+        for r in &m.regions {
+            let _ = write!(s, " {:.4e} |", r.2);
+        }
+        s.push('\n');
+    }
+    let mut others: Vec<Method> = Vec::new();
+    for m in measurements {
+        if m.method != Method::Product && !others.contains(&m.method) {
+            others.push(m.method);
+        }
+    }
     let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == Method::Product).collect();
-    if !product.is_empty() && !others.is_empty() {
-        s.push_str("\n## Equal time\n\nFor the time product sampling takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to product's (> 1: product is better).\n\n");
-        s.push_str("| product spp | seconds | product relMSE |");
+    if product.is_empty() || others.is_empty() {
+        return s;
+    }
+    s.push_str("\n## Equal time\n\nFor the time product sampling takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to product's (> 1: product is better).\n");
+    for region in std::iter::once("all".to_string()).chain(regions) {
+        let _ = write!(
+            s,
+            "\n### {}\n\n| product spp | seconds | product relMSE |",
+            if region == "all" { "whole image".to_string() } else { format!("pixels on {region}") }
+        );
         for o in &others {
             let _ = write!(s, " {o} relMSE | ratio |");
         }
         s.push_str("\n|---|---|---|");
-        for _ in &others {
-            s.push_str("---|---|");
-        }
+        s.push_str(&"---|---|".repeat(others.len()));
         s.push('\n');
-        for p in product {
-            let _ = write!(s, "| {} | {:.3} | {:.4e} |", p.spp, p.seconds, p.relmse);
+        for p in &product {
+            let Some(pe) = p.relmse_in(&region) else { continue };
+            let _ = write!(s, "| {} | {:.3} | {:.4e} |", p.spp, p.seconds, pe);
             for &o in &others {
-                match relmse_at(measurements, o, p.seconds) {
+                match relmse_at(measurements, o, &region, p.seconds) {
                     Some((e, outside)) => {
-                        let _ = write!(s, " {:.4e}{} | {:.2} |", e, if outside { "*" } else { "" }, e / p.relmse);
+                        let _ = write!(s, " {:.4e}{} | {:.2} |", e, if outside { "*" } else { "" }, e / pe);
                     }
                     None => s.push_str(" – | – |"),
                 }
@@ -230,18 +320,21 @@ mod tests {
     use super::*;
 
     fn m(method: Method, spp: usize, seconds: f64, relmse: f64) -> Measurement {
-        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse }
+        let regions = vec![("carpaint".into(), 0.0, relmse / 2.0)];
+        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse, regions }
     }
 
     #[test]
     fn equal_time_interpolates_log_log() {
         let ms = [m(Method::Env, 4, 1.0, 0.4), m(Method::Env, 16, 4.0, 0.1), m(Method::Product, 4, 2.0, 0.05)];
-        let (e, outside) = relmse_at(&ms, Method::Env, 2.0).unwrap();
+        let (e, outside) = relmse_at(&ms, Method::Env, "all", 2.0).unwrap();
         assert!((e - 0.2).abs() < 1e-9 && !outside); // error ∝ 1/t between the points
-        let (e, outside) = relmse_at(&ms, Method::Env, 8.0).unwrap();
+        let (e, outside) = relmse_at(&ms, Method::Env, "all", 8.0).unwrap();
         assert!((e - 0.05).abs() < 1e-9 && outside);
         let md = markdown("t", &ms, 2, "test");
         assert!(md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"), "{md}");
+        assert!(md.contains("### pixels on carpaint"), "{md}");
+        assert!(md.contains("| 4 | 2.000 | 2.5000e-2 | 1.0000e-1 | 4.00 |"), "{md}");
     }
 
     #[test]
