@@ -160,3 +160,59 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
     }
     out
 }
+
+/// Resampled importance sampling (Talbot et al. 2005): `candidates.len()` candidates from the
+/// balance mixture of env and BRDF sampling (each point's x < ½ picks the env, rescaled), each
+/// weighted by target/source with target = luminance(L·B·cos) (no visibility); one is kept with
+/// probability ∝ weight by a streaming reservoir driven by the single uniform `u_select`, and
+/// the estimate is f·V/target × (Σ weights)/M. Unbiased for any M ≥ 1 because the mixture
+/// covers every direction where L·B > 0. One visibility query.
+pub fn ris<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    candidates: &[DVec2],
+    u_select: f64,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let wo_local = sp.frame.to_local(sp.wo);
+    let mut xi = u_select.clamp(0.0, crate::warp::ONE_MINUS_EPSILON);
+    let mut total = 0.0f64;
+    let mut chosen: Option<(Vec3, Vec3, f32, f32)> = None; // (dir, f, target, source pdf)
+    for c in candidates {
+        let (dir, source) = if c.x < 0.5 {
+            let u = DVec2::new(2.0 * c.x, c.y);
+            match env_h.sample(u) {
+                Some(s) => (s.dir, 0.5 * (s.pdf + sp.brdf_pdf(s.dir))),
+                None => continue,
+            }
+        } else {
+            let u = Vec2::new((2.0 * c.x - 1.0) as f32, c.y as f32);
+            match sp.brdf.sample(wo_local, u) {
+                Some(s) => {
+                    let dir = sp.frame.to_world(s.wi);
+                    (dir, 0.5 * (s.pdf + env_h.pdf(dir)))
+                }
+                None => continue,
+            }
+        };
+        let f = env_h.radiance(dir) * sp.eval(dir);
+        let target = crate::env::luminance(f);
+        if !(target > 0.0 && source > 0.0) || !target.is_finite() {
+            continue;
+        }
+        let w = (target / source) as f64;
+        total += w;
+        // Keep this candidate with probability w/total, rescaling ξ to stay uniform.
+        let p = w / total;
+        if xi < p {
+            xi = (xi / p).min(crate::warp::ONE_MINUS_EPSILON);
+            chosen = Some((dir, f, target, source));
+        } else {
+            xi = ((xi - p) / (1.0 - p)).clamp(0.0, crate::warp::ONE_MINUS_EPSILON);
+        }
+    }
+    let Some((dir, f, target, source)) = chosen else { return Contribution::default() };
+    let m = candidates.len() as f64;
+    let value = if vis.visible(dir) { f * ((total / m) as f32 / target) } else { Vec3::ZERO };
+    Contribution { dir, value, pdf: source, other_pdf: 0.0 }
+}

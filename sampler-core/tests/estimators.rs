@@ -1,6 +1,10 @@
 //! Every estimator's mean equals brute-force quadrature of ∫ L·B·cos·V dω within 3 standard
-//! errors, at fixed shading points: sharp lobes (GGX α = 1e-3, Phong n = 1e5, car paint),
-//! grazing views, an occluder, and an environment with a bright texel.
+//! errors (plus the quadrature's own error estimate), at fixed shading points: sharp lobes (GGX
+//! α = 1e-3, Phong n = 1e5, car paint), grazing views, an occluder, and an environment with a
+//! bright texel. With 7 estimators × 12 cases, a 3σ excursion somewhere has a ~20% chance even
+//! for unbiased estimators; when one appeared (MIS, Lambert, 20°: 3.08σ with a stream shared by
+//! all estimators), 3 × 2M draws on independent streams gave 0.40164, 0.40165, 0.40137 ± 1.8e-4
+//! against the quadrature's 0.40169 — a fluke, and each estimator now has its own stream.
 
 mod common;
 
@@ -60,15 +64,28 @@ fn visible(d: Vec3) -> bool {
     d.dot(Vec3::new(0.3, 1.0, 0.0).normalize()) > -0.2
 }
 
-fn reference(env: &EnvHierarchy<'_>, case: &Case) -> f64 {
+/// Quadrature of ∫ L·B·cos·V and an estimate of its own error: the polar cells straddle texel
+/// edges and the occluder, so it converges only to first order; |Q(2n) − Q(n)| bounds what is
+/// left. Computed once per case and shared by the tests of this binary.
+fn reference(env: &EnvHierarchy<'_>, index: usize, case: &Case) -> (f64, f64) {
+    static CACHE: std::sync::OnceLock<std::sync::Mutex<std::collections::HashMap<usize, (f64, f64)>>> =
+        std::sync::OnceLock::new();
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(r) = cache.lock().unwrap().get(&index) {
+        return *r;
+    }
     let sp = ShadingPoint { frame: case.frame, wo: case.wo, brdf: case.brdf.as_ref() };
-    let n = case.frame.n;
     let wo_l = case.frame.to_local(case.wo);
     let axis = case.frame.to_world(Vec3::new(-wo_l.x, -wo_l.y, wo_l.z));
-    let _ = n;
-    integrate_lobe(axis, case.width, 1200, |d| {
-        if visible(d) { luminance(env.radiance(d) * sp.eval(d)) as f64 } else { 0.0 }
-    })
+    let q = |n| {
+        integrate_lobe(axis, case.width, n, |d| {
+            if visible(d) { luminance(env.radiance(d) * sp.eval(d)) as f64 } else { 0.0 }
+        })
+    };
+    let (coarse, fine) = (q(1200), q(2400));
+    let r = (fine, (fine - coarse).abs());
+    cache.lock().unwrap().insert(index, r);
+    r
 }
 
 /// Running mean and variance (Welford), so that millions of draws need no storage.
@@ -100,12 +117,14 @@ impl FromIterator<f64> for Stats {
     }
 }
 
-fn check(label: &str, reference: f64, stats: &Stats, failures: &mut Vec<String>) {
+fn check(label: &str, (reference, quadrature_error): (f64, f64), stats: &Stats, failures: &mut Vec<String>) {
     let (mean, se) = (stats.mean, stats.standard_error());
     assert!(mean.is_finite() && se.is_finite(), "{label}: non-finite estimate");
-    let tol = 3.0 * se + 1e-4 * reference.abs();
+    let tol = 3.0 * se + quadrature_error + 1e-5 * reference.abs();
     if (mean - reference).abs() > tol {
-        failures.push(format!("{label}: mean {mean:.6e} vs quadrature {reference:.6e}, SE {se:.2e}"));
+        failures.push(format!(
+            "{label}: mean {mean:.6e} vs quadrature {reference:.6e} (± {quadrature_error:.1e}), SE {se:.2e}"
+        ));
     }
 }
 
@@ -114,11 +133,13 @@ fn run(estimator: &str) {
     let e = env.view();
     let mut failures = Vec::new();
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    for case in cases() {
-        let reference = reference(&e, &case);
+    for (index, case) in cases().into_iter().enumerate() {
+        let reference = reference(&e, index, &case);
         let sp = ShadingPoint { frame: case.frame, wo: case.wo, brdf: case.brdf.as_ref() };
         let mut vis = visible;
-        let mut rng = Pcg32::new(17, 3);
+        // Each estimator its own stream: shared streams made their errors correlated.
+        let stream = estimator.bytes().fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
+        let mut rng = Pcg32::new(17, stream);
         let mut u = || DVec2::new(rng.next_f64(), rng.next_f64());
         let lum = |v: Vec3| luminance(v) as f64;
         let values: Stats = match estimator {
@@ -167,6 +188,16 @@ fn run(estimator: &str) {
                     })
                     .collect()
             }
+            "ris" => {
+                let mut rng = Pcg32::new(23, 4);
+                (0..100_000u64)
+                    .map(|k| {
+                        let mut cands = [DVec2::ZERO; 8];
+                        sobol02(k, 0, &mut cands);
+                        lum(estimator::ris(&e, &sp, &cands, rng.next_f64(), &mut vis).value)
+                    })
+                    .collect()
+            }
             "brdf" => (0..200_000).map(|_| lum(estimator::brdf(&e, &sp, u(), &mut vis).value)).collect(),
             "mis" => (0..200_000)
                 .map(|_| {
@@ -194,6 +225,11 @@ fn wavelet_product_estimator_is_unbiased() {
 #[test]
 fn product_mis_estimator_is_unbiased() {
     run("product-mis");
+}
+
+#[test]
+fn ris_estimator_is_unbiased() {
+    run("ris");
 }
 
 #[test]

@@ -86,6 +86,7 @@ fn ten_thousand_shading_points_allocate_nothing() {
             sink += (a.value.x + b.value.x) as f64;
             let [a, b] = estimator::product_mis(&sampler, &sp, u, u.as_vec2(), &mut vis);
             sink += (a.value.x + b.value.x) as f64;
+            sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x as f64;
         }
     }
     ARMED.with(|a| a.set(false));
