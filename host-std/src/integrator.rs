@@ -29,13 +29,23 @@ pub enum Method {
     Mis,
     /// MIS of product and BRDF sampling.
     ProductMis,
+    /// Resampled importance sampling: `RIS_CANDIDATES` env/BRDF candidates, one shadow ray.
+    Ris,
     /// Per material, the method expected to be cheapest at equal error (see `Method::for_material`).
     Auto,
 }
 
 impl Method {
-    pub const ALL: [Method; 7] =
-        [Method::Product, Method::Wavelet, Method::Env, Method::Brdf, Method::Mis, Method::ProductMis, Method::Auto];
+    pub const ALL: [Method; 8] = [
+        Method::Product,
+        Method::Wavelet,
+        Method::Env,
+        Method::Brdf,
+        Method::Mis,
+        Method::ProductMis,
+        Method::Ris,
+        Method::Auto,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -45,6 +55,7 @@ impl Method {
             Method::Brdf => "brdf",
             Method::Mis => "mis",
             Method::ProductMis => "product-mis",
+            Method::Ris => "ris",
             Method::Auto => "auto",
         }
     }
@@ -86,6 +97,9 @@ impl FromStr for Method {
         })
     }
 }
+
+/// Candidates per RIS estimate (each costs an env or BRDF sample and an evaluation, no ray).
+pub const RIS_CANDIDATES: usize = 8;
 
 /// Counts the shadow rays a visibility closure traces.
 pub struct CountingVisibility<F: FnMut(Vec3) -> bool> {
@@ -147,6 +161,11 @@ pub fn shade<B: Brdf + ?Sized>(
                 (Method::Mis, _) => {
                     let [a, b] = estimator::mis(env, sp, u, others[k].as_vec2(), vis);
                     a.value + b.value
+                }
+                (Method::Ris, _) => {
+                    let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
+                    sobol02(hash_combine(seed, 3 + (done + k) as u64), 0, &mut candidates);
+                    estimator::ris(env, sp, &candidates, u.x, vis).value
                 }
                 _ => Vec3::ZERO,
             };

@@ -197,7 +197,7 @@ pub fn ris<B: Brdf + ?Sized>(
         };
         let f = env_h.radiance(dir) * sp.eval(dir);
         let target = crate::env::luminance(f);
-        if !(target > 0.0 && source > 0.0) || !target.is_finite() {
+        if !(target > 0.0 && source > 0.0 && target.is_finite()) {
             continue;
         }
         let w = (target / source) as f64;
