@@ -11,6 +11,7 @@ use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::two_stage::TwoStageSampler;
 use std::fmt;
 use std::str::FromStr;
 
@@ -31,12 +32,15 @@ pub enum Method {
     ProductMis,
     /// Resampled importance sampling: `RIS_CANDIDATES` env/BRDF candidates, one shadow ray.
     Ris,
+    /// Two-stage importance sampling (Cline et al. 2006, reconstructed: sampler-core's
+    /// two_stage.rs): a BRDF-driven partition weighted through a summed-area table.
+    TwoStage,
     /// Per material, the method expected to be cheapest at equal error (see `Method::for_material`).
     Auto,
 }
 
 impl Method {
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Product,
         Method::Wavelet,
         Method::Env,
@@ -44,6 +48,7 @@ impl Method {
         Method::Mis,
         Method::ProductMis,
         Method::Ris,
+        Method::TwoStage,
         Method::Auto,
     ];
 
@@ -56,6 +61,7 @@ impl Method {
             Method::Mis => "mis",
             Method::ProductMis => "product-mis",
             Method::Ris => "ris",
+            Method::TwoStage => "two-stage",
             Method::Auto => "auto",
         }
     }
@@ -125,6 +131,7 @@ pub fn shade<B: Brdf + ?Sized>(
     brdf_samples: usize,
     seed: u64,
     arena: &mut Option<Box<ProductArena>>,
+    sat: Option<&[f64]>,
     vis: &mut impl Visibility,
 ) -> Vec3 {
     let budget = budget.max(1);
@@ -141,6 +148,10 @@ pub fn shade<B: Brdf + ?Sized>(
         Some(arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, hash_combine(seed, 0xb5df)))
     } else {
         None
+    };
+    let two_stage: Option<TwoStageSampler<'_, '_>> = match (method, sat) {
+        (Method::TwoStage, Some(sat)) => Some(TwoStageSampler::new(env, sat, sp.brdf, &sp.frame, sp.wo)),
+        _ => None,
     };
     // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
@@ -162,6 +173,10 @@ pub fn shade<B: Brdf + ?Sized>(
                     let [a, b] = estimator::mis(env, sp, u, others[k].as_vec2(), vis);
                     a.value + b.value
                 }
+                (Method::TwoStage, _) => match &two_stage {
+                    Some(t) => estimator::two_stage(t, env, sp, u, vis).value,
+                    None => Vec3::ZERO,
+                },
                 (Method::Ris, _) => {
                     let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
                     sobol02(hash_combine(seed, 3 + (done + k) as u64), 0, &mut candidates);

@@ -52,6 +52,16 @@ const TILE: usize = 16;
 
 /// Renders the scene. `env` is `None` when the scene has no environment light.
 pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Rendered {
+    // The summed-area table exists only for the method that reads it.
+    let sat = match (env, settings.method) {
+        (Some(e), Method::TwoStage) => {
+            let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(e.finest_level())];
+            sampler_core::two_stage::build_sat(e, &mut sat);
+            Some(sat)
+        }
+        _ => None,
+    };
+    let sat = sat.as_deref();
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tiles: Vec<(usize, usize)> =
@@ -71,7 +81,7 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
             let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(scene, bvh, env, &camera, settings, x, y, &mut arena, &mut local));
+                    out.push(pixel(scene, bvh, env, sat, &camera, settings, x, y, &mut arena, &mut local));
                 }
             }
             for (c, l) in counters.iter().zip(local) {
@@ -107,6 +117,7 @@ fn pixel(
     scene: &Scene,
     bvh: &Bvh,
     env: Option<&EnvHierarchy<'_>>,
+    sat: Option<&[f64]>,
     camera: &Camera,
     s: &Settings,
     x: usize,
@@ -153,7 +164,7 @@ fn pixel(
                         CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
                     let method = s.method.for_material(&material.bsdf);
                     let sp_seed = hash_combine(seed, (done + k + 1) as u64);
-                    let v = integrator::shade(method, env, &sp, budget, s.brdf_samples, sp_seed, arena, &mut vis);
+                    let v = integrator::shade(method, env, &sp, budget, s.brdf_samples, sp_seed, arena, sat, &mut vis);
                     stats[1] += vis.rays;
                     v
                 }

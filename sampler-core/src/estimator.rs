@@ -7,6 +7,7 @@ use crate::brdf::Brdf;
 use crate::env::EnvHierarchy;
 use crate::frame::Frame;
 use crate::sampler::ProductSampler;
+use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, Vec2, Vec3};
 
 /// Answers whether the environment is visible from the shading point in a world direction.
@@ -215,4 +216,18 @@ pub fn ris<B: Brdf + ?Sized>(
     let m = candidates.len() as f64;
     let value = if vis.visible(dir) { f * ((total / m) as f32 / target) } else { Vec3::ZERO };
     Contribution { dir, value, pdf: source, other_pdf: 0.0 }
+}
+
+/// Two-stage importance sampling (Cline et al. 2006, see `two_stage.rs`): one direction from
+/// the shading point's [`TwoStageSampler`].
+pub fn two_stage<B: Brdf + ?Sized, const R: usize>(
+    sampler: &TwoStageSampler<'_, '_, R>,
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u: DVec2,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = sampler.sample(u) else { return Contribution::default() };
+    let f = env_h.radiance(s.dir) * sp.eval(s.dir);
+    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }

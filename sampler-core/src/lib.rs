@@ -51,6 +51,7 @@ pub mod quadtree;
 pub mod rng;
 pub mod sampler;
 pub mod sampling;
+pub mod two_stage;
 pub mod warp;
 pub mod wavelet;
 

@@ -61,6 +61,8 @@ fn ten_thousand_shading_points_allocate_nothing() {
     ];
     let mut rng = Pcg32::new(1, 1);
     let mut sink = 0.0f64;
+    let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(level)];
+    assert!(sampler_core::two_stage::build_sat(&env, &mut sat));
 
     ARMED.with(|a| a.set(true));
     for i in 0..10_000u64 {
@@ -87,6 +89,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
             let [a, b] = estimator::product_mis(&sampler, &sp, u, u.as_vec2(), &mut vis);
             sink += (a.value.x + b.value.x) as f64;
             sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x as f64;
+            let two: sampler_core::two_stage::TwoStageSampler<'_, '_> =
+                sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
+            sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x as f64;
         }
     }
     ARMED.with(|a| a.set(false));

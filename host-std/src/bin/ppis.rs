@@ -39,7 +39,7 @@ struct ReportArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Comma-separated methods.
-    #[arg(long, default_value = "product,env,brdf,mis,product-mis,ris,auto", value_delimiter = ',', value_parser = parse_method)]
+    #[arg(long, default_value = "product,env,brdf,mis,product-mis,ris,two-stage,auto", value_delimiter = ',', value_parser = parse_method)]
     methods: Vec<Method>,
     /// Comma-separated visibility samples per pixel.
     #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
@@ -85,7 +85,7 @@ struct SceneArgs {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// product, wavelet, env, brdf, mis, product-mis, ris or auto.
+    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto.
     #[arg(long, default_value = "product", value_parser = parse_method)]
     method: Method,
     /// Visibility samples (shadow rays) per pixel.
