@@ -10,7 +10,7 @@ use sampler_core::glam::{DVec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::hash_combine;
-use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::sampler::{ProductParams, ProductSampler};
 use sampler_core::two_stage::TwoStageSampler;
 use std::fmt;
 use std::str::FromStr;
@@ -66,24 +66,24 @@ impl Method {
         }
     }
 
-    /// True when the method builds a product sampler per shading point.
+    /// True when the method builds product samplers.
     pub fn uses_product(self) -> bool {
         matches!(self, Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto)
     }
 
-    /// `auto`: BRDF sampling for needle-sharp lobes (where it is nearly exact under smooth
-    /// light, sampler-core's tests/efficiency.rs), environment sampling for Lambert (cheap and
-    /// adequate: the product's build costs more than its variance gain there), the product
-    /// otherwise. Provisional until `ppis report` measures it at equal time.
+    /// `auto`, from `ppis report` on the default and the shared scenes (docs/perf.md): MIS of
+    /// env and BRDF sampling for Lambert surfaces (env-only alone is far worse under a sun) and
+    /// for needle-sharp lobes (BRDF sampling is nearly exact there), product-MIS (its sampler
+    /// shared by the pixel's shading points) for the glossy lobes and car paint in between.
     pub fn for_material(self, bsdf: &Bsdf) -> Method {
         if self != Method::Auto {
             return self;
         }
         match bsdf {
-            Bsdf::Diffuse(_) => Method::Env,
-            Bsdf::Conductor(c) if c.ggx.alpha() < 0.01 => Method::Brdf,
-            Bsdf::Phong(p) if p.exponent > 2000.0 && p.kd == Vec3::ZERO => Method::Brdf,
-            _ => Method::Product,
+            Bsdf::Diffuse(_) => Method::Mis,
+            Bsdf::Conductor(c) if c.ggx.alpha() < 0.03 => Method::Mis,
+            Bsdf::Phong(p) if p.exponent > 1000.0 || p.ks == Vec3::ZERO => Method::Mis,
+            _ => Method::ProductMis,
         }
     }
 }
@@ -120,18 +120,33 @@ impl<F: FnMut(Vec3) -> bool> Visibility for CountingVisibility<F> {
     }
 }
 
+/// A per-shading-point (or shared) sampler that a method needs built before sampling.
+pub enum Technique<'s, 'e> {
+    /// Methods that need nothing built.
+    None,
+    Product(&'s ProductSampler<'s, 'e>),
+    TwoStage(&'s TwoStageSampler<'s, 'e>),
+}
+
+/// The product-sampler settings of a method.
+pub fn product_params(method: Method, brdf_samples: usize) -> ProductParams {
+    let kind = if method == Method::Wavelet { ProductKind::Wavelet } else { ProductKind::Quadtree };
+    ProductParams { brdf_samples, kind, ..ProductParams::default() }
+}
+
 /// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
-/// visibility samples of `method` (not `Auto`: resolve it per material first).
+/// visibility samples of `method` (not `Auto`: resolve it per material first). `technique`
+/// holds the product sampler or two-stage partition for the methods that need one; it may have
+/// been built for another shading point of the same pixel and material (still unbiased: it is
+/// a valid density that is positive wherever L > 0).
 #[allow(clippy::too_many_arguments)]
 pub fn shade<B: Brdf + ?Sized>(
     method: Method,
     env: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
     budget: usize,
-    brdf_samples: usize,
     seed: u64,
-    arena: &mut Option<Box<ProductArena>>,
-    sat: Option<&[f64]>,
+    technique: &Technique<'_, '_>,
     vis: &mut impl Visibility,
 ) -> Vec3 {
     let budget = budget.max(1);
@@ -140,19 +155,6 @@ pub fn shade<B: Brdf + ?Sized>(
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
     let mut sum = Vec3::ZERO;
-    let kind = if method == Method::Wavelet { ProductKind::Wavelet } else { ProductKind::Quadtree };
-    let params = ProductParams { brdf_samples, kind, ..ProductParams::default() };
-    let product = if matches!(method, Method::Product | Method::Wavelet | Method::ProductMis) {
-        // The arena exists only once a method needs it (36 KB per worker).
-        let arena = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
-        Some(arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, hash_combine(seed, 0xb5df)))
-    } else {
-        None
-    };
-    let two_stage: Option<TwoStageSampler<'_, '_>> = match (method, sat) {
-        (Method::TwoStage, Some(sat)) => Some(TwoStageSampler::new(env, sat, sp.brdf, &sp.frame, sp.wo)),
-        _ => None,
-    };
     // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
     while done < n {
@@ -161,22 +163,19 @@ pub fn shade<B: Brdf + ?Sized>(
         sobol02(hash_combine(seed, 2), done as u32, &mut others[..m]);
         for k in 0..m {
             let u = points[k];
-            sum += match (method, &product) {
-                (Method::Product | Method::Wavelet, Some(p)) => estimator::product(p, sp, u, vis).value,
-                (Method::ProductMis, Some(p)) => {
+            sum += match (method, technique) {
+                (Method::Product | Method::Wavelet, Technique::Product(p)) => estimator::product(p, sp, u, vis).value,
+                (Method::ProductMis, Technique::Product(p)) => {
                     let [a, b] = estimator::product_mis(p, sp, u, others[k].as_vec2(), vis);
                     a.value + b.value
                 }
+                (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
                 (Method::Env, _) => estimator::env(env, sp, u, vis).value,
                 (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
                 (Method::Mis, _) => {
                     let [a, b] = estimator::mis(env, sp, u, others[k].as_vec2(), vis);
                     a.value + b.value
                 }
-                (Method::TwoStage, _) => match &two_stage {
-                    Some(t) => estimator::two_stage(t, env, sp, u, vis).value,
-                    None => Vec3::ZERO,
-                },
                 (Method::Ris, _) => {
                     let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
                     sobol02(hash_combine(seed, 3 + (done + k) as u64), 0, &mut candidates);

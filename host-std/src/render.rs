@@ -5,10 +5,11 @@
 
 use crate::bvh::Bvh;
 use crate::camera::Camera;
-use crate::integrator::{self, CountingVisibility, Method};
+use crate::integrator::{self, CountingVisibility, Method, Technique};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
 use sampler_core::frame::Frame;
@@ -16,6 +17,7 @@ use sampler_core::glam::{DVec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::ProductArena;
+use sampler_core::two_stage::TwoStageSampler;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -110,8 +112,18 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     Rendered { width: w, height: h, pixels, render_seconds, shading_points, shadow_rays, camera_rays, non_finite }
 }
 
-/// One pixel: the mean over its shading points. `stats` counts shading points, shadow rays,
-/// camera rays and non-finite values.
+/// A primary ray's hit, ready to shade.
+struct Hit<'m> {
+    sp: ShadingPoint<'m, dyn Brdf + 'm>,
+    origin: Vec3,
+    material: usize,
+    method: Method,
+    index: usize,
+}
+
+/// One pixel: the mean over its shading points (product-MIS samplers shared per pixel and
+/// material, every other sampler built per shading point). `stats` counts shading points, shadow rays, camera rays and non-finite
+/// values.
 #[allow(clippy::too_many_arguments)]
 fn pixel(
     scene: &Scene,
@@ -130,46 +142,92 @@ fn pixel(
     let budget = (s.spp / p).max(1);
     let mut film = [DVec2::ZERO; 64];
     let mut sum = Vec3::ZERO;
+    let mut hits: Vec<Hit<'_>> = Vec::with_capacity(p.min(64));
     let mut done = 0;
     while done < p {
         let m = (p - done).min(64);
         sobol02(seed, done as u32, &mut film[..m]);
+        hits.clear();
         for (k, f) in film[..m].iter().enumerate() {
             let dir = camera.direction(x as f32 + f.x as f32, y as f32 + f.y as f32);
             stats[2] += 1;
-            let value = match bvh.intersect(camera.origin, dir, camera.near_clip, f32::INFINITY) {
-                None => match (env, scene.hide_emitters) {
-                    (Some(e), false) => e.radiance(dir),
-                    _ => Vec3::ZERO,
-                },
-                Some(hit) => {
-                    let material = &scene.materials[hit.material as usize];
-                    let wo = -dir;
-                    let mut n = hit.normal;
-                    if n.dot(wo) < 0.0 {
-                        // Seen from the back, a one-sided surface reflects nothing.
-                        if !material.twosided {
-                            continue;
-                        }
-                        n = -n;
+            let Some(hit) = bvh.intersect(camera.origin, dir, camera.near_clip, f32::INFINITY) else {
+                if let (Some(e), false) = (env, scene.hide_emitters) {
+                    sum += e.radiance(dir);
+                }
+                continue;
+            };
+            let material = &scene.materials[hit.material as usize];
+            let wo = -dir;
+            let mut n = hit.normal;
+            if n.dot(wo) < 0.0 {
+                // Seen from the back, a one-sided surface reflects nothing.
+                if !material.twosided {
+                    continue;
+                }
+                n = -n;
+            }
+            if env.is_none() {
+                continue;
+            }
+            let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
+            hits.push(Hit {
+                sp: ShadingPoint { frame: Frame::from_normal(n), wo, brdf: material.bsdf.as_brdf() },
+                origin: hit.point + n * eps,
+                material: hit.material as usize,
+                method: s.method.for_material(&material.bsdf),
+                index: done + k,
+            });
+        }
+        if let Some(env) = env {
+            // Product-MIS shares one sampler per pixel and material, built from the group's first
+            // shading point: MIS with BRDF sampling covers where another point's lobe leaves the
+            // shared B̃ (measured 2.4× faster at equal error on s1). Plain product, wavelet and
+            // two-stage build per shading point: shared, they grow fireflies near silhouettes and
+            // on sharp lobes, where only the defensive mixture covers the mismatch.
+            let mut first = 0;
+            while first < hits.len() {
+                let group = hits[first].material;
+                let shared = hits[first].method == Method::ProductMis;
+                if shared && hits[..first].iter().any(|h| h.material == group && h.method == Method::ProductMis) {
+                    first += 1;
+                    continue;
+                }
+                let lead = &hits[first];
+                let build_seed = hash_combine(seed, 0xb5df ^ (group as u64) << 20);
+                let product;
+                let two_stage;
+                let technique = match lead.method {
+                    Method::Product | Method::Wavelet | Method::ProductMis => {
+                        let a = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
+                        let params = integrator::product_params(lead.method, s.brdf_samples);
+                        product = a.build(env, lead.sp.brdf, &lead.sp.frame, lead.sp.wo, &params, build_seed);
+                        Technique::Product(&product)
                     }
-                    let Some(env) = env else {
-                        continue;
-                    };
+                    Method::TwoStage => match sat {
+                        Some(sat) => {
+                            two_stage = TwoStageSampler::new(env, sat, lead.sp.brdf, &lead.sp.frame, lead.sp.wo);
+                            Technique::TwoStage(&two_stage)
+                        }
+                        None => Technique::None,
+                    },
+                    _ => Technique::None,
+                };
+                let members = hits[first..]
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, h)| if shared { h.material == group } else { *k == 0 });
+                for (_, h) in members {
                     stats[0] += 1;
-                    let sp = ShadingPoint { frame: Frame::from_normal(n), wo, brdf: material.bsdf.as_brdf() };
-                    let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
-                    let origin = hit.point + n * eps;
+                    let origin = h.origin;
                     let mut vis =
                         CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
-                    let method = s.method.for_material(&material.bsdf);
-                    let sp_seed = hash_combine(seed, (done + k + 1) as u64);
-                    let v = integrator::shade(method, env, &sp, budget, s.brdf_samples, sp_seed, arena, sat, &mut vis);
+                    let sp_seed = hash_combine(seed, (h.index + 1) as u64);
+                    sum += integrator::shade(h.method, env, &h.sp, budget, sp_seed, &technique, &mut vis);
                     stats[1] += vis.rays;
-                    v
                 }
-            };
-            sum += value;
+                first += 1;
+            }
         }
         done += m;
     }

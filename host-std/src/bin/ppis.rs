@@ -79,6 +79,12 @@ struct SceneArgs {
     /// equal-area map).
     #[arg(long)]
     env: Option<PathBuf>,
+    /// Radiance scale of the environment (with --env; otherwise the scene's).
+    #[arg(long)]
+    env_scale: Option<f32>,
+    /// Rotation of the environment about +Y in degrees (d_world = R_y·d_local).
+    #[arg(long, allow_hyphen_values = true)]
+    env_rotate_y: Option<f32>,
 }
 
 #[derive(Args)]
@@ -158,6 +164,20 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
             bail!("{}: environment map not found", env.display());
         }
         scene.env = Some((EnvSource::File(env.clone()), Placement::default()));
+    }
+    if let Some((_, placement)) = scene.env.as_mut() {
+        if let Some(s) = args.env_scale {
+            if !(s >= 0.0 && s.is_finite()) {
+                bail!("--env-scale must be a finite number ≥ 0, got {s}");
+            }
+            placement.scale = s;
+        }
+        if let Some(r) = args.env_rotate_y {
+            if !r.is_finite() {
+                bail!("--env-rotate-y must be finite, got {r}");
+            }
+            placement.rotate_y_deg = r;
+        }
     }
     Ok(scene)
 }
