@@ -28,6 +28,8 @@ pub enum LoadError {
     FeatureDisabled { path: PathBuf, format: &'static str, feature: &'static str },
     #[error("{path}: the image is {width}×{height}, larger than the 32768×16384 this renderer accepts")]
     TooLarge { path: PathBuf, width: usize, height: usize },
+    #[error("{path}: the header claims {width}×{height} pixels, more than a file of {bytes} bytes can hold")]
+    Implausible { path: PathBuf, width: usize, height: usize, bytes: usize },
 }
 
 const MAX_WIDTH: usize = 32_768;
@@ -35,18 +37,21 @@ const MAX_HEIGHT: usize = 16_384;
 
 /// Loads an image by its extension.
 pub fn load(path: &Path) -> Result<RgbImage, LoadError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.to_owned(), source })?;
-    let image = match ext.as_str() {
-        "exr" => load_exr(path, &bytes)?,
-        "hdr" => load_with_image(path, &bytes, "Radiance HDR", image_format("hdr", path)?)?,
-        "png" => load_with_image(path, &bytes, "PNG", image::ImageFormat::Png)?,
-        "jpg" | "jpeg" => load_with_image(path, &bytes, "JPEG", image_format("jpeg", path)?)?,
-        _ => {
-            return Err(LoadError::Unsupported { path: path.to_owned() });
-        }
-    };
-    Ok(image)
+    load_bytes(path, &bytes)
+}
+
+/// Decodes the bytes of an image file; `path` gives the format (by extension) and names the
+/// file in errors.
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<RgbImage, LoadError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    match ext.as_str() {
+        "exr" => load_exr(path, bytes),
+        "hdr" => load_with_image(path, bytes, "Radiance HDR", image_format("hdr", path)?),
+        "png" => load_with_image(path, bytes, "PNG", image::ImageFormat::Png),
+        "jpg" | "jpeg" => load_with_image(path, bytes, "JPEG", image_format("jpeg", path)?),
+        _ => Err(LoadError::Unsupported { path: path.to_owned() }),
+    }
 }
 
 fn image_format(which: &'static str, path: &Path) -> Result<image::ImageFormat, LoadError> {
@@ -71,12 +76,19 @@ fn finish(path: &Path, width: usize, height: usize, mut texels: Vec<[f32; 3]>) -
     Ok(RgbImage { width, height, texels, sanitized })
 }
 
-fn check_size(path: &Path, width: usize, height: usize) -> Result<(), LoadError> {
+/// Checks a header's size before any pixel storage is allocated from it: non-empty, within the
+/// largest map we accept, and no larger than the file could hold — decoded RGB of at most 1000×
+/// the file's bytes (beyond any compression real maps reach), or 64 MB, whichever is more.
+fn check_size(path: &Path, width: usize, height: usize, file_bytes: usize) -> Result<(), LoadError> {
     if width == 0 || height == 0 {
         return Err(LoadError::Empty { path: path.to_owned() });
     }
     if width > MAX_WIDTH || height > MAX_HEIGHT {
         return Err(LoadError::TooLarge { path: path.to_owned(), width, height });
+    }
+    let decoded = width.saturating_mul(height).saturating_mul(12);
+    if decoded > (1000 * file_bytes).max(64 << 20) {
+        return Err(LoadError::Implausible { path: path.to_owned(), width, height, bytes: file_bytes });
     }
     Ok(())
 }
@@ -88,7 +100,7 @@ fn load_exr(path: &Path, bytes: &[u8]) -> Result<RgbImage, LoadError> {
     let meta = MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(|e| decode(e.to_string()))?;
     let header = meta.headers.first().ok_or_else(|| decode("no image layer".into()))?;
     let size = header.layer_size;
-    check_size(path, size.width(), size.height())?;
+    check_size(path, size.width(), size.height(), bytes.len())?;
     let image = read_first_rgba_layer_from_file_bytes(bytes, size).map_err(|e| decode(e.to_string()))?;
     let (width, height) = (size.width(), size.height());
     finish(path, width, height, image)
@@ -132,7 +144,7 @@ fn load_with_image(
     limits.max_alloc = Some(8 * 1024 * 1024 * 1024);
     reader.limits(limits);
     let (w, h) = reader.into_dimensions().map_err(|e| decode(e.to_string()))?;
-    check_size(path, w as usize, h as usize)?;
+    check_size(path, w as usize, h as usize, bytes.len())?;
     let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     reader.limits({
         let mut l = image::Limits::default();
