@@ -6,7 +6,7 @@ use crate::scene::Bsdf;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::{self, ShadingPoint, Visibility};
-use sampler_core::glam::{DVec2, Vec3};
+use sampler_core::glam::{DVec2, DVec3, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::hash_combine;
@@ -148,13 +148,13 @@ pub fn shade<B: Brdf + ?Sized>(
     seed: u64,
     technique: &Technique<'_, '_>,
     vis: &mut impl Visibility,
-) -> Vec3 {
+) -> DVec3 {
     let budget = budget.max(1);
     let pairs = (budget / 2).max(1);
     let n = if matches!(method, Method::Mis | Method::ProductMis) { pairs } else { budget };
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
-    let mut sum = Vec3::ZERO;
+    let mut sum = DVec3::ZERO;
     // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
     while done < n {
@@ -181,10 +181,10 @@ pub fn shade<B: Brdf + ?Sized>(
                     sobol02(hash_combine(seed, 3 + (done + k) as u64), 0, &mut candidates);
                     estimator::ris(env, sp, &candidates, u.x, vis).value
                 }
-                _ => Vec3::ZERO,
+                _ => DVec3::ZERO,
             };
         }
         done += m;
     }
-    sum / n as f32
+    sum / n as f64
 }

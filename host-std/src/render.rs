@@ -13,7 +13,7 @@ use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
 use sampler_core::frame::Frame;
-use sampler_core::glam::{DVec2, Vec3};
+use sampler_core::glam::{DVec2, DVec3, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::ProductArena;
@@ -141,7 +141,8 @@ fn pixel(
     let p = s.shading_points.max(1);
     let budget = (s.spp / p).max(1);
     let mut film = [DVec2::ZERO; 64];
-    let mut sum = Vec3::ZERO;
+    // Accumulated in f64: single samples of a 1e30 map can exceed the f32 range.
+    let mut sum = DVec3::ZERO;
     let mut hits: Vec<Hit<'_>> = Vec::with_capacity(p.min(64));
     let mut done = 0;
     while done < p {
@@ -153,7 +154,7 @@ fn pixel(
             stats[2] += 1;
             let Some(hit) = bvh.intersect(camera.origin, dir, camera.near_clip, f32::INFINITY) else {
                 if let (Some(e), false) = (env, scene.hide_emitters) {
-                    sum += e.radiance(dir);
+                    sum += e.radiance(dir).as_dvec3();
                 }
                 continue;
             };
@@ -231,10 +232,11 @@ fn pixel(
         }
         done += m;
     }
-    let mean = sum / p as f32;
+    let mean = (sum / p as f64).as_vec3();
     if mean.is_finite() {
         mean.to_array()
     } else {
+        // The mean itself exceeds the f32 range of the output (or is NaN): counted, written as 0.
         stats[3] += 1;
         [0.0; 3]
     }

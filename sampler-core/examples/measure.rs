@@ -2,7 +2,7 @@
 //! mixture. `cargo run --release -p sampler-core --example measure`
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, RoughConductor};
-use sampler_core::env::{EnvHierarchy, build_pyramid, luminance, pyramid_len};
+use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::{angle_between, sphere_to_square, square_to_sphere};
@@ -63,7 +63,7 @@ fn main() {
                 let mut pts = [DVec2::ZERO; 64];
                 sobol02(seed + 77, 0, &mut pts);
                 for u in pts {
-                    let v = luminance(estimator::product(&sampler, &sp, u, &mut |_| true).value) as f64;
+                    let v = estimator::luminance64(estimator::product(&sampler, &sp, u, &mut |_| true).value);
                     s1 += v;
                     s2 += v * v;
                     cnt += 1.0;

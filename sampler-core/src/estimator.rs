@@ -8,7 +8,7 @@ use crate::env::EnvHierarchy;
 use crate::frame::Frame;
 use crate::sampler::ProductSampler;
 use crate::two_stage::TwoStageSampler;
-use glam::{DVec2, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {
@@ -52,17 +52,31 @@ impl<B: Brdf + ?Sized> ShadingPoint<'_, B> {
 pub struct Contribution {
     /// World direction sampled (zero when no direction could be drawn).
     pub dir: Vec3,
-    /// f·V/p, times the MIS weight for MIS samples.
-    pub value: Vec3,
+    /// f·V/p, times the MIS weight for MIS samples — in f64: with radiances near 1e30 and
+    /// needle lobes at grazing views, L·B alone exceeds the f32 range.
+    pub value: DVec3,
     /// Density (solid angle) of the technique that drew the direction.
     pub pdf: f32,
     /// Density of the other technique at `dir` (MIS only; 0 otherwise).
     pub other_pdf: f32,
 }
 
+/// L·B in f64.
 #[inline]
-fn weighted(f: Vec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> Vec3 {
-    if pdf > 0.0 && f.cmpgt(Vec3::ZERO).any() && vis.visible(dir) { f / pdf } else { Vec3::ZERO }
+fn times(l: Vec3, b: Vec3) -> DVec3 {
+    l.as_dvec3() * b.as_dvec3()
+}
+
+/// Rec. 709 luminance of an f64 RGB value.
+#[inline]
+#[must_use]
+pub fn luminance64(c: DVec3) -> f64 {
+    0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
+}
+
+#[inline]
+fn weighted(f: DVec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> DVec3 {
+    if pdf > 0.0 && f.cmpgt(DVec3::ZERO).any() && vis.visible(dir) { f / pdf as f64 } else { DVec3::ZERO }
 }
 
 /// Product importance sampling: one direction from the shading point's [`ProductSampler`].
@@ -75,7 +89,7 @@ pub fn product<B: Brdf + ?Sized>(
     let Some(s) = sampler.sample(u) else {
         return Contribution::default();
     };
-    let f = sampler.env().radiance(s.dir) * sp.eval(s.dir);
+    let f = times(sampler.env().radiance(s.dir), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
@@ -89,7 +103,7 @@ pub fn env<B: Brdf + ?Sized>(
     let Some(s) = env.sample(u) else {
         return Contribution::default();
     };
-    let f = env.radiance(s.dir) * sp.eval(s.dir);
+    let f = times(env.radiance(s.dir), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
@@ -104,7 +118,7 @@ pub fn brdf<B: Brdf + ?Sized>(
         return Contribution::default();
     };
     let dir = sp.frame.to_world(s.wi);
-    let f = env.radiance(dir) * s.value;
+    let f = times(env.radiance(dir), s.value);
     Contribution { dir, value: weighted(f, s.pdf, vis, dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
@@ -150,13 +164,13 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
     let mut out = [Contribution::default(); 2];
     if let Some((dir, p)) = drawn {
         let p_brdf = sp.brdf_pdf(dir);
-        let f = env_h.radiance(dir) * sp.eval(dir);
+        let f = times(env_h.radiance(dir), sp.eval(dir));
         out[0] = Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf };
     }
     if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
         let dir = sp.frame.to_world(s.wi);
         let p_other = pdf(dir);
-        let f = env_h.radiance(dir) * s.value;
+        let f = times(env_h.radiance(dir), s.value);
         out[1] = Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other };
     }
     out
@@ -178,7 +192,7 @@ pub fn ris<B: Brdf + ?Sized>(
     let wo_local = sp.frame.to_local(sp.wo);
     let mut xi = u_select.clamp(0.0, crate::warp::ONE_MINUS_EPSILON);
     let mut total = 0.0f64;
-    let mut chosen: Option<(Vec3, Vec3, f32, f32)> = None; // (dir, f, target, source pdf)
+    let mut chosen: Option<(Vec3, DVec3, f64, f32)> = None; // (dir, f, target, source pdf)
     for c in candidates {
         let (dir, source) = if c.x < 0.5 {
             let u = DVec2::new(2.0 * c.x, c.y);
@@ -196,12 +210,12 @@ pub fn ris<B: Brdf + ?Sized>(
                 None => continue,
             }
         };
-        let f = env_h.radiance(dir) * sp.eval(dir);
-        let target = crate::env::luminance(f);
+        let f = times(env_h.radiance(dir), sp.eval(dir));
+        let target = luminance64(f);
         if !(target > 0.0 && source > 0.0 && target.is_finite()) {
             continue;
         }
-        let w = (target / source) as f64;
+        let w = target / source as f64;
         total += w;
         // Keep this candidate with probability w/total, rescaling ξ to stay uniform.
         let p = w / total;
@@ -214,7 +228,7 @@ pub fn ris<B: Brdf + ?Sized>(
     }
     let Some((dir, f, target, source)) = chosen else { return Contribution::default() };
     let m = candidates.len() as f64;
-    let value = if vis.visible(dir) { f * ((total / m) as f32 / target) } else { Vec3::ZERO };
+    let value = if vis.visible(dir) { f * (total / m / target) } else { DVec3::ZERO };
     Contribution { dir, value, pdf: source, other_pdf: 0.0 }
 }
 
@@ -228,6 +242,6 @@ pub fn two_stage<B: Brdf + ?Sized, const R: usize>(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let Some(s) = sampler.sample(u) else { return Contribution::default() };
-    let f = env_h.radiance(s.dir) * sp.eval(s.dir);
+    let f = times(env_h.radiance(s.dir), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }

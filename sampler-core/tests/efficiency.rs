@@ -12,8 +12,7 @@ mod common;
 use common::TestEnv;
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
-use sampler_core::env::luminance;
-use sampler_core::estimator::{self, ShadingPoint};
+use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
 use sampler_core::rng::Pcg32;
@@ -51,7 +50,7 @@ fn product_sampling_beats_env_and_brdf_sampling() {
             let wo = frame.to_world(Vec3::new(0.4, -0.2, 0.89).normalize());
             let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
             let mut vis = |_: Vec3| true;
-            let lum = |v: Vec3| luminance(v) as f64;
+            let lum = luminance64;
             let (mut a, mut b) = (Pcg32::new(1, 2), Pcg32::new(3, 4));
             let n = 100_000;
             let (_, v_env) = variance(

@@ -12,7 +12,7 @@ use common::*;
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, luminance};
-use sampler_core::estimator::{self, ShadingPoint};
+use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
@@ -141,7 +141,7 @@ fn run(estimator: &str) {
         let stream = estimator.bytes().fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
         let mut rng = Pcg32::new(17, stream);
         let mut u = || DVec2::new(rng.next_f64(), rng.next_f64());
-        let lum = |v: Vec3| luminance(v) as f64;
+        let lum = luminance64;
         let values: Stats = match estimator {
             "product" | "wavelet" => {
                 // Each unit: a fresh B̃ (new BRDF samples) and 32 warped points: the whole

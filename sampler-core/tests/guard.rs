@@ -12,7 +12,7 @@ use common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, BrdfSample};
 use sampler_core::env::luminance;
-use sampler_core::estimator::{self, ShadingPoint};
+use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
 use sampler_core::sampler::{ProductArena, ProductParams};
@@ -62,8 +62,7 @@ fn estimate(params: &ProductParams, env: &TestEnv, frame: &Frame, wo: Vec3) -> (
         let s = arena.build(&e, &brdf, frame, wo, params, seed);
         let mut pts = [DVec2::ZERO; 32];
         sobol02(seed + 1000, 0, &mut pts);
-        let v =
-            pts.iter().map(|p| luminance(estimator::product(&s, &sp, *p, &mut vis).value) as f64).sum::<f64>() / 32.0;
+        let v = pts.iter().map(|p| luminance64(estimator::product(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0;
         sum += v;
         sum2 += v * v;
     }

@@ -81,17 +81,17 @@ fn ten_thousand_shading_points_allocate_nothing() {
             if let Some(s) = sampler.sample(u) {
                 sink += s.pdf as f64 + sampler.pdf(s.dir) as f64;
             }
-            sink += estimator::product(&sampler, &sp, u, &mut vis).value.x as f64;
-            sink += estimator::env(&env, &sp, u, &mut vis).value.x as f64;
-            sink += estimator::brdf(&env, &sp, u, &mut vis).value.x as f64;
+            sink += estimator::product(&sampler, &sp, u, &mut vis).value.x;
+            sink += estimator::env(&env, &sp, u, &mut vis).value.x;
+            sink += estimator::brdf(&env, &sp, u, &mut vis).value.x;
             let [a, b] = estimator::mis(&env, &sp, u, u.as_vec2(), &mut vis);
-            sink += (a.value.x + b.value.x) as f64;
+            sink += a.value.x + b.value.x;
             let [a, b] = estimator::product_mis(&sampler, &sp, u, u.as_vec2(), &mut vis);
-            sink += (a.value.x + b.value.x) as f64;
-            sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x as f64;
+            sink += a.value.x + b.value.x;
+            sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x;
             let two: sampler_core::two_stage::TwoStageSampler<'_, '_> =
                 sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
-            sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x as f64;
+            sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x;
         }
     }
     ARMED.with(|a| a.set(false));

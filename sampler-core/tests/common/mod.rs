@@ -389,7 +389,12 @@ pub fn sidak(tests: usize) -> f64 {
 /// a polar chart inside the cone of half-angle 30·width (capped at π) and an equal-area grid
 /// outside it, each `n`×`n`.
 pub fn integrate_lobe(axis: Vec3, width: f64, n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
-    let cone = (30.0 * width).min(PI);
+    integrate_cone(axis, (30.0 * width).min(PI), n, f)
+}
+
+/// [`integrate_lobe`] with an explicit cone half-angle.
+pub fn integrate_cone(axis: Vec3, cone: f64, n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+    let cone = cone.min(PI);
     let cos_cone = cone.cos();
     let axis_d = axis.as_dvec3().normalize();
     // Polar chart with θ = cone·g(t), g concentrating points near the axis.
@@ -415,4 +420,22 @@ pub fn integrate_lobe(axis: Vec3, width: f64, n: usize, f: impl Fn(Vec3) -> f64)
         integrate(Chart::EqualArea, n, |d| if d.as_dvec3().normalize().dot(axis_d) < cos_cone { f(d) } else { 0.0 })
     };
     inner + outer
+}
+
+/// ∫ f(ωi) dωi over the sphere, integrated over half vectors: ωi = reflect(ωo, h) maps the
+/// half vectors with ωo·h > 0 one-to-one onto the sphere with dωi = 4 |ωo·h| dωh. In h a GGX
+/// lobe is an isotropic needle of width ~α around the normal whatever the view, so this stays
+/// accurate at grazing views, where the lobe in ωi is stretched by ~1/cos θo. `normal`, `wo`:
+/// world space; `alpha`: the sharpest lobe's width.
+pub fn integrate_half_vector(normal: Vec3, wo: Vec3, alpha: f64, n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+    let wo = wo.normalize();
+    // GGX's tail falls as α²/θ⁴: beyond a cone of 1000 α it holds ~1e-6 of the mass.
+    integrate_cone(normal, 1000.0 * alpha, n, |h| {
+        let c = wo.dot(h);
+        if c <= 0.0 {
+            return 0.0;
+        }
+        let wi = (2.0 * c * h - wo).normalize();
+        f(wi) * 4.0 * c as f64
+    })
 }
