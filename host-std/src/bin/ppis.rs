@@ -53,19 +53,8 @@ struct ReportArgs {
     /// Method of the rendered reference (an independent code path from the product by default).
     #[arg(long, default_value = "mis", value_parser = parse_method)]
     reference_method: Method,
-    /// Primary rays per pixel (reduced to a divisor of each spp).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    shading_points: u32,
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
-    brdf_samples: u32,
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    threads: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    width: Option<u32>,
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    height: Option<u32>,
+    #[command(flatten)]
+    sampling: SamplingArgs,
     /// Output folder (created if missing).
     #[arg(long)]
     out: PathBuf,
@@ -97,8 +86,21 @@ struct RenderArgs {
     /// Visibility samples (shadow rays) per pixel.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     spp: u32,
-    /// Primary rays (shading points) per pixel; must divide --spp. Each builds its own product
-    /// sampler and spends spp/P visibility samples.
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+    /// Write timings and counts as JSON.
+    #[arg(long)]
+    stats_json: Option<PathBuf>,
+}
+
+/// How a render samples, shared by `render` and `report`.
+#[derive(Args)]
+struct SamplingArgs {
+    /// Primary rays (shading points) per pixel. `render`: must divide --spp, each shading point
+    /// spends spp/P visibility samples; `report`: reduced to a divisor of each spp.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
     shading_points: u32,
     /// BRDF samples per product sampler (the paper's K).
@@ -109,16 +111,29 @@ struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
+    /// Image width, overriding the scene's camera.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     width: Option<u32>,
+    /// Image height, overriding the scene's camera.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
-    /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
-    #[arg(short = 'o', long = "output")]
-    output: Option<PathBuf>,
-    /// Write timings and counts as JSON.
-    #[arg(long)]
-    stats_json: Option<PathBuf>,
+}
+
+impl SamplingArgs {
+    /// Applies --width/--height to the scene's camera.
+    fn resize(&self, scene: &mut Scene) {
+        if let Some(w) = self.width {
+            scene.camera.width = w;
+        }
+        if let Some(h) = self.height {
+            scene.camera.height = h;
+        }
+    }
+
+    /// Worker threads: --threads, or every core.
+    fn threads(&self) -> usize {
+        self.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize)
+    }
 }
 
 #[derive(Args)]
@@ -183,8 +198,8 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
-    if !args.spp.is_multiple_of(args.shading_points) {
-        bail!("--shading-points {} must divide --spp {}", args.shading_points, args.spp);
+    if !args.spp.is_multiple_of(args.sampling.shading_points) {
+        bail!("--shading-points {} must divide --spp {}", args.sampling.shading_points, args.spp);
     }
     let exr_path = args.output.clone().unwrap_or_else(|| PathBuf::from("render.exr"));
     let png_path = exr_path.with_extension("png");
@@ -192,12 +207,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
 
     let t_load = Instant::now();
     let mut scene = load_scene(&args.scene)?;
-    if let Some(w) = args.width {
-        scene.camera.width = w;
-    }
-    if let Some(h) = args.height {
-        scene.camera.height = h;
-    }
+    args.sampling.resize(&mut scene);
     let load_seconds_scene = t_load.elapsed().as_secs_f64();
 
     // Preprocess: only what this render uses.
@@ -217,16 +227,15 @@ fn render_command(args: RenderArgs) -> Result<()> {
         );
     }
 
-    let threads =
-        args.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let threads = args.sampling.threads();
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let settings = Settings {
         method: args.method,
         spp: args.spp as usize,
-        shading_points: args.shading_points as usize,
-        brdf_samples: args.brdf_samples as usize,
-        seed: args.seed,
+        shading_points: args.sampling.shading_points as usize,
+        brdf_samples: args.sampling.brdf_samples as usize,
+        seed: args.sampling.seed,
         progress: true,
     };
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
@@ -243,10 +252,10 @@ fn render_command(args: RenderArgs) -> Result<()> {
             "scene": scene.name,
             "method": args.method.name(),
             "spp": args.spp,
-            "shading_points_per_pixel": args.shading_points,
-            "brdf_samples": args.brdf_samples,
+            "shading_points_per_pixel": args.sampling.shading_points,
+            "brdf_samples": args.sampling.brdf_samples,
             "threads": threads,
-            "seed": args.seed,
+            "seed": args.sampling.seed,
             "width": image.width,
             "height": image.height,
             "load_seconds": load_seconds_scene + env_load,
@@ -276,7 +285,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         image.width,
         image.height,
         args.spp,
-        args.shading_points,
+        args.sampling.shading_points,
         args.method,
         threads,
         image.render_seconds,
@@ -303,12 +312,7 @@ fn check_writable(path: &Path) -> Result<()> {
 fn report_command(args: ReportArgs) -> Result<()> {
     use host_std::report;
     let mut scene = load_scene(&args.scene)?;
-    if let Some(w) = args.width {
-        scene.camera.width = w;
-    }
-    if let Some(h) = args.height {
-        scene.camera.height = h;
-    }
+    args.sampling.resize(&mut scene);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
     let environment = match &scene.env {
@@ -317,16 +321,15 @@ fn report_command(args: ReportArgs) -> Result<()> {
     };
     let bvh = Bvh::build(&scene);
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
-    let threads =
-        args.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let threads = args.sampling.threads();
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let base = Settings {
         method: Method::Product,
         spp: 1,
-        shading_points: args.shading_points as usize,
-        brdf_samples: args.brdf_samples as usize,
-        seed: args.seed,
+        shading_points: args.sampling.shading_points as usize,
+        brdf_samples: args.sampling.brdf_samples as usize,
+        seed: args.sampling.seed,
         progress: false,
     };
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
@@ -344,7 +347,7 @@ fn report_command(args: ReportArgs) -> Result<()> {
                 method: args.reference_method,
                 spp,
                 shading_points: report::shading_points_for(spp, 16),
-                seed: args.seed ^ 0x0005_eed0_f4ef,
+                seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
                 progress: true,
                 ..base
             };

@@ -194,33 +194,9 @@ pub fn chi_square(
             expected[(j / sub) * res + i / sub] += pdf(d) as f64 * jac / (m * m) as f64 * samples as f64;
         }
     }
-    let total_expected: f64 = expected.iter().sum();
-    // Pool small bins; a separate bin holds the missing mass (failed draws).
-    let mut cells: Vec<(f64, f64)> = Vec::new();
-    let (mut pool_o, mut pool_e) = (0.0, 0.0);
-    let mut impossible = 0;
-    for (o, e) in observed.iter().zip(&expected) {
-        if *e == 0.0 && *o > 0.0 {
-            impossible += *o as usize;
-        }
-        if *e < 5.0 {
-            pool_o += o;
-            pool_e += e;
-        } else {
-            cells.push((*o, *e));
-        }
-    }
-    let missing_e = (samples as f64 - total_expected).max(0.0);
-    pool_o += failed as f64;
-    pool_e += missing_e;
-    if pool_e >= 5.0 {
-        cells.push((pool_o, pool_e));
-    } else if let Some(last) = cells.last_mut() {
-        last.0 += pool_o;
-        last.1 += pool_e;
-    }
-    let stat: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
-    let dof = cells.len().saturating_sub(1).max(1);
+    let impossible =
+        observed.iter().zip(&expected).filter(|(o, e)| **e == 0.0 && **o > 0.0).map(|(o, _)| *o as usize).sum();
+    let (stat, dof) = pooled_statistic(observed.into_iter().zip(expected), failed as f64, samples as f64);
     ChiSquare {
         stat,
         dof,
@@ -350,26 +326,7 @@ pub fn chi_square_dyadic(
             _ => impossible += 1,
         }
     }
-    let mut cells: Vec<(f64, f64)> = Vec::new();
-    let (mut pool_o, mut pool_e) = (failed as f64, 0.0);
-    let total_e: f64 = bins.values().map(|b| b.1).sum();
-    pool_e += (n - total_e).max(0.0);
-    for (o, e) in bins.values() {
-        if *e < 5.0 {
-            pool_o += o;
-            pool_e += e;
-        } else {
-            cells.push((*o, *e));
-        }
-    }
-    if pool_e >= 5.0 {
-        cells.push((pool_o, pool_e));
-    } else if let Some(last) = cells.last_mut() {
-        last.0 += pool_o;
-        last.1 += pool_e;
-    }
-    let stat: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
-    let dof = cells.len().saturating_sub(1).max(1);
+    let (stat, dof) = pooled_statistic(bins.values().copied(), failed as f64, n);
     ChiSquare {
         stat,
         dof,
@@ -378,6 +335,32 @@ pub fn chi_square_dyadic(
         pdf_mismatch: 0.0,
         failed: failed as f64 / n,
     }
+}
+
+/// Pearson's statistic and degrees of freedom of (observed, expected) cells: cells expecting
+/// fewer than 5 samples are pooled, together with the mass the pdf misses (`failed` draws of
+/// `samples`, against the expected count not covered by the cells).
+fn pooled_statistic(cells: impl Iterator<Item = (f64, f64)>, failed: f64, samples: f64) -> (f64, usize) {
+    let mut kept: Vec<(f64, f64)> = Vec::new();
+    let (mut pool_o, mut pool_e, mut total_e) = (failed, 0.0, 0.0);
+    for (o, e) in cells {
+        total_e += e;
+        if e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            kept.push((o, e));
+        }
+    }
+    pool_e += (samples - total_e).max(0.0);
+    if pool_e >= 5.0 {
+        kept.push((pool_o, pool_e));
+    } else if let Some(last) = kept.last_mut() {
+        last.0 += pool_o;
+        last.1 += pool_e;
+    }
+    let stat = kept.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    (stat, kept.len().saturating_sub(1).max(1))
 }
 
 /// Šidák-corrected significance level for one of `tests` tests at overall level 1%.
