@@ -102,8 +102,19 @@ pub fn errors(image: &[[f32; 3]], reference: &[[f32; 3]]) -> (f64, f64) {
     ((se / n).sqrt(), rel / n)
 }
 
-/// Shading points per pixel for a given spp: the requested P if it divides spp, otherwise
-/// their greatest common divisor.
+/// Shading points per pixel for a given spp: with `per_point` visibility samples per shading
+/// point, P = spp / per_point (so primary rays, and with them the pixel-footprint integration,
+/// grow with spp — with a fixed P the antialiasing error of edges and of a visible sun floors
+/// every method at the same error); otherwise the requested P if it divides spp, else their
+/// greatest common divisor.
+pub fn shading_points_per_pixel(spp: usize, requested: usize, per_point: Option<usize>) -> usize {
+    match per_point {
+        Some(v) => (spp / v.max(1)).max(1),
+        None => shading_points_for(spp, requested),
+    }
+}
+
+/// The requested P if it divides spp, otherwise their greatest common divisor.
 pub fn shading_points_for(spp: usize, requested: usize) -> usize {
     fn gcd(a: usize, b: usize) -> usize {
         if b == 0 { a } else { gcd(b, a % b) }
@@ -121,6 +132,7 @@ pub fn sweep(
     methods: &[Method],
     spps: &[usize],
     base: &Settings,
+    per_point: Option<usize>,
     reference: &[[f32; 3]],
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
@@ -128,8 +140,12 @@ pub fn sweep(
     let mut out = Vec::new();
     for &method in methods {
         for &spp in spps {
-            let settings =
-                Settings { method, spp, shading_points: shading_points_for(spp, base.shading_points), ..*base };
+            let settings = Settings {
+                method,
+                spp,
+                shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
+                ..*base
+            };
             let image = render::render(scene, bvh, env, &settings);
             let (rmse, relmse) = errors(&image.pixels, reference);
             let regions = regions.errors(&image.pixels, reference);

@@ -50,6 +50,10 @@ struct ReportArgs {
     /// Visibility samples per pixel of the rendered reference.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     reference_spp: u32,
+    /// Visibility samples per shading point: primary rays per pixel then grow as spp / V
+    /// (instead of the fixed --shading-points), so the pixel-footprint integration converges too.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    samples_per_point: Option<u32>,
     /// Method of the rendered reference (an independent code path from the product by default).
     #[arg(long, default_value = "mis", value_parser = parse_method)]
     reference_method: Method,
@@ -346,7 +350,7 @@ fn report_command(args: ReportArgs) -> Result<()> {
             let settings = Settings {
                 method: args.reference_method,
                 spp,
-                shading_points: report::shading_points_for(spp, 16),
+                shading_points: report::shading_points_per_pixel(spp, 16, args.samples_per_point.map(|v| v as usize)),
                 seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
                 progress: true,
                 ..base
@@ -365,7 +369,8 @@ fn report_command(args: ReportArgs) -> Result<()> {
     };
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
     let measurements = pool.install(|| {
-        report::sweep(&scene, &bvh, hierarchy.as_ref(), &args.methods, &spps, &base, &reference, |m| {
+        let per_point = args.samples_per_point.map(|v| v as usize);
+        report::sweep(&scene, &bvh, hierarchy.as_ref(), &args.methods, &spps, &base, per_point, &reference, |m| {
             eprintln!(
                 "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
                 m.method.name(),
