@@ -114,6 +114,8 @@ fn report_writes_csv_plots_and_table() {
         .current_dir(&dir)
         .args([
             "report",
+            "--samples-per-point",
+            "2",
             "--width",
             "24",
             "--height",
