@@ -426,7 +426,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
         ),
     }
     println!(
-        "a render builds: {} BVH primitives{}; per shading point a product sampler for methods product, wavelet, product-mis (auto: non-diffuse, non-needle materials)",
+        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis and auto (per pixel and material)",
         Bvh::build(&scene).primitive_count(),
         if scene.env.is_some() { ", the env hierarchy" } else { "" }
     );
