@@ -136,23 +136,19 @@ fn load_with_image(
     format: image::ImageFormat,
 ) -> Result<RgbImage, LoadError> {
     let decode = |message: String| LoadError::Decode { path: path.to_owned(), format: name, message };
-    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-    // Refuse allocations a header could request beyond what a real map needs.
+    // The decoders refuse sizes beyond the largest map we accept; `check_size` then bounds the
+    // header by what the file can hold, before any pixel storage is allocated.
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_WIDTH as u32);
     limits.max_image_height = Some(MAX_HEIGHT as u32);
-    limits.max_alloc = Some(8 * 1024 * 1024 * 1024);
-    reader.limits(limits);
-    let (w, h) = reader.into_dimensions().map_err(|e| decode(e.to_string()))?;
+    let reader = |limits: image::Limits| {
+        let mut r = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+        r.limits(limits);
+        r
+    };
+    let (w, h) = reader(limits.clone()).into_dimensions().map_err(|e| decode(e.to_string()))?;
     check_size(path, w as usize, h as usize, bytes.len())?;
-    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-    reader.limits({
-        let mut l = image::Limits::default();
-        l.max_image_width = Some(MAX_WIDTH as u32);
-        l.max_image_height = Some(MAX_HEIGHT as u32);
-        l
-    });
-    let decoded = reader.decode().map_err(|e| decode(e.to_string()))?;
+    let decoded = reader(limits).decode().map_err(|e| decode(e.to_string()))?;
     let srgb = !matches!(format, image::ImageFormat::Hdr)
         && !matches!(decoded, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
     let rgb = decoded.into_rgb32f();

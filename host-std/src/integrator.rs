@@ -66,11 +66,6 @@ impl Method {
         }
     }
 
-    /// True when the method builds product samplers.
-    pub fn uses_product(self) -> bool {
-        matches!(self, Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto)
-    }
-
     /// `auto`: product-MIS (its sampler shared by the pixel's shading points) for every
     /// material. Measured with `ppis report --samples-per-point 16` on the default and the three
     /// shared scenes (docs/perf.md): at equal time it is the best method on the whole image in

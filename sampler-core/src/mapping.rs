@@ -106,7 +106,7 @@ pub fn square_to_sphere(p: Vec2) -> Vec3 {
     // φ = π/4 + w: cos φ = (cos w − sin w)/√2, sin φ = (cos w + sin w)/√2.
     let cos_phi = (cw - sw) * FRAC_1_SQRT_2;
     let sin_phi = (cw + sw) * FRAC_1_SQRT_2;
-    let rs = r * (2.0 - r * r).max(0.0).sqrt_core();
+    let rs = r * libm::sqrtf((2.0 - r * r).max(0.0));
     Vec3::new((cos_phi * rs).copysign(s), (sin_phi * rs).copysign(t), (1.0 - r * r).copysign(sd))
 }
 
@@ -120,9 +120,9 @@ pub fn sphere_to_square(d: Vec3) -> Vec2 {
     let (x, y, z) = (d.x / m, d.y / m, d.z / m);
     let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
     let xy2 = x * x + y * y;
-    let len = (xy2 + z * z).sqrt_core();
+    let len = libm::sqrtf(xy2 + z * z);
     // r² = 1 − |z|/len, written without cancellation near the poles.
-    let r = (xy2 / (len * (len + az)).max(TINY)).min(1.0).sqrt_core();
+    let r = libm::sqrtf((xy2 / (len * (len + az)).max(TINY)).min(1.0));
     let a = ax.min(ay) / ax.max(ay).max(TINY);
     let phi = atan_unit(a) * FRAC_2_PI; // in [0, ½]
     let phi = if ay > ax { 1.0 - phi } else { phi };
@@ -265,18 +265,6 @@ pub fn texel_of(p: Vec2, n: u32) -> (u32, u32) {
     let i = ((p.x * nf) as u32).min(n - 1); // `as` saturates: negative and NaN give 0
     let j = ((p.y * nf) as u32).min(n - 1);
     (i, j)
-}
-
-/// Square root through libm so the crate stays `no_std` (compiles to `sqrtss`).
-trait SqrtCore {
-    fn sqrt_core(self) -> Self;
-}
-
-impl SqrtCore for f32 {
-    #[inline(always)]
-    fn sqrt_core(self) -> f32 {
-        libm::sqrtf(self)
-    }
 }
 
 /// Solid-angle measure of a region of the square: `4π × area`.

@@ -37,10 +37,9 @@ pub struct Node {
     /// Index of the first of four consecutive children; 0 marks a leaf (the root is never a
     /// child).
     pub child: u32,
-    /// Mean of the product B̃ · (L / mean L) over the node.
+    /// Mean of the product B̃ · (L / mean L) over the node. (B̃ itself is not kept: the
+    /// density is the product of branch probabilities, see `ProductSampler::pdf_square`.)
     pub product: f32,
-    /// Mean of B̃ over the node (the piecewise-constant value at a leaf).
-    pub btilde: f32,
 }
 
 impl Node {
@@ -137,7 +136,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
             let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
             let b = sum / (hi - lo) as f32;
             let product = b * env;
-            set(&mut self.nodes[index], 0, b, product);
+            set(&mut self.nodes[index], 0, product);
             return (b, product);
         }
         let first = self.nodes.len();
@@ -191,7 +190,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
                 };
                 b[c] = fill;
                 p[c] = fill * l[c];
-                set(&mut self.nodes[first + c], 0, fill, p[c]);
+                set(&mut self.nodes[first + c], 0, p[c]);
             }
         }
         let mean_b = 0.25 * ((b[0] + b[1]) + (b[2] + b[3]));
@@ -199,7 +198,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
             ProductKind::Quadtree => 0.25 * ((p[0] + p[1]) + (p[2] + p[3])),
             ProductKind::Wavelet => haar_product_mean(b, l, p),
         };
-        set(&mut self.nodes[index], first as u32, mean_b, product);
+        set(&mut self.nodes[index], first as u32, product);
         (mean_b, product)
     }
 }
@@ -224,9 +223,8 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
 }
 
 #[inline(always)]
-fn set(n: &mut Node, child: u32, btilde: f32, product: f32) {
+fn set(n: &mut Node, child: u32, product: f32) {
     n.child = child;
-    n.btilde = btilde;
     n.product = product;
 }
 
