@@ -152,7 +152,10 @@ pub fn shade<B: Brdf + ?Sized>(
     while done < n {
         let m = (n - done).min(64);
         sobol02(hash_combine(seed, 1), done as u32, &mut points[..m]);
-        sobol02(hash_combine(seed, 2), done as u32, &mut others[..m]);
+        // The second technique's points, for the MIS methods only.
+        if matches!(method, Method::Mis | Method::ProductMis) {
+            sobol02(hash_combine(seed, 2), done as u32, &mut others[..m]);
+        }
         for k in 0..m {
             let u = points[k];
             sum += match (method, technique) {

@@ -79,11 +79,13 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         .par_iter()
         .map(|&(tx, ty)| {
             let mut arena: Option<Box<ProductArena>> = None;
+            // The pixel's primary hits, one buffer reused by every pixel of the tile.
+            let mut hits: Vec<Hit<'_>> = Vec::with_capacity(settings.shading_points.clamp(1, 64));
             let mut out = Vec::with_capacity(TILE * TILE);
             let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(scene, bvh, env, sat, &camera, settings, x, y, &mut arena, &mut local));
+                    out.push(pixel(scene, bvh, env, sat, &camera, settings, x, y, &mut arena, &mut hits, &mut local));
                 }
             }
             for (c, l) in counters.iter().zip(local) {
@@ -125,8 +127,8 @@ struct Hit<'m> {
 /// material, every other sampler built per shading point). `stats` counts shading points, shadow rays, camera rays and non-finite
 /// values.
 #[allow(clippy::too_many_arguments)]
-fn pixel(
-    scene: &Scene,
+fn pixel<'s>(
+    scene: &'s Scene,
     bvh: &Bvh,
     env: Option<&EnvHierarchy<'_>>,
     sat: Option<&[f64]>,
@@ -135,6 +137,7 @@ fn pixel(
     x: usize,
     y: usize,
     arena: &mut Option<Box<ProductArena>>,
+    hits: &mut Vec<Hit<'s>>,
     stats: &mut [u64; 4],
 ) -> [f32; 3] {
     let seed = hash_combine(s.seed, (y * camera.width as usize + x) as u64);
@@ -143,7 +146,6 @@ fn pixel(
     let mut film = [DVec2::ZERO; 64];
     // Accumulated in f64: single samples of a 1e30 map can exceed the f32 range.
     let mut sum = DVec3::ZERO;
-    let mut hits: Vec<Hit<'_>> = Vec::with_capacity(p.min(64));
     let mut done = 0;
     while done < p {
         let m = (p - done).min(64);
