@@ -18,8 +18,12 @@ pub enum Primitive {
         e1: Vec3,
         e2: Vec3,
         material: u32,
+        /// Index into the corner shading normals, or `NO_NORMALS` (face normal).
+        normals: u32,
     },
 }
+
+const NO_NORMALS: u32 = u32::MAX;
 
 impl Primitive {
     fn bounds(&self) -> Aabb {
@@ -128,8 +132,11 @@ struct Node {
 pub struct Hit {
     pub t: f32,
     pub point: Vec3,
-    /// Geometric (and shading) normal, unit, on the front side of the surface.
+    /// Geometric normal, unit, on the front side of the surface.
     pub normal: Vec3,
+    /// Interpolated shading normal (the geometric normal where none is given), unit, on the
+    /// side of the front face's authored normals.
+    pub shading_normal: Vec3,
     pub material: u32,
 }
 
@@ -137,12 +144,15 @@ pub struct Hit {
 pub struct Bvh {
     prims: Vec<Primitive>,
     nodes: Vec<Node>,
+    /// Per-corner shading normals of triangles that have them.
+    shading_normals: Vec<[Vec3; 3]>,
 }
 
 impl Bvh {
     /// Builds the hierarchy over every shape of the scene (rectangles become two triangles).
     pub fn build(scene: &Scene) -> Self {
         let mut prims = Vec::new();
+        let mut shading_normals = Vec::new();
         for o in &scene.objects {
             let material = o.material as u32;
             match &o.shape {
@@ -150,20 +160,28 @@ impl Bvh {
                     prims.push(Primitive::Sphere { center: *center, radius: *radius, material })
                 }
                 Shape::Rectangle { p0, e1, e2 } => {
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material });
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material });
+                    let normals = NO_NORMALS;
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material, normals });
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material, normals });
                 }
-                Shape::Mesh { positions, triangles } => {
-                    for t in triangles {
+                Shape::Mesh { positions, triangles, normals: corner_normals } => {
+                    for (k, t) in triangles.iter().enumerate() {
                         let [a, b, c] = t.map(|i| positions[i as usize]);
                         if (b - a).cross(c - a).length_squared() > 0.0 {
-                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material });
+                            let normals = match corner_normals.get(k) {
+                                Some(n) if n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0) => {
+                                    shading_normals.push(*n);
+                                    (shading_normals.len() - 1) as u32
+                                }
+                                _ => NO_NORMALS,
+                            };
+                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material, normals });
                         }
                     }
                 }
             }
         }
-        let mut bvh = Bvh { prims, nodes: Vec::new() };
+        let mut bvh = Bvh { prims, nodes: Vec::new(), shading_normals };
         if !bvh.prims.is_empty() {
             let n = bvh.prims.len();
             let mut centroids: Vec<(Aabb, Vec3)> = bvh
@@ -271,11 +289,31 @@ impl Bvh {
         });
         let prim = best?;
         let point = o + t_max * d;
-        let (normal, material) = match self.prims[prim] {
-            Primitive::Sphere { center, radius, material } => ((point - center) / radius, material),
-            Primitive::Triangle { e1, e2, material, .. } => (e1.cross(e2), material),
+        let (normal, shading, material) = match self.prims[prim] {
+            Primitive::Sphere { center, radius, material } => {
+                let n = ((point - center) / radius).normalize();
+                (n, n, material)
+            }
+            Primitive::Triangle { v0, e1, e2, material, normals } => {
+                let n = e1.cross(e2).normalize();
+                let shading = match self.shading_normals.get(normals as usize) {
+                    Some(c) => {
+                        // Barycentrics of the hit point (its projection on the plane).
+                        let p = point - v0;
+                        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+                        let (d20, d21) = (p.dot(e1), p.dot(e2));
+                        let den = d00 * d11 - d01 * d01;
+                        let v = ((d11 * d20 - d01 * d21) / den).clamp(0.0, 1.0);
+                        let w = ((d00 * d21 - d01 * d20) / den).clamp(0.0, 1.0 - v);
+                        let s = (c[0] * (1.0 - v - w) + c[1] * v + c[2] * w).normalize_or_zero();
+                        if s == Vec3::ZERO { n } else { s }
+                    }
+                    None => n,
+                };
+                (n, shading, material)
+            }
         };
-        Some(Hit { t: t_max, point, normal: normal.normalize(), material })
+        Some(Hit { t: t_max, point, normal, shading_normal: shading, material })
     }
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).

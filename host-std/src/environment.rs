@@ -16,19 +16,26 @@ pub enum EnvSource {
     Sky { level: u32 },
     /// An image file: lat-long (2:1) or an equal-area square.
     File(PathBuf),
+    /// An image already in memory (e.g. read from inside a usdz package), named for messages.
+    Bytes { name: PathBuf, bytes: std::sync::Arc<Vec<u8>> },
+    /// The same radiance from every direction (a DomeLight without a texture).
+    Constant { level: u32 },
 }
 
-/// How an environment is placed: radiance scale and rotation about +Y (degrees), as in the
-/// scene format: d_world = R_y(angle)·d_local.
+/// How an environment is placed: radiance scale and tint, and rotation: d_world =
+/// R_y(rotate_y_deg) · rotation · d_local (the scene format's rotation about +Y is the first
+/// factor; a USD DomeLight's frame is `rotation`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
     pub scale: f32,
+    pub tint: [f32; 3],
     pub rotate_y_deg: f32,
+    pub rotation: Mat3,
 }
 
 impl Default for Placement {
     fn default() -> Self {
-        Self { scale: 1.0, rotate_y_deg: 0.0 }
+        Self { scale: 1.0, tint: [1.0; 3], rotate_y_deg: 0.0, rotation: Mat3::IDENTITY }
     }
 }
 
@@ -84,8 +91,21 @@ impl Environment {
                 };
                 (rgb, *level, stats)
             }
-            EnvSource::File(path) => {
-                let image = env_io::load(path)?;
+            EnvSource::Constant { level } => {
+                let rgb = vec![[1.0f32; 3]; 1usize << (2 * level)];
+                let stats = EnvStats {
+                    source: "constant dome".into(),
+                    source_size: (1 << level, 1 << level),
+                    ..EnvStats::default()
+                };
+                (rgb, *level, stats)
+            }
+            EnvSource::File(_) | EnvSource::Bytes { .. } => {
+                let (path, image) = match source {
+                    EnvSource::File(path) => (path, env_io::load(path)?),
+                    EnvSource::Bytes { name, bytes } => (name, env_io::load_bytes(name, bytes)?),
+                    _ => unreachable!("matched above"),
+                };
                 let load_seconds = t0.elapsed().as_secs_f64();
                 let (rgb, level, source_mean) = Self::to_equal_area(path, &image)?;
                 let stats = EnvStats {
@@ -99,24 +119,24 @@ impl Environment {
                 (rgb, level, stats)
             }
         };
-        if placement.scale != 1.0 {
-            let s = placement.scale.max(0.0);
-            rgb.iter_mut().for_each(|t| *t = t.map(|c| c * s));
+        let gain = placement.tint.map(|t| if t.is_finite() { (t * placement.scale).max(0.0) } else { 0.0 });
+        if gain != [1.0; 3] {
+            rgb.iter_mut().for_each(|t| *t = [t[0] * gain[0], t[1] * gain[1], t[2] * gain[2]]);
         }
         sampler_core::env::sanitize_rgb(&mut rgb);
         let mut pyramid = vec![0.0f32; pyramid_len(level)];
         build_pyramid(level, &rgb, &mut pyramid)?;
         stats.level = level;
         stats.map_mean = resample::equal_area_mean(&rgb);
-        if matches!(source, EnvSource::Sky { .. }) {
+        if matches!(source, EnvSource::Sky { .. } | EnvSource::Constant { .. }) {
             stats.source_mean = stats.map_mean;
         } else {
-            stats.source_mean = stats.source_mean.map(|m| m * placement.scale as f64);
+            stats.source_mean = std::array::from_fn(|c| stats.source_mean[c] * gain[c] as f64);
         }
         // Everything after reading the file: resampling, scaling, the pyramid.
         stats.build_seconds = t0.elapsed().as_secs_f64() - stats.load_seconds;
         stats.bytes = rgb.len() * 12 + pyramid.len() * 4;
-        let map_to_world = Mat3::from_rotation_y(placement.rotate_y_deg.to_radians());
+        let map_to_world = Mat3::from_rotation_y(placement.rotate_y_deg.to_radians()) * placement.rotation;
         Ok(Self { level, rgb, pyramid, map_to_world, stats })
     }
 

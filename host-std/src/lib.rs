@@ -15,3 +15,5 @@ pub mod resample;
 pub mod scene;
 pub mod scene_json;
 pub mod sky;
+#[cfg(feature = "usd")]
+pub mod usd_scene;

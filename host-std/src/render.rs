@@ -162,20 +162,25 @@ fn pixel<'s>(
             };
             let material = &scene.materials[hit.material as usize];
             let wo = -dir;
-            let mut n = hit.normal;
+            let (mut n, mut ns) = (hit.normal, hit.shading_normal);
             if n.dot(wo) < 0.0 {
                 // Seen from the back, a one-sided surface reflects nothing.
                 if !material.twosided {
                     continue;
                 }
-                n = -n;
+                (n, ns) = (-n, -ns);
+            }
+            // The shading frame follows the interpolated normal, kept on the viewer's side
+            // of the surface.
+            if ns.dot(n) <= 0.0 {
+                ns = n;
             }
             if env.is_none() {
                 continue;
             }
             let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
             hits.push(Hit {
-                sp: ShadingPoint { frame: Frame::from_normal(n), wo, brdf: material.bsdf.as_brdf() },
+                sp: ShadingPoint { frame: Frame::from_normal(ns), wo, brdf: material.bsdf.as_brdf() },
                 origin: hit.point + n * eps,
                 material: hit.material as usize,
                 method: s.method.for_material(&material.bsdf),

@@ -30,10 +30,12 @@ pub enum Shape {
         e1: Vec3,
         e2: Vec3,
     },
-    /// Triangles (counter-clockwise front faces) with face normals.
+    /// Triangles (counter-clockwise front faces); optional per-corner shading normals
+    /// (empty: face normals).
     Mesh {
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
+        normals: Vec<[Vec3; 3]>,
     },
 }
 

@@ -209,15 +209,18 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     let m = Mat4::from_cols_array_2d(&m).transpose();
                     positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
                 }
-                (Shape::Mesh { positions, triangles }, material)
+                (Shape::Mesh { positions, triangles, normals: Vec::new() }, material)
             }
         };
         materials.push(material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?);
         objects.push(Object { shape, material: materials.len() - 1 });
     }
-    let env = json
-        .envmap
-        .map(|e| (EnvSource::File(dir.join(e.file)), Placement { scale: e.scale, rotate_y_deg: e.rotate_y_deg }));
+    let env = json.envmap.map(|e| {
+        (
+            EnvSource::File(dir.join(e.file)),
+            Placement { scale: e.scale, rotate_y_deg: e.rotate_y_deg, ..Placement::default() },
+        )
+    });
     let name =
         json.name.unwrap_or_else(|| path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()));
     Ok(Scene { name, camera, objects, materials, env, hide_emitters: json.hide_emitters })

@@ -1,2 +1,22 @@
-//! `host-usd`: USD scene import (usda, usdc, usdz) for ppis. Tracked by the host-usd issue;
-//! empty until then.
+//! `host-usd`: USD scene import (usda, usdc, usdz) for ppis through the pure-Rust `openusd`
+//! crate (pinned to 0.6.0). `stage.rs` is the only file that touches openusd; the rest
+//! works on its plain values and yields a [`UsdScene`] of plain data.
+
+pub mod camera;
+pub mod conformance;
+pub mod dome;
+pub mod error;
+pub mod import;
+pub mod instancer;
+pub mod material;
+pub mod mesh;
+pub mod primvar;
+pub mod scene;
+pub mod shapes;
+pub mod stage;
+pub mod xform;
+pub mod xform_ops;
+
+pub use error::UsdError;
+pub use import::{Options, load, load_with};
+pub use scene::*;

@@ -190,7 +190,11 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
                     near_clip: 1e-3,
                 },
                 objects: vec![Object {
-                    shape: Shape::Mesh { positions: positions.clone(), triangles: triangles.clone() },
+                    shape: Shape::Mesh {
+                        positions: positions.clone(),
+                        triangles: triangles.clone(),
+                        normals: Vec::new(),
+                    },
                     material: 0,
                 }],
                 materials: vec![Material { bsdf: bsdf.clone(), twosided: false }],

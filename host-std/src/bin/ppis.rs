@@ -66,8 +66,12 @@ struct ReportArgs {
 
 #[derive(Args)]
 struct SceneArgs {
-    /// Scene file (.json, see docs/scene-format.md). Without it: the embedded default scene.
+    /// Scene file: .json (docs/scene-format.md) or USD (.usda, .usdc, .usdz, .usd). Without
+    /// it: the embedded default scene.
     scene: Option<PathBuf>,
+    /// USD: the camera prim to render through (default: the stage's first camera).
+    #[arg(long)]
+    camera: Option<String>,
     /// Environment map replacing the scene's (lat-long .exr/.hdr/.png/.jpg, or a square
     /// equal-area map).
     #[arg(long)]
@@ -144,6 +148,10 @@ impl SamplingArgs {
 struct InfoArgs {
     #[command(flatten)]
     scene: SceneArgs,
+    /// USD conformance: check every USD file under DIR that has a `<name>.expected.json`
+    /// (Pixar's answers: world matrices, bound materials, metadata) and import it.
+    #[arg(long, value_name = "DIR")]
+    expected: Option<PathBuf>,
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -163,21 +171,47 @@ fn main() {
     }
 }
 
+/// A loaded scene with what the importer left out or reduced (USD), for the user.
+struct Loaded {
+    scene: Scene,
+    notes: Vec<String>,
+    #[cfg(feature = "usd")]
+    usd: Option<host_usd::UsdScene>,
+}
+
 /// Loads the scene the arguments name (or the default scene) and applies `--env`.
-fn load_scene(args: &SceneArgs) -> Result<Scene> {
+fn load_scene(args: &SceneArgs) -> Result<Loaded> {
+    #[cfg(feature = "usd")]
+    let mut usd = None;
+    let mut notes = Vec::new();
     let mut scene = match &args.scene {
         None => default_scene::scene(),
         Some(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
             match ext.as_str() {
                 "json" => scene_json::load(path)?,
+                #[cfg(feature = "usd")]
                 "usd" | "usda" | "usdc" | "usdz" => {
-                    bail!("{}: USD scenes are not supported yet (host-usd issue)", path.display())
+                    let c = host_std::usd_scene::load(path, args.camera.clone())?;
+                    notes = c.notes;
+                    usd = Some(c.usd);
+                    c.scene
                 }
-                _ => bail!("{}: unknown scene format (expected .json)", path.display()),
+                #[cfg(not(feature = "usd"))]
+                "usd" | "usda" | "usdc" | "usdz" => {
+                    bail!("{}: this ppis was built without USD support (cargo feature `usd`)", path.display())
+                }
+                _ => bail!("{}: unknown scene format (expected .json, .usda, .usdc, .usdz or .usd)", path.display()),
             }
         }
     };
+    let is_usd =
+        args.scene.as_ref().and_then(|p| p.extension()).is_some_and(|e| {
+            matches!(e.to_string_lossy().to_ascii_lowercase().as_str(), "usd" | "usda" | "usdc" | "usdz")
+        });
+    if args.camera.is_some() && !is_usd {
+        bail!("--camera applies to USD scenes only");
+    }
     if let Some(env) = &args.env {
         if !env.exists() {
             bail!("{}: environment map not found", env.display());
@@ -198,7 +232,45 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
             placement.rotate_y_deg = r;
         }
     }
-    Ok(scene)
+    Ok(Loaded {
+        scene,
+        notes,
+        #[cfg(feature = "usd")]
+        usd,
+    })
+}
+
+/// One warning summary of what an import left out (all of it is in `ppis info`).
+fn warn_notes(scene: &Scene, notes: &[String]) {
+    const SHOWN: usize = 12;
+    if notes.is_empty() {
+        return;
+    }
+    // Group alike notes: the same message about different prims or files.
+    let mut groups: Vec<(String, usize, &str)> = Vec::new();
+    for n in notes {
+        let (path, what) = n.split_once(": ").unwrap_or(("", n));
+        let key: String = what
+            .split(' ')
+            .map(|w| if w.contains('/') || w.contains('.') && w.len() > 4 { "…" } else { w })
+            .collect::<Vec<_>>()
+            .join(" ");
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(g) => g.1 += 1,
+            None => groups.push((key, 1, path)),
+        }
+    }
+    eprintln!(
+        "ppis: warning: {}: {} things were not rendered as authored (`ppis info` lists them all):",
+        scene.name,
+        notes.len()
+    );
+    for (key, count, first) in groups.iter().take(SHOWN) {
+        eprintln!("  {count}× {key} (e.g. {first})");
+    }
+    if groups.len() > SHOWN {
+        eprintln!("  … and {} more kinds", groups.len() - SHOWN);
+    }
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
@@ -210,7 +282,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
     check_writable(&exr_path)?;
 
     let t_load = Instant::now();
-    let mut scene = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.scene)?;
+    warn_notes(&loaded.scene, &loaded.notes);
+    let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
     let load_seconds_scene = t_load.elapsed().as_secs_f64();
 
@@ -315,7 +389,9 @@ fn check_writable(path: &Path) -> Result<()> {
 
 fn report_command(args: ReportArgs) -> Result<()> {
     use host_std::report;
-    let mut scene = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.scene)?;
+    warn_notes(&loaded.scene, &loaded.notes);
+    let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
@@ -398,7 +474,21 @@ fn report_command(args: ReportArgs) -> Result<()> {
 }
 
 fn info_command(args: InfoArgs) -> Result<()> {
-    let scene = load_scene(&args.scene)?;
+    if let Some(dir) = &args.expected {
+        return conformance_command(dir);
+    }
+    let loaded = load_scene(&args.scene)?;
+    #[cfg(feature = "usd")]
+    if let Some(usd) = &loaded.usd {
+        print_usd_import(usd);
+    }
+    if !loaded.notes.is_empty() {
+        println!("not rendered as authored ({}):", loaded.notes.len());
+        for n in &loaded.notes {
+            println!("  {n}");
+        }
+    }
+    let scene = loaded.scene;
     let c = &scene.camera;
     println!("scene {}", scene.name);
     println!(
@@ -418,6 +508,12 @@ fn info_command(args: InfoArgs) -> Result<()> {
         Some((EnvSource::Sky { level }, _)) => {
             println!("environment: built-in sky, equal-area {}² (pyramid {} MB)", 1u32 << level, pyramid_mb(*level))
         }
+        Some((EnvSource::Bytes { name, .. }, p)) => println!(
+            "environment: {} (tint {:?}), resampled to a power-of-two equal-area square",
+            name.display(),
+            p.tint
+        ),
+        Some((EnvSource::Constant { .. }, p)) => println!("environment: constant radiance {:?}", p.tint),
         Some((EnvSource::File(path), p)) => println!(
             "environment: {} (scale {}, rotate_y {}°), resampled to a power-of-two equal-area square",
             path.display(),
@@ -435,4 +531,119 @@ fn info_command(args: InfoArgs) -> Result<()> {
 
 fn pyramid_mb(level: u32) -> f64 {
     (sampler_core::env::pyramid_len(level) * 4 + (1usize << (2 * level)) * 12) as f64 / 1e6
+}
+
+#[cfg(feature = "usd")]
+fn print_usd_import(u: &host_usd::UsdScene) {
+    let c = &u.counts;
+    println!(
+        "USD {}: upAxis {:?}, metersPerUnit {}, time code {}, imported in {:.3} s",
+        u.file.display(),
+        u.up_axis,
+        u.meters_per_unit,
+        u.time_code,
+        u.import_seconds
+    );
+    println!(
+        "  {} prims; {} gprims ({} meshes, {} exact spheres), {} triangles, {} instances, {} hidden",
+        c.prims,
+        c.gprims,
+        c.meshes,
+        u.spheres.len(),
+        c.triangles,
+        c.instances,
+        c.hidden
+    );
+    println!("  materials: {}", u.materials.len());
+    for m in &u.materials {
+        let l = m.lobes();
+        println!(
+            "    {}: diffuse {:?}, specular F0 {:?}, α {:.4}, clearcoat {} (α {:.4}){}",
+            m.name,
+            l.diffuse.to_array(),
+            l.specular.to_array(),
+            l.alpha,
+            l.clearcoat,
+            l.clearcoat_alpha,
+            if m.textures.is_empty() { String::new() } else { format!(", {} textures", m.textures.len()) }
+        );
+    }
+    match &u.dome {
+        Some(d) => println!(
+            "  lights: DomeLight {} ({}, radiance scale {:?})",
+            d.path,
+            d.texture.as_ref().map_or("constant".to_string(), |t| format!("texture {}", t.0)),
+            d.radiance.to_array()
+        ),
+        None => println!("  lights: no DomeLight (a render builds no env hierarchy)"),
+    }
+    match &u.camera {
+        Some(c) => println!(
+            "  camera: {} (focal length {}, aperture {} × {})",
+            c.path, c.focal_length, c.horizontal_aperture, c.vertical_aperture
+        ),
+        None => println!("  camera: none"),
+    }
+}
+
+/// `ppis info --expected DIR`: host-usd against Pixar's answers for every file that has them.
+#[cfg(feature = "usd")]
+fn conformance_command(dir: &Path) -> Result<()> {
+    if !dir.is_dir() {
+        bail!("{}: not a folder", dir.display());
+    }
+    let pairs = host_usd::conformance::pairs(dir);
+    if pairs.is_empty() {
+        bail!("{}: no USD file with a <name>.expected.json beside it", dir.display());
+    }
+    let (mut ok, mut max_err) = (0, 0.0f64);
+    let (mut prims, mut mats, mut binds) = (0, 0, 0);
+    for (usd, expected) in &pairs {
+        let name = usd.strip_prefix(dir).unwrap_or(usd).display().to_string();
+        let check = host_usd::conformance::check(usd, expected);
+        let import = host_usd::load(usd);
+        match (check, import) {
+            (Ok(r), Ok(s)) if r.mismatches.is_empty() => {
+                ok += 1;
+                max_err = max_err.max(r.max_matrix_error);
+                (prims, mats, binds) = (prims + r.prims, mats + r.matrices, binds + r.materials);
+                println!(
+                    "ok    {name}: {} prims, {} world matrices (max error {:.1e}), {} bindings, {} meshes; import {} triangles, {} skips, {:.3} s",
+                    r.prims,
+                    r.matrices,
+                    r.max_matrix_error,
+                    r.materials,
+                    r.meshes,
+                    s.counts.triangles,
+                    s.skipped.len(),
+                    s.import_seconds
+                );
+            }
+            (check, import) => {
+                println!("FAIL  {name}");
+                match check {
+                    Ok(r) => r.mismatches.iter().for_each(|m| println!("      {m}")),
+                    Err(e) => println!("      check: {e}"),
+                }
+                if let Err(e) = import {
+                    println!("      import: {e}");
+                }
+            }
+        }
+    }
+    println!(
+        "{ok} of {} files match Pixar's answers ({prims} prims, {mats} world matrices within {:.0e} (max {:.1e}), {binds} material bindings) and import without error",
+        pairs.len(),
+        host_usd::conformance::MATRIX_TOLERANCE,
+        max_err
+    );
+    if ok != pairs.len() {
+        bail!("{} of {} files differ from Pixar's answers", pairs.len() - ok, pairs.len());
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "usd"))]
+fn conformance_command(_dir: &Path) -> Result<()> {
+    bail!("--expected: this ppis was built without USD support (cargo feature `usd`)")
 }

@@ -1,6 +1,7 @@
 //! A layered car paint: a Lambertian base and a GGX metallic-flake lobe under a very sharp GGX
 //! clear coat with Schlick Fresnel (F0 = 0.04, i.e. η = 1.5). Light that the coat reflects does
-//! not reach the base: the base is weighted by (1 − F(cosθo))(1 − F(cosθi)).
+//! not reach the base: for coat weight c the base is weighted by (1 − c·F(cosθo))(1 − c·F(cosθi))
+//! (c = 0 is a base and flake lobe with no coat at all, as a UsdPreviewSurface without clearcoat).
 //! This is the paper's hard case: a wide lobe and a needle-sharp one in one BRDF.
 
 use super::microfacet::{Ggx, fresnel_schlick, half_vector};
@@ -38,7 +39,7 @@ impl CarPaint {
     /// (at least 1/4 of the samples when present): it is needle-sharp, so under a bright light
     /// it dominates a tiny cone that the other lobes would never find.
     fn lobe_weights(&self, wo: Vec3) -> [f32; 3] {
-        let transmit = 1.0 - fresnel_schlick(self.coat_f0, wo.z);
+        let transmit = 1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z);
         let flake = transmit * luminance(self.flake);
         let base = transmit * luminance(self.base);
         let coat = if self.coat > 0.0 {
@@ -76,7 +77,8 @@ impl Brdf for CarPaint {
         let (c, f) = (&self.coat_ggx, &self.flake_ggx);
         let coat = self.coat * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi) * c.g1(wo) / (4.0 * wo.z);
         let flake = f.d(h) * f.g1(wi) * f.g1(wo) / (4.0 * wo.z);
-        let transmit = (1.0 - fresnel_schlick(self.coat_f0, wo.z)) * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
+        let transmit = (1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z))
+            * (1.0 - self.coat * fresnel_schlick(self.coat_f0, wi.z));
         Vec3::splat(coat) + transmit * (self.flake * flake + self.base * (FRAC_1_PI * wi.z))
     }
 
@@ -97,7 +99,7 @@ impl Brdf for CarPaint {
         let (c, f) = (&self.coat_ggx, &self.flake_ggx);
         let (wc, wf) = (c.stretch(wo), f.stretch(wo));
         let (gc, gf) = (c.g1(wo) / (4.0 * wo.z), f.g1(wo) / (4.0 * wo.z));
-        let transmit_o = 1.0 - fresnel_schlick(self.coat_f0, wo.z);
+        let transmit_o = 1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z);
         let (p0, p1) = (w[0] / total, (w[0] + w[1]) / total);
         let (flake, base) = (luminance(self.flake), luminance(self.base) * FRAC_1_PI);
         for (p, o) in u.iter().zip(out.iter_mut()) {
@@ -111,7 +113,7 @@ impl Brdf for CarPaint {
             let value = match half_vector(wo, wi) {
                 Some(h) if wi.z > 0.0 => {
                     let coat = self.coat * gc * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi);
-                    let transmit = transmit_o * (1.0 - fresnel_schlick(self.coat_f0, wi.z));
+                    let transmit = transmit_o * (1.0 - self.coat * fresnel_schlick(self.coat_f0, wi.z));
                     coat + transmit * (flake * gf * f.d(h) * f.g1(wi) + base * wi.z)
                 }
                 _ => 0.0,

@@ -1,0 +1,160 @@
+//! Conformance against Pixar's answers: a `*.expected.json` beside a USD file holds what
+//! Pixar's own library computes (stage metadata; per prim its type, world matrix, bound
+//! material, point and face counts). [`check`] recomputes each with host-usd and reports
+//! every difference; world matrices must agree to 1e-9.
+
+use crate::import;
+use crate::mesh;
+use crate::stage::Value;
+use crate::xform::WorldTransforms;
+use serde_json::Value as Json;
+use std::path::{Path, PathBuf};
+
+/// Largest allowed difference of a world-matrix entry (relative to max(1, |entry|)).
+pub const MATRIX_TOLERANCE: f64 = 1e-9;
+
+/// The outcome of one file's check.
+#[derive(Clone, Debug, Default)]
+pub struct Report {
+    pub prims: usize,
+    pub matrices: usize,
+    pub materials: usize,
+    pub meshes: usize,
+    pub max_matrix_error: f64,
+    pub mismatches: Vec<String>,
+}
+
+/// Checks `usd` against Pixar's answers in `expected`.
+pub fn check(usd: &Path, expected: &Path) -> Result<Report, String> {
+    let text = std::fs::read_to_string(expected).map_err(|e| format!("{}: {e}", expected.display()))?;
+    let want: Json = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", expected.display()))?;
+    let stage = import::open(usd).map_err(|e| e.to_string())?;
+    let mut r = Report::default();
+    let mut mismatch = |m: String| r.mismatches.push(m);
+
+    let meta = &want["stage"];
+    let up = stage.metadata("upAxis")?.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| "Y".into());
+    if meta["upAxis"].as_str() != Some(up.as_str()) {
+        mismatch(format!("upAxis: Pixar {} host-usd {up}", meta["upAxis"]));
+    }
+    let mpu = stage.metadata("metersPerUnit")?.and_then(|v| v.scalar()).unwrap_or(0.01);
+    if meta["metersPerUnit"].as_f64().is_none_or(|m| (m - mpu).abs() > 1e-12 * m.abs()) {
+        mismatch(format!("metersPerUnit: Pixar {} host-usd {mpu}", meta["metersPerUnit"]));
+    }
+    let default_prim = stage.default_prim().map(|d| if d.starts_with('/') { d } else { format!("/{d}") });
+    if meta["defaultPrim"].as_str().map(str::to_string) != default_prim {
+        mismatch(format!("defaultPrim: Pixar {} host-usd {default_prim:?}", meta["defaultPrim"]));
+    }
+
+    let ours = stage.all_prims()?;
+    let Some(prims) = want["prims"].as_object() else {
+        return Err(format!("{}: no \"prims\" object", expected.display()));
+    };
+    for p in prims.keys().filter(|p| !ours.contains(p)) {
+        mismatch(format!("{p}: in Pixar's traversal, not in ours"));
+    }
+    for p in ours.iter().filter(|p| !prims.contains_key(*p)) {
+        mismatch(format!("{p}: in our traversal, not in Pixar's"));
+    }
+    let mut worlds = WorldTransforms::default();
+    let mut max_err = 0.0f64;
+    let (mut n_mat, mut n_bind, mut n_mesh) = (0, 0, 0);
+    for (path, want) in prims.iter().filter(|(p, _)| ours.contains(p)) {
+        let t = stage.type_name(path)?;
+        if want["type"].as_str() != Some(t.as_str()) {
+            mismatch(format!("{path}: type Pixar {} host-usd {t:?}", want["type"]));
+        }
+        for (key, ours) in [("instance", stage.is_instance(path)?), ("instanceProxy", stage.is_instance_proxy(path)?)] {
+            if want[key].as_bool().is_some_and(|w| w != ours) {
+                mismatch(format!("{path}: {key} Pixar {} host-usd {ours}", want[key]));
+            }
+        }
+        if let Some(rows) = want["world"].as_array() {
+            n_mat += 1;
+            let m = worlds.world(&stage, path)?.to_cols_array();
+            // glam's columns are USD's rows.
+            let mut prim_err = 0.0f64;
+            for (i, row) in rows.iter().enumerate() {
+                for (j, w) in row.as_array().into_iter().flatten().enumerate() {
+                    let w = w.as_f64().unwrap_or(f64::NAN);
+                    let err = (m[4 * i + j] - w).abs() / w.abs().max(1.0);
+                    prim_err = prim_err.max(if err.is_nan() { f64::INFINITY } else { err });
+                }
+            }
+            if prim_err > MATRIX_TOLERANCE {
+                mismatch(format!("{path}: world matrix differs from Pixar's by {prim_err:.3e}"));
+            }
+            max_err = max_err.max(prim_err);
+        }
+        if let Some(wanted) = want.get("material") {
+            n_bind += 1;
+            let ours = stage.bound_material(path)?;
+            if wanted.as_str().map(str::to_string) != ours {
+                mismatch(format!("{path}: material Pixar {wanted} host-usd {ours:?}"));
+            }
+        }
+        if want.get("points").is_some() {
+            n_mesh += 1;
+            let points = match stage.value(path, "points")? {
+                Some(Value::Numbers { values, .. }) => values.len() / 3,
+                _ => 0,
+            };
+            if want["points"].as_u64() != Some(points as u64) {
+                mismatch(format!("{path}: points Pixar {} host-usd {points}", want["points"]));
+            }
+            let counts: Vec<i64> = match stage.value(path, "faceVertexCounts")? {
+                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
+                _ => Vec::new(),
+            };
+            // Pixar's answer lists the counts, or for large meshes their number and sum.
+            let fvc = &want["faceVertexCounts"];
+            let same = match fvc.as_array() {
+                Some(a) => a.iter().filter_map(Json::as_i64).eq(counts.iter().copied()),
+                None => {
+                    fvc["faces"].as_u64() == Some(counts.len() as u64)
+                        && fvc["sum"].as_i64() == Some(counts.iter().sum::<i64>())
+                }
+            };
+            if !same {
+                mismatch(format!("{path}: faceVertexCounts differ from Pixar's {fvc}"));
+            }
+            if let Err(e) = mesh::read(&stage, path) {
+                mismatch(format!("{path}: {e}"));
+            }
+        }
+    }
+    r.prims = prims.len();
+    r.matrices = n_mat;
+    r.materials = n_bind;
+    r.meshes = n_mesh;
+    r.max_matrix_error = max_err;
+    Ok(r)
+}
+
+/// Every USD file under `dir` (recursively) with a `<stem>.expected.json` beside it.
+pub fn pairs(dir: &Path) -> Vec<(PathBuf, PathBuf)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_owned()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        let mut entries: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        entries.sort();
+        for p in entries {
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+            if !matches!(ext.as_str(), "usd" | "usda" | "usdc" | "usdz") {
+                continue;
+            }
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            let expected = p.with_file_name(format!("{stem}.expected.json"));
+            if expected.is_file() {
+                out.push((p, expected));
+            }
+        }
+    }
+    out.sort();
+    out
+}

@@ -1,0 +1,394 @@
+//! The importer: walks the composed stage once and turns what it renders into a
+//! [`UsdScene`], recording everything it leaves out.
+
+use crate::error::UsdError;
+use crate::material::Material;
+use crate::mesh::{self, LocalMesh};
+use crate::scene::{Counts, Mesh, Skip, Sphere, UpAxis, UsdScene};
+use crate::stage::{Stage, Value};
+use crate::xform::{WorldTransforms, uniform_scale, up_axis_conversion};
+use crate::{camera, dome, instancer, shapes};
+use glam::{DMat3, DMat4, DVec3, Vec3};
+use std::collections::HashMap;
+use std::path::Path;
+use std::time::Instant;
+
+/// Import options.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// The camera prim to use (default: the stage's first camera).
+    pub camera: Option<String>,
+}
+
+/// Gprim types the importer renders.
+pub const GPRIMS: [&str; 7] = ["Mesh", "Sphere", "Cube", "Cylinder", "Cone", "Capsule", "Plane"];
+/// Prim types that carry no geometry of their own.
+const STRUCTURE: [&str; 8] = ["", "Xform", "Scope", "Material", "Shader", "NodeGraph", "GeomSubset", "Camera"];
+const OTHER_LIGHTS: [&str; 7] =
+    ["SphereLight", "RectLight", "DiskLight", "DistantLight", "CylinderLight", "GeometryLight", "PortalLight"];
+const SKELETAL: [&str; 4] = ["SkelRoot", "Skeleton", "SkelAnimation", "BlendShape"];
+
+struct Importer<'a> {
+    stage: &'a Stage,
+    conversion: DMat4,
+    worlds: WorldTransforms,
+    scene: UsdScene,
+    materials: HashMap<String, usize>,
+}
+
+/// Imports a USD file with default options.
+pub fn load(file: &Path) -> Result<UsdScene, UsdError> {
+    load_with(file, &Options::default())
+}
+
+/// Opens the stage, with errors naming the file. A layer, reference or payload that cannot
+/// be found or read does not stop the import (Pixar's library opens such stages too): the
+/// import lists it among the skips.
+pub fn open(file: &Path) -> Result<Stage, UsdError> {
+    if !file.is_file() {
+        return Err(UsdError::NotFound { file: file.to_owned() });
+    }
+    Stage::open(file).map_err(|message| UsdError::Open { file: file.to_owned(), message })
+}
+
+/// Imports a USD file.
+pub fn load_with(file: &Path, options: &Options) -> Result<UsdScene, UsdError> {
+    let t0 = Instant::now();
+    let stage = open(file)?;
+    let at = |prim: &str| {
+        let (file, prim) = (file.to_owned(), prim.to_string());
+        move |message: String| UsdError::Prim { file, prim, message }
+    };
+    let mut skipped: Vec<Skip> = stage
+        .composition_errors()
+        .into_iter()
+        .map(|e| Skip { path: "/".into(), what: format!("composition: {e} (the prims it would bring are absent)") })
+        .collect();
+    let up = stage.metadata("upAxis").map_err(at("/"))?;
+    let up_axis = match up.as_ref().and_then(Value::token) {
+        Some("Z") => UpAxis::Z,
+        None | Some("Y") => UpAxis::Y,
+        Some(other) => {
+            skipped.push(Skip { path: "/".into(), what: format!("upAxis {other:?} is not Y or Z; treated as Y") });
+            UpAxis::Y
+        }
+    };
+    let meters_per_unit = stage.metadata("metersPerUnit").map_err(at("/"))?.and_then(|v| v.scalar()).unwrap_or(0.01);
+    let scene = UsdScene {
+        file: file.to_owned(),
+        up_axis,
+        meters_per_unit,
+        time_code: stage.time(),
+        meshes: Vec::new(),
+        spheres: Vec::new(),
+        materials: Vec::new(),
+        dome: None,
+        camera: None,
+        bounds: None,
+        skipped,
+        counts: Counts::default(),
+        import_seconds: 0.0,
+    };
+    let mut imp = Importer {
+        stage: &stage,
+        conversion: up_axis_conversion(up_axis == UpAxis::Z),
+        worlds: WorldTransforms::default(),
+        scene,
+        materials: HashMap::new(),
+    };
+    let prims = stage.prims().map_err(at("/"))?;
+    imp.walk(&prims, options).map_err(|(prim, message)| UsdError::Prim { file: file.to_owned(), prim, message })?;
+    let mut scene = imp.scene;
+    if let Some(name) = &options.camera
+        && scene.camera.as_ref().is_none_or(|c| &c.path != name)
+    {
+        return Err(UsdError::Prim { file: file.to_owned(), prim: name.clone(), message: "no such camera".into() });
+    }
+    if scene.camera.is_none()
+        && let Some(b) = scene.bounds
+    {
+        scene.camera = Some(camera::framing(b));
+    }
+    scene.import_seconds = t0.elapsed().as_secs_f64();
+    Ok(scene)
+}
+
+type Failure = (String, String);
+
+impl Importer<'_> {
+    fn skip(&mut self, path: &str, what: impl Into<String>) {
+        self.scene.skipped.push(Skip { path: path.to_string(), what: what.into() });
+    }
+
+    fn walk(&mut self, prims: &[String], options: &Options) -> Result<(), Failure> {
+        let stage = self.stage;
+        let fail = |prim: &str| {
+            let prim = prim.to_string();
+            move |m: String| (prim, m)
+        };
+        // Prototypes render only through their instancers.
+        let mut prototypes: Vec<String> = Vec::new();
+        for prim in prims {
+            if stage.type_name(prim).map_err(fail(prim))? == "PointInstancer" {
+                prototypes.extend(stage.targets(prim, "prototypes").map_err(fail(prim))?);
+            }
+        }
+        let in_prototype = |p: &str| prototypes.iter().any(|r| p == r || p.starts_with(&format!("{r}/")));
+        for prim in prims {
+            self.scene.counts.prims += 1;
+            if in_prototype(prim) {
+                continue;
+            }
+            let type_name = stage.type_name(prim).map_err(fail(prim))?;
+            let t = type_name.as_str();
+            if GPRIMS.contains(&t) || t == "PointInstancer" {
+                if self.hidden(prim).map_err(fail(prim))? {
+                    self.scene.counts.hidden += 1;
+                    continue;
+                }
+                let world = self.worlds.world(stage, prim).map_err(fail(prim))?;
+                if t == "PointInstancer" {
+                    self.instancer(prim, prims, &world)?;
+                } else {
+                    let proxy = stage.is_instance_proxy(prim).map_err(fail(prim))?;
+                    self.scene.counts.instances += usize::from(proxy);
+                    self.gprim(prim, t, prim, &(self.conversion * world)).map_err(fail(prim))?;
+                }
+            } else if t == "Camera" {
+                let wanted = options.camera.as_deref().is_none_or(|c| c == prim);
+                if self.scene.camera.is_none() && wanted {
+                    let world = self.conversion * self.worlds.world(stage, prim).map_err(fail(prim))?;
+                    let (c, notes) = camera::read(stage, prim, &world).map_err(fail(prim))?;
+                    notes.into_iter().for_each(|n| self.skip(prim, n));
+                    self.scene.camera = Some(c);
+                }
+            } else if t == "DomeLight" || t == "DomeLight_1" {
+                if self.scene.dome.is_some() {
+                    self.skip(prim, "a second DomeLight; only the first lights the scene");
+                    continue;
+                }
+                if self.hidden(prim).map_err(fail(prim))? {
+                    self.skip(prim, "invisible DomeLight");
+                    continue;
+                }
+                let world = self.worlds.world(stage, prim).map_err(fail(prim))?;
+                let z_up = self.scene.up_axis == UpAxis::Z;
+                let (d, notes) = dome::read(stage, prim, t, z_up, &world, &self.conversion).map_err(fail(prim))?;
+                notes.into_iter().for_each(|n| self.skip(prim, n));
+                self.scene.dome = Some(d);
+            } else if OTHER_LIGHTS.contains(&t) {
+                self.skip(prim, format!("{t} not rendered (only a DomeLight lights the scene)"));
+            } else if SKELETAL.contains(&t) {
+                self.skip(prim, format!("{t}: skinning not applied (meshes render in their rest pose)"));
+            } else if !STRUCTURE.contains(&t) {
+                self.skip(prim, format!("prim type {t} not rendered"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Invisible, or a proxy/guide purpose.
+    fn hidden(&self, prim: &str) -> Result<bool, String> {
+        if self.stage.is_invisible(prim)? {
+            return Ok(true);
+        }
+        Ok(matches!(self.stage.purpose(prim)?.as_str(), "proxy" | "guide"))
+    }
+
+    fn instancer(&mut self, prim: &str, prims: &[String], world: &DMat4) -> Result<(), Failure> {
+        let stage = self.stage;
+        let fail = |p: &str| {
+            let p = p.to_string();
+            move |m: String| (p, m)
+        };
+        let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
+        // Each prototype's renderable prims, with their transform relative to the
+        // prototype root's parent.
+        let mut parts: Vec<Vec<(String, String, DMat4)>> = Vec::new();
+        for root in &protos {
+            let mut list = Vec::new();
+            for p in prims.iter().filter(|p| *p == root || p.starts_with(&format!("{root}/"))) {
+                let t = stage.type_name(p).map_err(fail(p))?;
+                if GPRIMS.contains(&t.as_str()) && !self.hidden(p).map_err(fail(p))? {
+                    let rel = self.worlds.relative_to(stage, p, root).map_err(fail(p))?;
+                    list.push((p.clone(), t, rel));
+                }
+            }
+            parts.push(list);
+        }
+        for inst in &instances {
+            for (p, t, rel) in &parts[inst.prototype] {
+                let m = self.conversion * *world * inst.transform * *rel;
+                let label = format!("{p}[{prim}:{}]", inst.index);
+                self.gprim(p, t, &label, &m).map_err(fail(p))?;
+            }
+        }
+        self.scene.counts.instances += instances.len();
+        Ok(())
+    }
+
+    /// One gprim with its local-to-renderer transform `m`.
+    fn gprim(&mut self, prim: &str, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
+        let stage = self.stage;
+        let double_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
+        let material = self.material_for(prim)?;
+        self.scene.counts.gprims += 1;
+        if type_name == "Sphere"
+            && let Some(s) = uniform_scale(m)
+        {
+            let r = shapes::number(stage, prim, "radius", 1.0)? * s;
+            let center = m.transform_point3(DVec3::ZERO);
+            if !(r.is_finite() && center.is_finite()) {
+                return Err("the sphere's transform or radius is not finite".into());
+            }
+            let (c, r) = (center.as_vec3(), r as f32);
+            self.grow(c - Vec3::splat(r));
+            self.grow(c + Vec3::splat(r));
+            let path = label.to_string();
+            self.scene.spheres.push(Sphere { path, center: c, radius: r, material, double_sided });
+            return Ok(());
+        }
+        let local = if type_name == "Mesh" {
+            self.scene.counts.meshes += 1;
+            mesh::read(stage, prim)?
+        } else {
+            shapes::tessellate(stage, prim, type_name)?.unwrap_or_default()
+        };
+        // Per-face materials from GeomSubsets of the materialBind family.
+        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
+        let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
+        for (i, &face) in local.faces.iter().enumerate() {
+            let mat = face_materials.iter().find(|(faces, _)| faces.contains(&(face as i64))).map_or(material, |f| f.1);
+            groups.entry(mat).or_default().push(i);
+        }
+        let mut keys: Vec<usize> = groups.keys().copied().collect();
+        keys.sort_unstable();
+        let m3 = DMat3::from_mat4(*m);
+        if !(m3.determinant().is_finite() && m3.determinant() != 0.0) {
+            self.skip(label, "its world transform is singular (the gprim has no area)");
+            return Ok(());
+        }
+        for mat in keys {
+            let mesh = transform(&local, &groups[&mat], m, label, mat, double_sided)?;
+            self.scene.counts.triangles += mesh.triangles.len();
+            for &p in &mesh.positions {
+                self.grow(p);
+            }
+            self.scene.meshes.push(mesh);
+        }
+        Ok(())
+    }
+
+    fn grow(&mut self, p: Vec3) {
+        let b = self.scene.bounds.get_or_insert((p, p));
+        *b = (b.0.min(p), b.1.max(p));
+    }
+
+    /// (faces, material) of the mesh's `materialBind` GeomSubsets that bind a material.
+    fn subset_materials(&mut self, prim: &str) -> Result<Vec<(std::collections::HashSet<i64>, usize)>, String> {
+        let mut out = Vec::new();
+        for child in self.stage.children(prim)? {
+            if self.stage.type_name(&child)? != "GeomSubset" {
+                continue;
+            }
+            let family = self.stage.value(&child, "familyName")?;
+            if family.as_ref().and_then(Value::token) != Some("materialBind") {
+                continue;
+            }
+            if self.stage.bound_material(&child)?.is_none() {
+                continue;
+            }
+            let faces = match self.stage.value(&child, "indices")? {
+                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
+                _ => Default::default(),
+            };
+            let mat = self.material_for(&child)?;
+            out.push((faces, mat));
+        }
+        Ok(out)
+    }
+
+    /// The index of the material bound to `prim` (imported on first use), or of a fallback.
+    fn material_for(&mut self, prim: &str) -> Result<usize, String> {
+        let bound = self.stage.bound_material(prim)?;
+        let key = match &bound {
+            Some(m) => m.clone(),
+            None => "<fallback>".to_string(),
+        };
+        if let Some(&i) = self.materials.get(&key) {
+            return Ok(i);
+        }
+        let material = match &bound {
+            None => Material::fallback(&key),
+            Some(path) => match self.stage.surface_shader(path)? {
+                Some((shader, id)) if id == "UsdPreviewSurface" => {
+                    let (m, notes) = Material::read(self.stage, path, &shader)?;
+                    notes.into_iter().for_each(|n| self.skip(path, n));
+                    m
+                }
+                Some((shader, id)) => {
+                    self.skip(path, format!("surface shader {shader} ({id}) is not a UsdPreviewSurface (MaterialX?); fallback material used"));
+                    Material::fallback(path)
+                }
+                None => {
+                    self.skip(path, "no surface shader; fallback material used");
+                    Material::fallback(path)
+                }
+            },
+        };
+        self.scene.materials.push(material);
+        let i = self.scene.materials.len() - 1;
+        self.materials.insert(key, i);
+        Ok(i)
+    }
+}
+
+/// The triangles `which` of a local mesh, transformed by `m` (normals by its inverse
+/// transpose; winding reversed when `m` mirrors).
+fn transform(
+    local: &LocalMesh,
+    which: &[usize],
+    m: &DMat4,
+    label: &str,
+    material: usize,
+    double_sided: bool,
+) -> Result<Mesh, String> {
+    let m3 = DMat3::from_mat4(*m);
+    let det = m3.determinant();
+    if !det.is_finite() || det == 0.0 {
+        return Err(format!("the world transform is singular (determinant {det})"));
+    }
+    let normal_matrix = m3.inverse().transpose();
+    let mirror = det < 0.0;
+    let mut remap: HashMap<u32, u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::with_capacity(which.len());
+    let mut normals = Vec::new();
+    for &i in which {
+        let mut t = local.triangles[i];
+        let mut n = local.normals.get(i).copied();
+        if mirror {
+            t.swap(1, 2);
+            if let Some(n) = n.as_mut() {
+                n.swap(1, 2);
+            }
+        }
+        let t = t.map(|v| {
+            *remap.entry(v).or_insert_with(|| {
+                positions.push(m.transform_point3(local.positions[v as usize]).as_vec3());
+                (positions.len() - 1) as u32
+            })
+        });
+        triangles.push(t);
+        if let Some(n) = n {
+            normals.push(n.map(|n| (normal_matrix * n).normalize_or_zero().as_vec3()));
+        }
+    }
+    if normals.len() != triangles.len() {
+        normals.clear();
+    }
+    if positions.iter().any(|p: &Vec3| !p.is_finite()) {
+        return Err("a transformed point is not finite".into());
+    }
+    Ok(Mesh { path: label.to_string(), positions, triangles, normals, material, double_sided })
+}

@@ -1,0 +1,115 @@
+//! What an import yields: plain data in the renderer's frame (Y up, scene units), with no
+//! openusd types, so host-std converts it without knowing USD.
+
+pub use crate::material::{Lobes, Material, Texture, TextureInput};
+use glam::{DMat3, Vec3};
+use std::path::PathBuf;
+
+/// The stage's up axis. A Z-up stage is rotated once into the renderer's Y-up frame
+/// (geometry, camera and lights alike): (x, y, z) → (x, z, −y).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpAxis {
+    Y,
+    Z,
+}
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// The prim it came from (an instance proxy or a PointInstancer instance is named by
+    /// its prim path, with `[i]` for the instance).
+    pub path: String,
+    pub positions: Vec<Vec3>,
+    /// Counter-clockwise front faces (USD's `orientation` and negative-determinant
+    /// transforms already applied).
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-triangle corner shading normals, or empty for face normals.
+    pub normals: Vec<[Vec3; 3]>,
+    pub material: usize,
+    pub double_sided: bool,
+}
+
+/// An exact sphere (a UsdGeomSphere under a similarity transform).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sphere {
+    pub path: String,
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: usize,
+    pub double_sided: bool,
+}
+
+/// The DomeLight: radiance = texture · color · intensity · 2^exposure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dome {
+    pub path: String,
+    /// A lat-long image (name for messages, and its bytes); `None` for a constant dome.
+    pub texture: Option<(String, Vec<u8>)>,
+    /// color · intensity · 2^exposure.
+    pub radiance: Vec3,
+    /// Maps the lat-long's local frame (top pole +Y, centre +Z, u = ¼ → +X) to the
+    /// renderer's world: the up-axis conversion · the light's world rotation · the pole
+    /// axis correction.
+    pub map_to_world: DMat3,
+}
+
+/// The camera in world space; field of view from focal length and apertures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub path: String,
+    pub origin: Vec3,
+    pub forward: Vec3,
+    pub up: Vec3,
+    pub focal_length: f32,
+    pub horizontal_aperture: f32,
+    pub vertical_aperture: f32,
+    pub near: f32,
+}
+
+impl Camera {
+    /// Vertical field of view (degrees) for an image of `aspect` = width/height, conforming
+    /// the aperture by expanding it (UsdRender's default `expandAperture`).
+    pub fn fov_y_deg(&self, aspect: f32) -> f32 {
+        let (h, v) = (self.horizontal_aperture, self.vertical_aperture);
+        let v = if h / v > aspect { h / aspect } else { v };
+        (2.0 * (0.5 * v / self.focal_length).atan()).to_degrees()
+    }
+}
+
+/// A prim or feature the importer did not render, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skip {
+    pub path: String,
+    pub what: String,
+}
+
+/// Counts for `ppis info` and the import summary.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Counts {
+    pub prims: usize,
+    pub meshes: usize,
+    pub gprims: usize,
+    pub triangles: usize,
+    /// Instance proxies and PointInstancer instances that were rendered.
+    pub instances: usize,
+    pub hidden: usize,
+}
+
+/// An imported scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UsdScene {
+    pub file: PathBuf,
+    pub up_axis: UpAxis,
+    pub meters_per_unit: f64,
+    pub time_code: f64,
+    pub meshes: Vec<Mesh>,
+    pub spheres: Vec<Sphere>,
+    pub materials: Vec<Material>,
+    pub dome: Option<Dome>,
+    pub camera: Option<Camera>,
+    /// World bounds of the geometry (min, max), Y up.
+    pub bounds: Option<(Vec3, Vec3)>,
+    pub skipped: Vec<Skip>,
+    pub counts: Counts,
+    pub import_seconds: f64,
+}
