@@ -26,6 +26,13 @@ pub struct Report {
 
 /// Checks `usd` against Pixar's answers in `expected`.
 pub fn check(usd: &Path, expected: &Path) -> Result<Report, String> {
+    crate::guard::guarded(usd, || {
+        check_unguarded(usd, expected).map_err(|e| crate::UsdError::Open { file: usd.to_owned(), message: e })
+    })
+    .map_err(|e| e.to_string())
+}
+
+fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     let text = std::fs::read_to_string(expected).map_err(|e| format!("{}: {e}", expected.display()))?;
     let want: Json = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", expected.display()))?;
     let stage = import::open(usd).map_err(|e| e.to_string())?;

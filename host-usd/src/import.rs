@@ -48,11 +48,17 @@ pub fn open(file: &Path) -> Result<Stage, UsdError> {
     if !file.is_file() {
         return Err(UsdError::NotFound { file: file.to_owned() });
     }
-    Stage::open(file).map_err(|message| UsdError::Open { file: file.to_owned(), message })
+    crate::guard::guarded(file, || {
+        Stage::open(file).map_err(|message| UsdError::Open { file: file.to_owned(), message })
+    })
 }
 
-/// Imports a USD file.
+/// Imports a USD file. A corrupt file that makes the USD reader panic is an error too.
 pub fn load_with(file: &Path, options: &Options) -> Result<UsdScene, UsdError> {
+    crate::guard::guarded(file, || load_unguarded(file, options))
+}
+
+fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> {
     let t0 = Instant::now();
     let stage = open(file)?;
     let at = |prim: &str| {

@@ -6,6 +6,7 @@ pub mod camera;
 pub mod conformance;
 pub mod dome;
 pub mod error;
+mod guard;
 pub mod import;
 pub mod instancer;
 pub mod material;

@@ -183,6 +183,7 @@ struct Loaded {
 fn load_scene(args: &SceneArgs) -> Result<Loaded> {
     #[cfg(feature = "usd")]
     let mut usd = None;
+    #[cfg_attr(not(feature = "usd"), allow(unused_mut))]
     let mut notes = Vec::new();
     let mut scene = match &args.scene {
         None => default_scene::scene(),

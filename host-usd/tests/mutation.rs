@@ -1,0 +1,87 @@
+//! Bad USD files never panic: the fixtures (usda, usdc, usdz), truncated at random and with
+//! bytes flipped (proptest), import to `Ok` or to a clean error naming the file, and no
+//! single allocation made while importing exceeds 64 MB (the files are a few KB; unpatched,
+//! openusd 0.6 let a flipped count ask for terabytes and abort — see vendor/openusd).
+
+use proptest::prelude::*;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::{Path, PathBuf};
+
+struct PeakAlloc;
+
+thread_local! {
+    static ARMED: Cell<bool> = const { Cell::new(false) };
+    static PEAK: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for PeakAlloc {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if ARMED.with(|a| a.get()) {
+            PEAK.with(|p| p.set(p.get().max(layout.size())));
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if ARMED.with(|a| a.get()) {
+            PEAK.with(|p| p.set(p.get().max(new_size)));
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: PeakAlloc = PeakAlloc;
+
+const MAX_ALLOCATION: usize = 64 << 20;
+
+fn fixtures() -> Vec<(String, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    ["materials.usda", "instancing.usdc", "transforms.usdc", "textured.usdz"]
+        .iter()
+        .map(|n| (n.to_string(), std::fs::read(dir.join(n)).unwrap()))
+        .collect()
+}
+
+fn scratch() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ppis-usd-mutation-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn mutated_usd_files_fail_cleanly(
+        which in 0usize..4,
+        cut in 0.0f64..1.2,
+        flips in proptest::collection::vec((0.0f64..1.0, 1u8..=255), 0..8),
+    ) {
+        let (name, mut bytes) = fixtures().swap_remove(which);
+        if cut < 1.0 {
+            bytes.truncate((bytes.len() as f64 * cut) as usize);
+        }
+        for (at, x) in flips {
+            if !bytes.is_empty() {
+                let i = ((bytes.len() - 1) as f64 * at) as usize;
+                bytes[i] ^= x;
+            }
+        }
+        let path = scratch().join(format!("{}-{name}", std::thread::current().name().unwrap_or("t").replace("::", "_")));
+        std::fs::write(&path, &bytes).unwrap();
+        PEAK.with(|p| p.set(0));
+        ARMED.with(|a| a.set(true));
+        let result = std::panic::catch_unwind(|| host_usd::load(&path).map(|s| s.counts.triangles));
+        ARMED.with(|a| a.set(false));
+        let peak = PEAK.with(|p| p.get());
+        prop_assert!(result.is_ok(), "{name}: the importer panicked");
+        prop_assert!(peak <= MAX_ALLOCATION, "{name}: one allocation of {peak} bytes for a {}-byte file", bytes.len());
+        if let Ok(Err(e)) = result {
+            prop_assert!(e.to_string().contains(path.file_name().unwrap().to_str().unwrap()), "{e}");
+        }
+    }
+}
