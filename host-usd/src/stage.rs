@@ -290,6 +290,15 @@ impl Stage {
 
     /// The material's surface shader id (`UsdPreviewSurface`, `ND_standard_surface…`), if any.
     pub fn surface_shader(&self, material: &str) -> Result<Option<(String, String)>> {
+        // The universal `outputs:surface`, followed through NodeGraph outputs (openusd 0.6
+        // stops at a NodeGraph), is what a UsdPreviewSurface renderer reads.
+        if let Some(source) = self.connection(material, "outputs:surface")? {
+            let shader = source.prim_path().as_str().to_string();
+            let id = self.value(&shader, "info:id")?.and_then(|v| v.token().map(str::to_string));
+            if let Some(id) = id {
+                return Ok(Some((shader, id)));
+            }
+        }
         let Some(m) = shade::Material::get(&self.inner, path(material)?).map_err(err)? else {
             return Ok(None);
         };
