@@ -16,8 +16,10 @@ pub enum EnvSource {
     Sky { level: u32 },
     /// An image file: lat-long (2:1) or an equal-area square.
     File(PathBuf),
-    /// An image already in memory (e.g. read from inside a usdz package), named for messages.
-    Bytes { name: PathBuf, bytes: std::sync::Arc<Vec<u8>> },
+    /// An image already in memory (e.g. read from inside a usdz package), named for messages;
+    /// `latlong` reads it as lat-long whatever its shape (a USD dome texture is lat-long even
+    /// when square).
+    Bytes { name: PathBuf, bytes: std::sync::Arc<Vec<u8>>, latlong: bool },
     /// The same radiance from every direction (a DomeLight without a texture).
     Constant { level: u32 },
 }
@@ -101,13 +103,13 @@ impl Environment {
                 (rgb, *level, stats)
             }
             EnvSource::File(_) | EnvSource::Bytes { .. } => {
-                let (path, image) = match source {
-                    EnvSource::File(path) => (path, env_io::load(path)?),
-                    EnvSource::Bytes { name, bytes } => (name, env_io::load_bytes(name, bytes)?),
+                let (path, image, latlong) = match source {
+                    EnvSource::File(path) => (path, env_io::load(path)?, false),
+                    EnvSource::Bytes { name, bytes, latlong } => (name, env_io::load_bytes(name, bytes)?, *latlong),
                     _ => unreachable!("matched above"),
                 };
                 let load_seconds = t0.elapsed().as_secs_f64();
-                let (rgb, level, source_mean) = Self::to_equal_area(path, &image)?;
+                let (rgb, level, source_mean) = Self::to_equal_area(path, &image, latlong)?;
                 let stats = EnvStats {
                     source: path.display().to_string(),
                     source_size: (image.width, image.height),
@@ -141,9 +143,9 @@ impl Environment {
     }
 
     /// The equal-area texels, their level, and the source's mean radiance.
-    fn to_equal_area(path: &Path, image: &RgbImage) -> Result<EqualArea, EnvError> {
+    fn to_equal_area(path: &Path, image: &RgbImage, latlong: bool) -> Result<EqualArea, EnvError> {
         let (w, h) = (image.width, image.height);
-        if w == 2 * h {
+        if w == 2 * h || latlong {
             let level = resample::equal_area_level(w, h);
             let rgb = resample::latlong_to_equal_area(image, level, 2);
             Ok((rgb, level, resample::latlong_mean(image)))

@@ -126,7 +126,9 @@ pub fn convert(mut usd: UsdScene) -> Converted {
             ..Placement::default()
         };
         let source = match &d.texture {
-            Some((name, bytes)) => EnvSource::Bytes { name: texture_name(name), bytes: Arc::new(bytes.clone()) },
+            Some((name, bytes)) => {
+                EnvSource::Bytes { name: texture_name(name), bytes: Arc::new(bytes.clone()), latlong: true }
+            }
             None => EnvSource::Constant { level: 3 },
         };
         (source, placement)
