@@ -64,6 +64,10 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         _ => None,
     };
     let sat = sat.as_deref();
+    // `auto` resolves per material once, knowing how peaked the lighting is.
+    let env_peak = env.map_or(f32::MAX, |e| e.peak(5));
+    let methods: Vec<Method> =
+        scene.materials.iter().map(|m| settings.method.for_material(&m.bsdf, env_peak)).collect();
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tiles: Vec<(usize, usize)> =
@@ -85,7 +89,9 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
             let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(scene, bvh, env, sat, &camera, settings, x, y, &mut arena, &mut hits, &mut local));
+                    out.push(pixel(
+                        scene, bvh, env, sat, &camera, settings, &methods, x, y, &mut arena, &mut hits, &mut local,
+                    ));
                 }
             }
             for (c, l) in counters.iter().zip(local) {
@@ -134,6 +140,7 @@ fn pixel<'s>(
     sat: Option<&[f64]>,
     camera: &Camera,
     s: &Settings,
+    methods: &[Method],
     x: usize,
     y: usize,
     arena: &mut Option<Box<ProductArena>>,
@@ -183,7 +190,7 @@ fn pixel<'s>(
                 sp: ShadingPoint { frame: Frame::from_normal(ns), wo, brdf: material.bsdf.as_brdf() },
                 origin: hit.point + n * eps,
                 material: hit.material as usize,
-                method: s.method.for_material(&material.bsdf),
+                method: methods[hit.material as usize],
                 index: done + k,
             });
         }

@@ -257,6 +257,22 @@ impl<'a> EnvHierarchy<'a> {
         [q[0] * s, q[1] * s, q[2] * s, q[3] * s]
     }
 
+    /// How peaked the lighting is at a scale: the largest node of `level` (clamped to the
+    /// finest) relative to the mean — 1 for a constant map, ~700 for a sky with a sun at
+    /// level 5 (cells ~6.4° wide). A cheap test of whether sampling the lighting can pay.
+    #[must_use]
+    pub fn peak(&self, level: u32) -> f32 {
+        let level = level.min(self.finest);
+        let n = 1u32 << level;
+        let mut max = 0.0f32;
+        for y in 0..n {
+            for x in 0..n {
+                max = max.max(self.node_relative(level, x, y));
+            }
+        }
+        if max.is_finite() { max } else { f32::MAX }
+    }
+
     /// Mean importance (relative) of the region covered by a quadtree cell at any depth:
     /// below the finest level a cell lies inside one texel.
     #[inline]
@@ -428,6 +444,24 @@ mod tests {
         assert_eq!(sanitize_rgb(&mut t), 3);
         assert_eq!(t[0], [1.0, 0.0, 0.0]);
         assert_eq!(t[2], [0.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn peak_measures_how_concentrated_the_light_is() {
+        // 8×8 map: constant → 1; one texel 64× brighter than the others.
+        let mut rgb = [[1.0f32; 3]; 64];
+        let mut p = [0.0f32; 85];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        assert!((EnvHierarchy::new(3, &p, &rgb).unwrap().peak(5) - 1.0).abs() < 1e-6);
+        rgb[9] = [64.0; 3];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        let env = EnvHierarchy::new(3, &p, &rgb).unwrap();
+        // Mean (63 + 64)/64; at level 3 the bright texel is its own block, at level 1 it
+        // shares a block with 15 others.
+        let mean = 127.0 / 64.0;
+        assert!((env.peak(5) - 64.0 / mean).abs() < 1e-4);
+        assert!((env.peak(1) - (15.0 + 64.0) / 16.0 / mean).abs() < 1e-4);
+        assert!((env.peak(0) - 1.0).abs() < 1e-6);
     }
 
     #[test]

@@ -355,6 +355,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
                 (0..3).map(|c| (e.stats.map_mean[c] / e.stats.source_mean[c].max(1e-300) - 1.0).abs()).fold(0.0, f64::max)
             }),
             "primitives": bvh.primitive_count(),
+            "env_peak": hierarchy.as_ref().map(|h| h.peak(5)),
         });
         output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
     }
@@ -523,9 +524,10 @@ fn info_command(args: InfoArgs) -> Result<()> {
         ),
     }
     println!(
-        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis and auto (per pixel and material)",
+        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material); auto = product-mis, or BRDF sampling when the lighting is smooth (peak < {})",
         Bvh::build(&scene).primitive_count(),
-        if scene.env.is_some() { ", the env hierarchy" } else { "" }
+        if scene.env.is_some() { ", the env hierarchy" } else { "" },
+        host_std::integrator::SMOOTH_LIGHTING_PEAK
     );
     Ok(())
 }
