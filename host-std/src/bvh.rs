@@ -2,7 +2,7 @@
 //! surface-area heuristic (16 bins, up to 4 primitives per leaf), flattened depth-first.
 
 use crate::scene::{Scene, Shape};
-use sampler_core::glam::Vec3;
+use sampler_core::glam::{Vec2, Vec3};
 
 /// One intersectable primitive.
 #[derive(Clone, Copy, Debug)]
@@ -18,12 +18,20 @@ pub enum Primitive {
         e1: Vec3,
         e2: Vec3,
         material: u32,
-        /// Index into the corner shading normals, or `NO_NORMALS` (face normal).
-        normals: u32,
+        /// Index into the corner attributes, or `NO_ATTRS` (face normal, no texture
+        /// coordinates).
+        attrs: u32,
     },
 }
 
-const NO_NORMALS: u32 = u32::MAX;
+const NO_ATTRS: u32 = u32::MAX;
+
+/// Per-corner shading normals and texture coordinates of a triangle (either may be absent).
+#[derive(Clone, Copy, Debug)]
+struct CornerAttrs {
+    normals: Option<[Vec3; 3]>,
+    uvs: Option<[Vec2; 3]>,
+}
 
 impl Primitive {
     fn bounds(&self) -> Aabb {
@@ -137,6 +145,8 @@ pub struct Hit {
     /// Interpolated shading normal (the geometric normal where none is given), unit, on the
     /// side of the front face's authored normals.
     pub shading_normal: Vec3,
+    /// Interpolated texture coordinates, where the mesh has them.
+    pub uv: Option<Vec2>,
     pub material: u32,
 }
 
@@ -144,15 +154,15 @@ pub struct Hit {
 pub struct Bvh {
     prims: Vec<Primitive>,
     nodes: Vec<Node>,
-    /// Per-corner shading normals of triangles that have them.
-    shading_normals: Vec<[Vec3; 3]>,
+    /// Per-corner shading normals and texture coordinates of triangles that have them.
+    corner_attrs: Vec<CornerAttrs>,
 }
 
 impl Bvh {
     /// Builds the hierarchy over every shape of the scene (rectangles become two triangles).
     pub fn build(scene: &Scene) -> Self {
         let mut prims = Vec::new();
-        let mut shading_normals = Vec::new();
+        let mut corner_attrs = Vec::new();
         for o in &scene.objects {
             let material = o.material as u32;
             match &o.shape {
@@ -160,28 +170,32 @@ impl Bvh {
                     prims.push(Primitive::Sphere { center: *center, radius: *radius, material })
                 }
                 Shape::Rectangle { p0, e1, e2 } => {
-                    let normals = NO_NORMALS;
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material, normals });
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material, normals });
+                    let attrs = NO_ATTRS;
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material, attrs });
+                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material, attrs });
                 }
-                Shape::Mesh { positions, triangles, normals: corner_normals } => {
+                Shape::Mesh { positions, triangles, normals, uvs } => {
                     for (k, t) in triangles.iter().enumerate() {
                         let [a, b, c] = t.map(|i| positions[i as usize]);
                         if (b - a).cross(c - a).length_squared() > 0.0 {
-                            let normals = match corner_normals.get(k) {
-                                Some(n) if n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0) => {
-                                    shading_normals.push(*n);
-                                    (shading_normals.len() - 1) as u32
-                                }
-                                _ => NO_NORMALS,
+                            let n = normals
+                                .get(k)
+                                .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0))
+                                .copied();
+                            let uv = uvs.get(k).filter(|uv| uv.iter().all(|t| t.is_finite())).copied();
+                            let attrs = if n.is_some() || uv.is_some() {
+                                corner_attrs.push(CornerAttrs { normals: n, uvs: uv });
+                                (corner_attrs.len() - 1) as u32
+                            } else {
+                                NO_ATTRS
                             };
-                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material, normals });
+                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material, attrs });
                         }
                     }
                 }
             }
         }
-        let mut bvh = Bvh { prims, nodes: Vec::new(), shading_normals };
+        let mut bvh = Bvh { prims, nodes: Vec::new(), corner_attrs };
         if !bvh.prims.is_empty() {
             let n = bvh.prims.len();
             let mut centroids: Vec<(Aabb, Vec3)> = bvh
@@ -289,14 +303,15 @@ impl Bvh {
         });
         let prim = best?;
         let point = o + t_max * d;
+        let mut uv = None;
         let (normal, shading, material) = match self.prims[prim] {
             Primitive::Sphere { center, radius, material } => {
                 let n = ((point - center) / radius).normalize();
                 (n, n, material)
             }
-            Primitive::Triangle { v0, e1, e2, material, normals } => {
+            Primitive::Triangle { v0, e1, e2, material, attrs } => {
                 let n = e1.cross(e2).normalize();
-                let shading = match self.shading_normals.get(normals as usize) {
+                match self.corner_attrs.get(attrs as usize) {
                     Some(c) => {
                         // Barycentrics of the hit point (its projection on the plane).
                         let p = point - v0;
@@ -305,15 +320,19 @@ impl Bvh {
                         let den = d00 * d11 - d01 * d01;
                         let v = ((d11 * d20 - d01 * d21) / den).clamp(0.0, 1.0);
                         let w = ((d00 * d21 - d01 * d20) / den).clamp(0.0, 1.0 - v);
-                        let s = (c[0] * (1.0 - v - w) + c[1] * v + c[2] * w).normalize_or_zero();
-                        if s == Vec3::ZERO { n } else { s }
+                        let u = 1.0 - v - w;
+                        let shading = c.normals.map_or(n, |c| {
+                            let s = (c[0] * u + c[1] * v + c[2] * w).normalize_or_zero();
+                            if s == Vec3::ZERO { n } else { s }
+                        });
+                        uv = c.uvs.map(|c| c[0] * u + c[1] * v + c[2] * w);
+                        (n, shading, material)
                     }
-                    None => n,
-                };
-                (n, shading, material)
+                    None => (n, n, material),
+                }
             }
         };
-        Some(Hit { t: t_max, point, normal, shading_normal: shading, material })
+        Some(Hit { t: t_max, point, normal, shading_normal: shading, uv, material })
     }
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).

@@ -11,7 +11,7 @@ use sampler_core::glam::Vec3;
 pub const SKY_LEVEL: u32 = 10;
 
 pub fn scene() -> Scene {
-    let material = |bsdf| Material { bsdf, twosided: false };
+    let material = |bsdf| Material::new(bsdf, false);
     let materials = vec![
         material(Bsdf::Diffuse(Lambert::new(Vec3::new(0.8, 0.45, 0.3)))),
         material(Bsdf::Conductor(RoughConductor::new(0.15, Vec3::new(0.95, 0.8, 0.55)))),

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 /// A loaded image: linear RGB, rows top to bottom.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RgbImage {
     pub width: usize,
     pub height: usize,
@@ -44,12 +44,18 @@ pub fn load(path: &Path) -> Result<RgbImage, LoadError> {
 /// Decodes the bytes of an image file; `path` gives the format (by extension) and names the
 /// file in errors.
 pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<RgbImage, LoadError> {
+    load_bytes_as(path, bytes, None)
+}
+
+/// [`load_bytes`] with the encoding of 8- and 16-bit images forced: `Some(true)` sRGB,
+/// `Some(false)` linear data (a roughness map); `None` sRGB for 8/16-bit, linear for float.
+pub fn load_bytes_as(path: &Path, bytes: &[u8], srgb: Option<bool>) -> Result<RgbImage, LoadError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     match ext.as_str() {
         "exr" => load_exr(path, bytes),
-        "hdr" => load_with_image(path, bytes, "Radiance HDR", image_format("hdr", path)?),
-        "png" => load_with_image(path, bytes, "PNG", image::ImageFormat::Png),
-        "jpg" | "jpeg" => load_with_image(path, bytes, "JPEG", image_format("jpeg", path)?),
+        "hdr" => load_with_image(path, bytes, "Radiance HDR", image_format("hdr", path)?, srgb),
+        "png" => load_with_image(path, bytes, "PNG", image::ImageFormat::Png, srgb),
+        "jpg" | "jpeg" => load_with_image(path, bytes, "JPEG", image_format("jpeg", path)?, srgb),
         _ => Err(LoadError::Unsupported { path: path.to_owned() }),
     }
 }
@@ -134,6 +140,7 @@ fn load_with_image(
     bytes: &[u8],
     name: &'static str,
     format: image::ImageFormat,
+    srgb_override: Option<bool>,
 ) -> Result<RgbImage, LoadError> {
     let decode = |message: String| LoadError::Decode { path: path.to_owned(), format: name, message };
     // The decoders refuse sizes beyond the largest map we accept; `check_size` then bounds the
@@ -149,8 +156,9 @@ fn load_with_image(
     let (w, h) = reader(limits.clone()).into_dimensions().map_err(|e| decode(e.to_string()))?;
     check_size(path, w as usize, h as usize, bytes.len())?;
     let decoded = reader(limits).decode().map_err(|e| decode(e.to_string()))?;
-    let srgb = !matches!(format, image::ImageFormat::Hdr)
-        && !matches!(decoded, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let float = matches!(format, image::ImageFormat::Hdr)
+        || matches!(decoded, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let srgb = srgb_override.unwrap_or(!float);
     let rgb = decoded.into_rgb32f();
     let (width, height) = (rgb.width() as usize, rgb.height() as usize);
     // 8- and 16-bit images are sRGB-encoded: decode to linear radiance.

@@ -15,5 +15,6 @@ pub mod resample;
 pub mod scene;
 pub mod scene_json;
 pub mod sky;
+pub mod texture;
 #[cfg(feature = "usd")]
 pub mod usd_scene;

@@ -6,7 +6,7 @@
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::integrator::{self, CountingVisibility, Method, Technique};
-use crate::scene::Scene;
+use crate::scene::{Bsdf, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sampler_core::brdf::Brdf;
@@ -84,7 +84,7 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         .map(|&(tx, ty)| {
             let mut arena: Option<Box<ProductArena>> = None;
             // The pixel's primary hits, one buffer reused by every pixel of the tile.
-            let mut hits: Vec<Hit<'_>> = Vec::with_capacity(settings.shading_points.clamp(1, 64));
+            let mut hits: Vec<Hit> = Vec::with_capacity(settings.shading_points.clamp(1, 64));
             let mut out = Vec::with_capacity(TILE * TILE);
             let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
@@ -121,8 +121,11 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
 }
 
 /// A primary ray's hit, ready to shade.
-struct Hit<'m> {
-    sp: ShadingPoint<'m, dyn Brdf + 'm>,
+struct Hit {
+    frame: Frame,
+    wo: Vec3,
+    /// The BRDF at this hit when its material is textured; otherwise the material's.
+    bsdf: Option<Bsdf>,
     origin: Vec3,
     material: usize,
     method: Method,
@@ -133,8 +136,8 @@ struct Hit<'m> {
 /// material, every other sampler built per shading point). `stats` counts shading points, shadow rays, camera rays and non-finite
 /// values.
 #[allow(clippy::too_many_arguments)]
-fn pixel<'s>(
-    scene: &'s Scene,
+fn pixel(
+    scene: &Scene,
     bvh: &Bvh,
     env: Option<&EnvHierarchy<'_>>,
     sat: Option<&[f64]>,
@@ -144,7 +147,7 @@ fn pixel<'s>(
     x: usize,
     y: usize,
     arena: &mut Option<Box<ProductArena>>,
-    hits: &mut Vec<Hit<'s>>,
+    hits: &mut Vec<Hit>,
     stats: &mut [u64; 4],
 ) -> [f32; 3] {
     let seed = hash_combine(s.seed, (y * camera.width as usize + x) as u64);
@@ -187,7 +190,12 @@ fn pixel<'s>(
             }
             let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
             hits.push(Hit {
-                sp: ShadingPoint { frame: Frame::from_normal(ns), wo, brdf: material.bsdf.as_brdf() },
+                frame: Frame::from_normal(ns),
+                wo,
+                bsdf: match (&material.texture, hit.uv) {
+                    (Some(t), Some(uv)) => Some(t.0.bsdf_at(uv)),
+                    _ => None,
+                },
                 origin: hit.point + n * eps,
                 material: hit.material as usize,
                 method: methods[hit.material as usize],
@@ -209,6 +217,7 @@ fn pixel<'s>(
                     continue;
                 }
                 let lead = &hits[first];
+                let lead_sp = shading_point(scene, lead);
                 let build_seed = hash_combine(seed, 0xb5df ^ (group as u64) << 20);
                 let product;
                 let two_stage;
@@ -216,12 +225,12 @@ fn pixel<'s>(
                     Method::Product | Method::Wavelet | Method::ProductMis => {
                         let a = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
                         let params = integrator::product_params(lead.method, s.brdf_samples);
-                        product = a.build(env, lead.sp.brdf, &lead.sp.frame, lead.sp.wo, &params, build_seed);
+                        product = a.build(env, lead_sp.brdf, &lead_sp.frame, lead_sp.wo, &params, build_seed);
                         Technique::Product(&product)
                     }
                     Method::TwoStage => match sat {
                         Some(sat) => {
-                            two_stage = TwoStageSampler::new(env, sat, lead.sp.brdf, &lead.sp.frame, lead.sp.wo);
+                            two_stage = TwoStageSampler::new(env, sat, lead_sp.brdf, &lead_sp.frame, lead_sp.wo);
                             Technique::TwoStage(&two_stage)
                         }
                         None => Technique::None,
@@ -238,7 +247,15 @@ fn pixel<'s>(
                     let mut vis =
                         CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
                     let sp_seed = hash_combine(seed, (h.index + 1) as u64);
-                    sum += integrator::shade(h.method, env, &h.sp, budget, sp_seed, &technique, &mut vis);
+                    sum += integrator::shade(
+                        h.method,
+                        env,
+                        &shading_point(scene, h),
+                        budget,
+                        sp_seed,
+                        &technique,
+                        &mut vis,
+                    );
                     stats[1] += vis.rays;
                 }
                 first += 1;
@@ -254,4 +271,13 @@ fn pixel<'s>(
         stats[3] += 1;
         [0.0; 3]
     }
+}
+
+/// The hit's shading point: its own BRDF if its material is textured, the material's otherwise.
+fn shading_point<'a>(scene: &'a Scene, h: &'a Hit) -> ShadingPoint<'a, dyn Brdf + 'a> {
+    let brdf = match &h.bsdf {
+        Some(b) => b.as_brdf(),
+        None => scene.materials[h.material].bsdf.as_brdf(),
+    };
+    ShadingPoint { frame: h.frame, wo: h.wo, brdf }
 }

@@ -3,7 +3,7 @@
 
 use crate::environment::{EnvSource, Placement};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
-use sampler_core::glam::Vec3;
+use sampler_core::glam::{Vec2, Vec3};
 
 /// A pinhole camera, the scene format's exact convention (see `camera.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,20 +31,45 @@ pub enum Shape {
         e2: Vec3,
     },
     /// Triangles (counter-clockwise front faces); optional per-corner shading normals
-    /// (empty: face normals).
+    /// (empty: face normals) and texture coordinates (empty: none).
     Mesh {
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
         normals: Vec<[Vec3; 3]>,
+        uvs: Vec<[Vec2; 3]>,
     },
 }
 
-/// A material: one of the core's BRDFs, one- or two-sided.
+/// A material: one of the core's BRDFs, one- or two-sided, optionally varying over the
+/// surface with textures (then `bsdf` is its value at the textures' means).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub bsdf: Bsdf,
     /// Seen from the back, a one-sided surface reflects nothing.
     pub twosided: bool,
+    pub texture: Option<TextureHandle>,
+}
+
+impl Material {
+    pub fn new(bsdf: Bsdf, twosided: bool) -> Self {
+        Self { bsdf, twosided, texture: None }
+    }
+}
+
+/// A material whose BRDF depends on texture coordinates.
+pub trait Textured: std::fmt::Debug + Send + Sync {
+    /// The BRDF at texture coordinate `st`.
+    fn bsdf_at(&self, st: Vec2) -> Bsdf;
+}
+
+/// A shared [`Textured`] material (equal when it is the same one).
+#[derive(Clone, Debug)]
+pub struct TextureHandle(pub std::sync::Arc<dyn Textured>);
+
+impl PartialEq for TextureHandle {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// The built-in BRDFs, by value (enum dispatch; each is a few floats).

@@ -209,7 +209,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     let m = Mat4::from_cols_array_2d(&m).transpose();
                     positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
                 }
-                (Shape::Mesh { positions, triangles, normals: Vec::new() }, material)
+                (Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() }, material)
             }
         };
         materials.push(material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?);
@@ -237,7 +237,7 @@ fn material_of(m: JsonMaterial) -> Result<Material, String> {
     };
     Ok(match m {
         JsonMaterial::Diffuse { albedo, twosided } => {
-            Material { bsdf: Bsdf::Diffuse(Lambert::new(colour("albedo", albedo)?)), twosided }
+            Material::new(Bsdf::Diffuse(Lambert::new(colour("albedo", albedo)?)), twosided)
         }
         JsonMaterial::Roughconductor { distribution, alpha, specular, twosided } => {
             if distribution != "ggx" {
@@ -246,13 +246,13 @@ fn material_of(m: JsonMaterial) -> Result<Material, String> {
             if !(alpha > 0.0 && alpha.is_finite()) {
                 return Err(format!("alpha must be > 0, got {alpha}"));
             }
-            Material { bsdf: Bsdf::Conductor(RoughConductor::new(alpha, colour("specular", specular)?)), twosided }
+            Material::new(Bsdf::Conductor(RoughConductor::new(alpha, colour("specular", specular)?)), twosided)
         }
         JsonMaterial::Phong { exponent, kd, ks, twosided } => {
             if !(exponent >= 0.0 && exponent.is_finite()) {
                 return Err(format!("exponent must be ≥ 0, got {exponent}"));
             }
-            Material { bsdf: Bsdf::Phong(Phong::new(colour("kd", kd)?, colour("ks", ks)?, exponent)), twosided }
+            Material::new(Bsdf::Phong(Phong::new(colour("kd", kd)?, colour("ks", ks)?, exponent)), twosided)
         }
         JsonMaterial::Carpaint { base, flake, flake_alpha, coat, coat_alpha, twosided } => {
             let d = CarPaint::default();
@@ -263,7 +263,7 @@ fn material_of(m: JsonMaterial) -> Result<Material, String> {
                 coat.unwrap_or(d.coat).max(0.0),
                 coat_alpha.unwrap_or(d.coat_ggx.alpha()),
             );
-            Material { bsdf: Bsdf::CarPaint(p), twosided }
+            Material::new(Bsdf::CarPaint(p), twosided)
         }
     })
 }

@@ -1,13 +1,15 @@
 //! USD scenes through host-usd: the imported plain data becomes the renderer's [`Scene`].
-//! Textures feeding a UsdPreviewSurface input are decoded and reduced to their mean (the
-//! tracer has no texture lookups yet); every reduction and skip is reported.
+//! Textures feeding a UsdPreviewSurface input (diffuse and specular colour, metallic,
+//! roughness) are decoded and looked up at each hit's texture coordinates; every skip is
+//! reported.
 
 use crate::env_io;
 use crate::environment::{EnvSource, Placement};
-use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
+use crate::texture::{ImageTexture, Wrap};
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor, microfacet::Ggx};
-use sampler_core::glam::{Mat3, Vec3};
+use sampler_core::glam::{Mat3, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -33,21 +35,89 @@ fn texture_name(resolved: &str) -> PathBuf {
     PathBuf::from(resolved.replace('[', "/").replace(']', ""))
 }
 
-/// The mean of a decoded texture's channel after the UsdUVTexture's scale and bias.
-fn texture_mean(t: &host_usd::Texture) -> Result<[f32; 3], String> {
-    let bytes = t.bytes.as_ref().map_err(Clone::clone)?;
-    let name = texture_name(t.resolved.as_deref().unwrap_or(&t.authored));
-    let image = env_io::load_bytes(&name, bytes).map_err(|e| e.to_string())?;
-    let mean = crate::resample::equal_area_mean(&image.texels);
-    let rgb: [f32; 3] = std::array::from_fn(|c| mean[c] as f32 * t.scale[c] + t.bias[c]);
-    Ok(match t.channel.as_str() {
-        "r" => [rgb[0]; 3],
-        "g" => [rgb[1]; 3],
-        "b" => [rgb[2]; 3],
-        // Alpha is not decoded: opaque.
-        "a" => [t.scale[3] + t.bias[3]; 3],
-        _ => rgb,
-    })
+/// Which of a texture's outputs an input reads.
+#[derive(Clone, Copy, Debug)]
+enum Channel {
+    Rgb,
+    One(usize),
+    /// Alpha is not decoded: the texture reads as opaque (1).
+    Alpha,
+}
+
+/// One textured input of a UsdPreviewSurface.
+#[derive(Debug)]
+struct Map {
+    input: TextureInput,
+    texture: ImageTexture,
+    scale: [f32; 4],
+    bias: [f32; 4],
+    channel: Channel,
+}
+
+impl Map {
+    fn decode(t: &host_usd::Texture) -> Result<Self, String> {
+        let bytes = t.bytes.as_ref().map_err(Clone::clone)?;
+        let src = &t.source;
+        let name = texture_name(src.resolved.as_deref().unwrap_or(&src.authored));
+        let srgb = match src.color_space.as_str() {
+            "raw" => Some(false),
+            "sRGB" => Some(true),
+            _ => None,
+        };
+        let image = env_io::load_bytes_as(&name, bytes, srgb).map_err(|e| e.to_string())?;
+        let channel = match src.channel.as_str() {
+            "r" => Channel::One(0),
+            "g" => Channel::One(1),
+            "b" => Channel::One(2),
+            "a" => Channel::Alpha,
+            _ => Channel::Rgb,
+        };
+        let wrap = [Wrap::from_usd(&src.wrap[0]), Wrap::from_usd(&src.wrap[1])];
+        Ok(Map { input: t.input, texture: ImageTexture { image, wrap }, scale: src.scale, bias: src.bias, channel })
+    }
+
+    /// The input's value from texel value `rgb`.
+    fn value(&self, rgb: [f32; 3]) -> [f32; 3] {
+        let v: [f32; 3] = std::array::from_fn(|c| rgb[c] * self.scale[c] + self.bias[c]);
+        match self.channel {
+            Channel::Rgb => v,
+            Channel::One(c) => [v[c]; 3],
+            Channel::Alpha => [self.scale[3] + self.bias[3]; 3],
+        }
+    }
+
+    fn apply(&self, m: &mut host_usd::Material, v: [f32; 3]) {
+        match self.input {
+            TextureInput::DiffuseColor => m.diffuse_color = Vec3::from_array(v),
+            TextureInput::SpecularColor => m.specular_color = Vec3::from_array(v),
+            TextureInput::Metallic => m.metallic = v[0],
+            TextureInput::Roughness => m.roughness = v[0],
+        }
+    }
+
+    /// The input's mean over the texture (for surfaces without texture coordinates).
+    fn mean(&self) -> [f32; 3] {
+        let mean = crate::resample::equal_area_mean(&self.texture.image.texels);
+        self.value(mean.map(|m| m as f32))
+    }
+}
+
+/// A UsdPreviewSurface whose inputs are read from textures at each hit.
+#[derive(Debug)]
+struct TexturedPreview {
+    base: host_usd::Material,
+    maps: Vec<Map>,
+}
+
+impl Textured for TexturedPreview {
+    fn bsdf_at(&self, st: Vec2) -> Bsdf {
+        let b = &self.base;
+        let mut m = host_usd::Material { name: String::new(), textures: Vec::new(), ..*b };
+        for map in &self.maps {
+            map.apply(&mut m, map.value(map.texture.eval(st)));
+        }
+        bsdf(&m.lobes())
+    }
 }
 
 /// The core BRDF for a UsdPreviewSurface's lobes: the cheapest one that represents them.
@@ -72,28 +142,34 @@ fn bsdf(l: &Lobes) -> Bsdf {
 /// Converts an imported USD scene.
 pub fn convert(mut usd: UsdScene) -> Converted {
     let mut notes: Vec<String> = usd.skipped.iter().map(|s| format!("{}: {}", s.path, s.what)).collect();
+    // Decode each material's textures; the material's plain BRDF is its value at their means.
+    let mut textured: Vec<Option<TextureHandle>> = Vec::with_capacity(usd.materials.len());
     for m in &mut usd.materials {
+        let mut maps = Vec::new();
         for t in std::mem::take(&mut m.textures) {
-            match texture_mean(&t) {
-                Ok(v) => {
-                    match t.input {
-                        TextureInput::DiffuseColor => m.diffuse_color = Vec3::from_array(v),
-                        TextureInput::SpecularColor => m.specular_color = Vec3::from_array(v),
-                        TextureInput::Metallic => m.metallic = v[0],
-                        TextureInput::Roughness => m.roughness = v[0],
-                    }
-                    notes.push(format!("{}: texture {} reduced to its mean {:?}", m.name, t.authored, v));
+            match Map::decode(&t) {
+                Ok(map) => maps.push(map),
+                Err(e) => {
+                    notes.push(format!("{}: texture {} not used ({e}); fallback value", m.name, t.source.authored))
                 }
-                Err(e) => notes.push(format!("{}: texture {} not used ({e}); fallback value", m.name, t.authored)),
             }
         }
+        for map in &maps {
+            let v = map.mean();
+            map.apply(m, v);
+        }
+        textured.push((!maps.is_empty()).then(|| {
+            let base = host_usd::Material { name: m.name.clone(), textures: Vec::new(), ..*m };
+            TextureHandle(Arc::new(TexturedPreview { base, maps }))
+        }));
     }
     // One renderer material per (USD material, sidedness).
     let mut materials = Vec::new();
     let mut index: HashMap<(usize, bool), usize> = HashMap::new();
     let mut material = |m: usize, twosided: bool| {
         *index.entry((m, twosided)).or_insert_with(|| {
-            materials.push(Material { bsdf: bsdf(&usd.materials[m].lobes()), twosided });
+            let texture = textured[m].clone();
+            materials.push(Material { bsdf: bsdf(&usd.materials[m].lobes()), twosided, texture });
             materials.len() - 1
         })
     };
@@ -103,8 +179,12 @@ pub fn convert(mut usd: UsdScene) -> Converted {
         objects.push(Object { shape, material: material(s.material, s.double_sided) });
     }
     for m in &usd.meshes {
-        let shape =
-            Shape::Mesh { positions: m.positions.clone(), triangles: m.triangles.clone(), normals: m.normals.clone() };
+        let shape = Shape::Mesh {
+            positions: m.positions.clone(),
+            triangles: m.triangles.clone(),
+            normals: m.normals.clone(),
+            uvs: m.uvs.clone(),
+        };
         objects.push(Object { shape, material: material(m.material, m.double_sided) });
     }
     let cam = usd.camera.clone().unwrap_or_else(|| host_usd::camera::framing((Vec3::splat(-1.0), Vec3::ONE)));

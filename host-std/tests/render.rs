@@ -62,7 +62,7 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material { bsdf: Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), twosided: false }],
+        materials: vec![Material::new(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), false)],
         env: None,
         hide_emitters: true,
     };

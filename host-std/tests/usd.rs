@@ -135,3 +135,26 @@ fn usd_errors_name_the_file_and_do_not_panic() {
     let e = usd_scene::load(&fixture("dome_y.usda"), Some("/Root/NoSuchCam".into())).err().unwrap().to_string();
     assert!(e.contains("/Root/NoSuchCam"), "{e}");
 }
+
+#[test]
+fn textures_are_looked_up_at_each_hit() {
+    // A quad with a 2×2 texture (red, green above blue, white; clamped), texture coordinates
+    // from the primvar the material names (`uv`), under a constant white dome.
+    let mut c = usd_scene::load(&fixture("uv_quad.usda"), None).unwrap();
+    assert!(c.notes.is_empty(), "{:?}", c.notes);
+    c.scene.camera.width = 40;
+    c.scene.camera.height = 30;
+    let (source, placement) = c.scene.env.clone().unwrap();
+    let env = Environment::build(&source, placement).unwrap();
+    let bvh = Bvh::build(&c.scene);
+    let settings =
+        Settings { method: Method::Auto, spp: 16, shading_points: 4, brdf_samples: 64, seed: 5, progress: false };
+    let image = render(&c.scene, &bvh, Some(&env.hierarchy()), &settings);
+    let at = |x: usize, y: usize| image.pixels[y * image.width + x];
+    let dominant = |p: [f32; 3], k: usize| (0..3).all(|j| j == k || p[k] > 3.0 * p[j]);
+    assert!(dominant(at(4, 4), 0), "top left is red: {:?}", at(4, 4));
+    assert!(dominant(at(35, 4), 1), "top right is green: {:?}", at(35, 4));
+    assert!(dominant(at(4, 25), 2), "bottom left is blue: {:?}", at(4, 25));
+    let white = at(35, 25);
+    assert!(white.iter().all(|&v| v > 0.6) && white[0] / white[2] < 1.2, "bottom right is white: {white:?}");
+}

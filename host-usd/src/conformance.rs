@@ -125,7 +125,7 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
             if !same {
                 mismatch(format!("{path}: faceVertexCounts differ from Pixar's {fvc}"));
             }
-            if let Err(e) = mesh::read(&stage, path) {
+            if let Err(e) = mesh::read(&stage, path, Some("st")) {
                 mismatch(format!("{path}: {e}"));
             }
         }

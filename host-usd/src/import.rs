@@ -254,14 +254,18 @@ impl Importer<'_> {
             self.scene.spheres.push(Sphere { path, center: c, radius: r, material, double_sided });
             return Ok(());
         }
+        // Per-face materials from GeomSubsets of the materialBind family.
+        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
         let local = if type_name == "Mesh" {
             self.scene.counts.meshes += 1;
-            mesh::read(stage, prim)?
+            // Texture coordinates only for a mesh whose materials read textures.
+            let uv = std::iter::once(material)
+                .chain(face_materials.iter().map(|f| f.1))
+                .find_map(|m| self.scene.materials[m].textures.first().map(|t| t.source.varname.clone()));
+            mesh::read(stage, prim, uv.as_deref())?
         } else {
             shapes::tessellate(stage, prim, type_name)?.unwrap_or_default()
         };
-        // Per-face materials from GeomSubsets of the materialBind family.
-        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
         let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
         for (i, &face) in local.faces.iter().enumerate() {
             let mat = face_materials.iter().find(|(faces, _)| faces.contains(&(face as i64))).map_or(material, |f| f.1);
@@ -370,15 +374,21 @@ fn transform(
     let mut positions = Vec::new();
     let mut triangles = Vec::with_capacity(which.len());
     let mut normals = Vec::new();
+    let mut uvs = Vec::new();
     for &i in which {
         let mut t = local.triangles[i];
         let mut n = local.normals.get(i).copied();
+        let mut uv = local.uvs.get(i).copied();
         if mirror {
             t.swap(1, 2);
             if let Some(n) = n.as_mut() {
                 n.swap(1, 2);
             }
+            if let Some(uv) = uv.as_mut() {
+                uv.swap(1, 2);
+            }
         }
+        uvs.extend(uv);
         let t = t.map(|v| {
             *remap.entry(v).or_insert_with(|| {
                 positions.push(m.transform_point3(local.positions[v as usize]).as_vec3());
@@ -393,8 +403,11 @@ fn transform(
     if normals.len() != triangles.len() {
         normals.clear();
     }
+    if uvs.len() != triangles.len() {
+        uvs.clear();
+    }
     if positions.iter().any(|p: &Vec3| !p.is_finite()) {
         return Err("a transformed point is not finite".into());
     }
-    Ok(Mesh { path: label.to_string(), positions, triangles, normals, material, double_sided })
+    Ok(Mesh { path: label.to_string(), positions, triangles, normals, uvs, material, double_sided })
 }

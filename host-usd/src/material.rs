@@ -3,7 +3,7 @@
 //! specularColor. GGX α = roughness²; the clear coat is a second GGX lobe (F0 = 0.04, α =
 //! clearcoatRoughness²). Unauthored inputs take the schema's fallbacks.
 
-use crate::stage::{Input, PreviewInputs, Stage};
+use crate::stage::{Input, PreviewInputs, Stage, TextureRef};
 use glam::Vec3;
 
 /// A UsdPreviewSurface's inputs, fallbacks applied.
@@ -37,14 +37,8 @@ pub enum TextureInput {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     pub input: TextureInput,
-    pub authored: String,
-    pub resolved: Option<String>,
+    pub source: TextureRef,
     pub bytes: Result<Vec<u8>, String>,
-    /// `inputs:scale` and `inputs:bias` (RGBA).
-    pub scale: [f32; 4],
-    pub bias: [f32; 4],
-    /// The output used: `rgb`, `r`, `g`, `b` or `a`.
-    pub channel: String,
 }
 
 /// The lobes the renderer builds.
@@ -99,7 +93,8 @@ impl Material {
         let mut notes: Vec<String> = inputs.unsupported.iter().map(|u| format!("{u} ignored")).collect();
         let v3 = |v: [f32; 3]| Vec3::from_array(v);
         let mut texture = |input: Option<TextureInput>, what: &str, i: &Input<()>| -> Option<Texture> {
-            let Input::Texture { authored, resolved, scale, bias, channel } = i else { return None };
+            let Input::Texture(source) = i else { return None };
+            let authored = &source.authored;
             let Some(input) = input else {
                 notes.push(format!("texture on {what} ignored"));
                 return None;
@@ -108,19 +103,11 @@ impl Material {
                 notes.push(format!("UDIM texture {authored} on {what} not supported; fallback value used"));
                 return None;
             }
-            let bytes = match resolved {
+            let bytes = match &source.resolved {
                 Some(r) => stage.read_asset(r).map_err(|e| format!("{r}: {e}")),
                 None => Err(format!("{authored}: texture not found")),
             };
-            Some(Texture {
-                input,
-                authored: authored.clone(),
-                resolved: resolved.clone(),
-                bytes,
-                scale: *scale,
-                bias: *bias,
-                channel: channel.clone(),
-            })
+            Some(Texture { input, source: source.clone(), bytes })
         };
         match inputs.diffuse_color {
             Input::Value(v) => m.diffuse_color = v3(v),
@@ -176,13 +163,7 @@ fn shape<T>(i: &Input<T>) -> Input<()> {
     match i {
         Input::Unset => Input::Unset,
         Input::Value(_) => Input::Value(()),
-        Input::Texture { authored, resolved, scale, bias, channel } => Input::Texture {
-            authored: authored.clone(),
-            resolved: resolved.clone(),
-            scale: *scale,
-            bias: *bias,
-            channel: channel.clone(),
-        },
+        Input::Texture(t) => Input::Texture(t.clone()),
     }
 }
 

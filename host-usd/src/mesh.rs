@@ -6,7 +6,7 @@
 
 use crate::primvar::Primvar;
 use crate::stage::{Stage, Value};
-use glam::DVec3;
+use glam::{DVec3, Vec2};
 
 /// A mesh in its prim's local space.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -18,6 +18,8 @@ pub struct LocalMesh {
     pub faces: Vec<u32>,
     /// Per-triangle corner normals, or empty.
     pub normals: Vec<[DVec3; 3]>,
+    /// Per-triangle corner texture coordinates, or empty.
+    pub uvs: Vec<[Vec2; 3]>,
     pub subdivision: bool,
 }
 
@@ -29,8 +31,8 @@ fn ints(v: Option<Value>, what: &str) -> Result<Vec<i64>, String> {
     }
 }
 
-/// Reads a Mesh prim.
-pub fn read(stage: &Stage, prim: &str) -> Result<LocalMesh, String> {
+/// Reads a Mesh prim, with texture coordinates from `primvars:<uv_primvar>` when asked.
+pub fn read(stage: &Stage, prim: &str, uv_primvar: Option<&str>) -> Result<LocalMesh, String> {
     let positions: Vec<DVec3> = match stage.value(prim, "points")? {
         None => Vec::new(),
         Some(Value::Numbers { values, shape: 3, .. }) => {
@@ -60,6 +62,13 @@ pub fn read(stage: &Stage, prim: &str) -> Result<LocalMesh, String> {
     let normals_pv =
         normals_pv.filter(|n| n.width == 3 && n.len() >= n.expected_len(counts.len(), indices.len(), positions.len()));
 
+    let uvs_pv = match uv_primvar {
+        Some(name) => Primvar::read(stage, prim, name, None)?,
+        None => None,
+    };
+    let uvs_pv =
+        uvs_pv.filter(|t| t.width == 2 && t.len() >= t.expected_len(counts.len(), indices.len(), positions.len()));
+
     let mut mesh = LocalMesh { positions, subdivision, ..LocalMesh::default() };
     let mut fv = 0usize;
     for (face, &count) in counts.iter().enumerate() {
@@ -84,6 +93,13 @@ pub fn read(stage: &Stage, prim: &str) -> Result<LocalMesh, String> {
                     n.element(e).map_or(DVec3::ZERO, |v| DVec3::new(v[0], v[1], v[2]))
                 };
                 mesh.normals.push(tri.map(corner_normal));
+            }
+            if let Some(t) = &uvs_pv {
+                let corner_uv = |c: usize| {
+                    let e = t.element_for(face, c, indices[c] as usize);
+                    t.element(e).map_or(Vec2::ZERO, |v| Vec2::new(v[0] as f32, v[1] as f32))
+                };
+                mesh.uvs.push(tri.map(corner_uv));
             }
         }
     }

@@ -2,7 +2,7 @@
 //! openusd types, so host-std converts it without knowing USD.
 
 pub use crate::material::{Lobes, Material, Texture, TextureInput};
-use glam::{DMat3, Vec3};
+use glam::{DMat3, Vec2, Vec3};
 use std::path::PathBuf;
 
 /// The stage's up axis. A Z-up stage is rotated once into the renderer's Y-up frame
@@ -25,6 +25,9 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Per-triangle corner shading normals, or empty for face normals.
     pub normals: Vec<[Vec3; 3]>,
+    /// Per-triangle corner texture coordinates (read only when a material on the mesh is
+    /// textured), or empty.
+    pub uvs: Vec<[Vec2; 3]>,
     pub material: usize,
     pub double_sided: bool,
 }

@@ -79,15 +79,28 @@ pub enum Input<T> {
     #[default]
     Unset,
     Value(T),
-    /// Connected to a UsdUVTexture: its `inputs:file`, resolved, and the texture's
-    /// `inputs:scale`/`inputs:bias` (per channel) and output channel (`rgb`, `r`, …).
-    Texture {
-        authored: String,
-        resolved: Option<String>,
-        scale: [f32; 4],
-        bias: [f32; 4],
-        channel: String,
-    },
+    /// Connected to a UsdUVTexture.
+    Texture(TextureRef),
+}
+
+/// A UsdUVTexture as a UsdPreviewSurface input sees it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TextureRef {
+    /// `inputs:file` as authored, and resolved against the layer that authored it.
+    pub authored: String,
+    pub resolved: Option<String>,
+    /// `inputs:scale` and `inputs:bias` (RGBA).
+    pub scale: [f32; 4],
+    pub bias: [f32; 4],
+    /// The output used: `rgb`, `r`, `g`, `b` or `a`.
+    pub channel: String,
+    /// The texture coordinate primvar (`inputs:varname` of the UsdPrimvarReader_float2 on
+    /// `inputs:st`; `st` when unconnected).
+    pub varname: String,
+    /// `inputs:wrapS`, `inputs:wrapT` (`black`, `clamp`, `repeat`, `mirror`, `useMetadata`).
+    pub wrap: [String; 2],
+    /// `inputs:sourceColorSpace` (`auto`, `raw`, `sRGB`).
+    pub color_space: String,
 }
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -376,13 +389,31 @@ impl Stage {
                     Ok(std::array::from_fn(|i| v.get(i).copied().unwrap_or(d) as f32))
                 };
                 if let Some(Value::Asset { authored, resolved }) = file_value {
-                    return Ok(Input::Texture {
+                    let token = |prim: &str, a: &str, d: &str| -> Result<String> {
+                        let v = match self.connection(prim, a)? {
+                            Some(p) => self.inner.attribute(p).get::<sdf::Value>().map_err(err)?.map(convert),
+                            None => self.value(prim, a)?,
+                        };
+                        Ok(v.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| d.to_string()))
+                    };
+                    // The st input reads a primvar through a UsdPrimvarReader_float2.
+                    let varname = match self.connection(&tex_prim, "inputs:st")? {
+                        Some(reader) => token(reader.prim_path().as_str(), "inputs:varname", "st")?,
+                        None => "st".into(),
+                    };
+                    return Ok(Input::Texture(TextureRef {
                         authored,
                         resolved,
                         scale: four("inputs:scale", 1.0)?,
                         bias: four("inputs:bias", 0.0)?,
                         channel,
-                    });
+                        varname,
+                        wrap: [
+                            token(&tex_prim, "inputs:wrapS", "useMetadata")?,
+                            token(&tex_prim, "inputs:wrapT", "useMetadata")?,
+                        ],
+                        color_space: token(&tex_prim, "inputs:sourceColorSpace", "auto")?,
+                    }));
                 }
                 return Ok(Input::Unset);
             }
@@ -411,9 +442,7 @@ fn map_input<T>(i: Input<Vec<f64>>, f: impl Fn(&[f64]) -> T) -> Input<T> {
     match i {
         Input::Unset => Input::Unset,
         Input::Value(v) => Input::Value(f(&v)),
-        Input::Texture { authored, resolved, scale, bias, channel } => {
-            Input::Texture { authored, resolved, scale, bias, channel }
-        }
+        Input::Texture(t) => Input::Texture(t),
     }
 }
 

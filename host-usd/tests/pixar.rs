@@ -89,7 +89,7 @@ fn usdz_texture_and_dome_are_read_from_inside_the_package() {
     let m = scene.materials.iter().find(|m| m.name == "/Root/Looks/Tex").unwrap();
     let t = &m.textures[0];
     assert_eq!(t.input, host_usd::TextureInput::DiffuseColor);
-    assert_eq!(t.scale, [0.5, 0.5, 0.5, 1.0]);
+    assert_eq!(t.source.scale, [0.5, 0.5, 0.5, 1.0]);
     assert_eq!(&t.bytes.as_ref().unwrap()[1..4], b"PNG");
     assert!(scene.camera.as_ref().is_some_and(|c| c.path == "/Root/Cam" && c.focal_length == 35.0));
 }

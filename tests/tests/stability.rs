@@ -56,7 +56,7 @@ fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material { bsdf, twosided: false }],
+        materials: vec![Material::new(bsdf, false)],
         env: None,
         hide_emitters: true,
     }
@@ -194,10 +194,11 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
                         positions: positions.clone(),
                         triangles: triangles.clone(),
                         normals: Vec::new(),
+                        uvs: Vec::new(),
                     },
                     material: 0,
                 }],
-                materials: vec![Material { bsdf: bsdf.clone(), twosided: false }],
+                materials: vec![Material::new(bsdf.clone(), false)],
                 env: None,
                 hide_emitters: true,
             };
