@@ -321,15 +321,35 @@ impl Importer<'_> {
     /// The index of the material bound to `prim` (imported on first use), or of a fallback.
     fn material_for(&mut self, prim: &str) -> Result<usize, String> {
         let bound = self.stage.bound_material(prim)?;
-        let key = match &bound {
-            Some(m) => m.clone(),
-            None => "<fallback>".to_string(),
+        // Unbound gprims show their displayColor (its mean over the elements), as viewers do.
+        let display = match &bound {
+            Some(_) => None,
+            None => crate::primvar::Primvar::read(self.stage, prim, "displayColor", None)?
+                .filter(|p| p.width == 3 && !p.is_empty())
+                .map(|p| {
+                    let n = p.len();
+                    let sum = (0..n)
+                        .filter_map(|i| p.element(i))
+                        .fold([0.0; 3], |a, e| [a[0] + e[0], a[1] + e[1], a[2] + e[2]]);
+                    Vec3::new((sum[0] / n as f64) as f32, (sum[1] / n as f64) as f32, (sum[2] / n as f64) as f32)
+                }),
+        };
+        let key = match (&bound, display) {
+            (Some(m), _) => m.clone(),
+            (None, Some(c)) => format!("<displayColor {} {} {}>", c.x, c.y, c.z),
+            (None, None) => "<fallback>".to_string(),
         };
         if let Some(&i) = self.materials.get(&key) {
             return Ok(i);
         }
         let material = match &bound {
-            None => Material::fallback(&key),
+            None => {
+                let mut m = Material::fallback(&key);
+                if let Some(c) = display {
+                    m.diffuse_color = c;
+                }
+                m
+            }
             Some(path) => match self.stage.surface_shader(path)? {
                 Some((shader, id)) if id == "UsdPreviewSurface" => {
                     let (m, notes) = Material::read(self.stage, path, &shader)?;

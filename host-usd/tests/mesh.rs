@@ -110,3 +110,13 @@ fn bad_topology_is_an_error_naming_the_prim() {
     let e = host_usd::load(&file).unwrap_err().to_string();
     assert!(e.contains("bad.usda") && e.contains("/Broken") && e.contains("40"), "{e}");
 }
+
+#[test]
+fn unbound_gprims_show_their_display_color() {
+    let s = import(&format!(
+        "def Mesh \"Red\" {{{QUADS}\n    color3f[] primvars:displayColor = [(0.8, 0.1, 0.1)] (interpolation = \"constant\")\n}}\ndef Mesh \"Plain\" {{{QUADS}\n}}"
+    ));
+    let name = |path: &str| &s.materials[s.meshes.iter().find(|m| m.path == path).unwrap().material];
+    assert!((name("/Red").diffuse_color - Vec3::new(0.8, 0.1, 0.1)).length() < 1e-6);
+    assert_eq!(name("/Plain").diffuse_color, Vec3::splat(0.18));
+}
