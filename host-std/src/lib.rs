@@ -17,4 +17,6 @@ pub mod scene_json;
 pub mod sky;
 pub mod texture;
 #[cfg(feature = "usd")]
+pub mod usd_info;
+#[cfg(feature = "usd")]
 pub mod usd_scene;
