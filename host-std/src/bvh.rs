@@ -133,6 +133,8 @@ struct Node {
     offset: u32,
     /// Primitives in a leaf; 0 for an inner node.
     count: u32,
+    /// Inner node: the split axis (its first child holds the lower side).
+    axis: u8,
 }
 
 /// Where a ray hit.
@@ -226,7 +228,7 @@ impl Bvh {
     ) -> usize {
         let bounds = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| b.union(info[i].0));
         let index = self.nodes.len();
-        self.nodes.push(Node { bounds, offset: lo as u32, count: (hi - lo) as u32 });
+        self.nodes.push(Node { bounds, offset: lo as u32, count: (hi - lo) as u32, axis: 0 });
         if hi - lo <= 4 {
             return index;
         }
@@ -282,6 +284,7 @@ impl Bvh {
         let right = self.build_node(info, order, mid, hi, depth + 1);
         self.nodes[index].offset = right as u32;
         self.nodes[index].count = 0;
+        self.nodes[index].axis = axis as u8;
         index
     }
 
@@ -294,7 +297,7 @@ impl Bvh {
     pub fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
         let mut best: Option<usize> = None;
         let mut t_max = t_max;
-        self.traverse(o, d, &mut t_max, |prim, t_max| {
+        self.traverse(o, d, &mut t_max, true, |prim, t_max| {
             if let Some(t) = self.prims[prim].intersect(o, d, t_min, *t_max) {
                 *t_max = t;
                 best = Some(prim);
@@ -339,7 +342,7 @@ impl Bvh {
     pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
         let mut hit = false;
         let mut t_max = t_max;
-        self.traverse(o, d, &mut t_max, |prim, t_max| {
+        self.traverse(o, d, &mut t_max, false, |prim, t_max| {
             hit = self.prims[prim].intersect(o, d, t_min, *t_max).is_some();
             hit
         });
@@ -349,7 +352,14 @@ impl Bvh {
     /// Visits the primitives of every leaf the ray's box test lets through; `visit` may shrink
     /// `t_max` and returns true to stop.
     #[inline]
-    fn traverse(&self, o: Vec3, d: Vec3, t_max: &mut f32, mut visit: impl FnMut(usize, &mut f32) -> bool) {
+    fn traverse(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: &mut f32,
+        near_first: bool,
+        mut visit: impl FnMut(usize, &mut f32) -> bool,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -370,11 +380,17 @@ impl Bvh {
                     }
                 }
             } else {
-                // Second child below, first child on top (visited next). The build bounds the
-                // depth (median splits past depth 40), so the stack cannot overflow.
+                // The near child on top (visited next): the first child holds the lower side of
+                // the split axis. The build bounds the depth (median splits past depth 40), so
+                // the stack cannot overflow.
                 debug_assert!(sp + 2 <= stack.len());
-                stack[sp] = node.offset;
-                stack[sp + 1] = index + 1;
+                let (near, far) = if (d[node.axis as usize] < 0.0) == near_first {
+                    (node.offset, index + 1)
+                } else {
+                    (index + 1, node.offset)
+                };
+                stack[sp] = far;
+                stack[sp + 1] = near;
                 sp += 2;
             }
         }
