@@ -215,3 +215,42 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
         }
     }
 }
+
+#[test]
+fn views_down_to_n_dot_v_1e_6_shade_finite_values() {
+    // A long floor seen from just above it through a very narrow lens: every primary ray meets
+    // it at n·v = 1e-3 or 1e-6 (± 1e-6; camera 4e-3 or 4e-6 above the plane, 4 away).
+    let env = env_from("sky+sun", 64, |x, y| if (x, y) == (40, 20) { [1e6; 3] } else { [0.3, 0.5, 1.0] });
+    for (name, bsdf) in materials() {
+        for height in [4e-3f32, 4e-6] {
+            let scene = Scene {
+                name: "floor".into(),
+                camera: CameraSpec {
+                    origin: Vec3::new(0.0, -4.0, height),
+                    target: Vec3::ZERO,
+                    up: Vec3::Z,
+                    fov_y_deg: 1e-4,
+                    width: 5,
+                    height: 5,
+                    near_clip: 1e-6,
+                },
+                objects: vec![Object {
+                    shape: Shape::Rectangle {
+                        p0: Vec3::new(-50.0, -3.99, 0.0),
+                        e1: Vec3::new(100.0, 0.0, 0.0),
+                        e2: Vec3::new(0.0, 1000.0, 0.0),
+                    },
+                    material: 0,
+                }],
+                materials: vec![Material::new(bsdf.clone(), false)],
+                env: None,
+                hide_emitters: true,
+            };
+            for method in Method::ALL {
+                let r = run(&scene, &env, method, 4, 64);
+                assert_eq!(r.shading_points, r.camera_rays, "{name} / {height} / {method}: a ray missed the floor");
+                assert!(all_finite(&r), "{name} / n·v {} / {method}", height / 4.0);
+            }
+        }
+    }
+}
