@@ -61,8 +61,11 @@ fn lights() -> Vec<Light> {
     };
     let (sun_env, sun) = with_sun(9, (300, 170), 1e6);
     let (pole_env, pole) = with_sun(9, (256, 256), 1e6);
+    // Full resolution: a 1e7× one-texel sun in a 4096² map (the texel subtends 7.5e-7 sr).
+    let (big_env, big) = with_sun(12, (2400, 1360), 1e7);
     vec![
         Light { name: "sun 1e6 (512²)", env: sun_env, sun },
+        Light { name: "sun 1e7 (4096²)", env: big_env, sun: big },
         Light { name: "sun on +z pole", env: pole_env, sun: pole },
         Light { name: "constant", env: TestEnv::constant(4, 1.0), sun: None },
         Light { name: "2×2", env: TestEnv::new(1, vec![[4.0; 3], [0.5; 3], [0.0; 3], [1.0; 3]]), sun: None },
