@@ -65,7 +65,10 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     };
     let sat = sat.as_deref();
     // `auto` resolves per material once, knowing how peaked the lighting is.
-    let env_peak = env.map_or(f32::MAX, |e| e.peak(5));
+    let env_peak = match (env, settings.method) {
+        (Some(e), Method::Auto) => e.peak(5),
+        _ => f32::MAX,
+    };
     let methods: Vec<Method> =
         scene.materials.iter().map(|m| settings.method.for_material(&m.bsdf, env_peak)).collect();
     let camera = Camera::new(&scene.camera);

@@ -274,12 +274,14 @@ impl Importer<'_> {
         let mut keys: Vec<usize> = groups.keys().copied().collect();
         keys.sort_unstable();
         let m3 = DMat3::from_mat4(*m);
-        if !(m3.determinant().is_finite() && m3.determinant() != 0.0) {
+        let det = m3.determinant();
+        if !(det.is_finite() && det != 0.0) {
             self.skip(label, "its world transform is singular (the gprim has no area)");
             return Ok(());
         }
+        let normal_matrix = m3.inverse().transpose();
         for mat in keys {
-            let mesh = transform(&local, &groups[&mat], m, label, mat, double_sided)?;
+            let mesh = transform(&local, &groups[&mat], m, &normal_matrix, det < 0.0, label, mat, double_sided)?;
             self.scene.counts.triangles += mesh.triangles.len();
             for &p in &mesh.positions {
                 self.grow(p);
@@ -373,23 +375,19 @@ impl Importer<'_> {
     }
 }
 
-/// The triangles `which` of a local mesh, transformed by `m` (normals by its inverse
-/// transpose; winding reversed when `m` mirrors).
+/// The triangles `which` of a local mesh, transformed by `m` (non-singular; normals by
+/// `normal_matrix`, its inverse transpose; winding reversed when it `mirror`s).
+#[allow(clippy::too_many_arguments)]
 fn transform(
     local: &LocalMesh,
     which: &[usize],
     m: &DMat4,
+    normal_matrix: &DMat3,
+    mirror: bool,
     label: &str,
     material: usize,
     double_sided: bool,
 ) -> Result<Mesh, String> {
-    let m3 = DMat3::from_mat4(*m);
-    let det = m3.determinant();
-    if !det.is_finite() || det == 0.0 {
-        return Err(format!("the world transform is singular (determinant {det})"));
-    }
-    let normal_matrix = m3.inverse().transpose();
-    let mirror = det < 0.0;
     let mut remap: HashMap<u32, u32> = HashMap::new();
     let mut positions = Vec::new();
     let mut triangles = Vec::with_capacity(which.len());
@@ -417,7 +415,7 @@ fn transform(
         });
         triangles.push(t);
         if let Some(n) = n {
-            normals.push(n.map(|n| (normal_matrix * n).normalize_or_zero().as_vec3()));
+            normals.push(n.map(|n| (*normal_matrix * n).normalize_or_zero().as_vec3()));
         }
     }
     if normals.len() != triangles.len() {

@@ -34,7 +34,6 @@ impl Value {
     pub fn numbers(&self) -> Option<&[f64]> {
         match self {
             Value::Numbers { values, .. } => Some(values),
-            Value::Bool(_) => None,
             _ => None,
         }
     }
@@ -368,6 +367,15 @@ impl Stage {
         Ok(connected)
     }
 
+    /// The value of `prim.attr`, or of the attribute its connections end at (an interface
+    /// input of a Material or NodeGraph).
+    fn connected_value(&self, prim: &str, attr: &str) -> Result<Option<Value>> {
+        match self.connection(prim, attr)? {
+            Some(p) => Ok(self.inner.attribute(p).get::<sdf::Value>().map_err(err)?.map(convert)),
+            None => self.value(prim, attr),
+        }
+    }
+
     /// One shader input: its authored value (numbers with `n` components), or the texture
     /// it is connected to.
     fn input(&self, shader: &str, name: &str, n: usize) -> Result<Input<Vec<f64>>> {
@@ -378,11 +386,7 @@ impl Stage {
             let channel = source.name().unwrap_or_default().trim_start_matches("outputs:").to_string();
             let id = self.value(&tex_prim, "info:id")?.and_then(|v| v.token().map(str::to_string));
             if id.as_deref() == Some("UsdUVTexture") {
-                let file = self.connection(&tex_prim, "inputs:file")?;
-                let file_value = match file {
-                    Some(p) => self.inner.attribute(p).get::<sdf::Value>().map_err(err)?.map(convert),
-                    None => self.value(&tex_prim, "inputs:file")?,
-                };
+                let file_value = self.connected_value(&tex_prim, "inputs:file")?;
                 let four = |a: &str, d: f64| -> Result<[f32; 4]> {
                     let v = self.value(&tex_prim, a)?.and_then(|v| v.numbers().map(<[f64]>::to_vec));
                     let v = v.unwrap_or_default();
@@ -390,10 +394,7 @@ impl Stage {
                 };
                 if let Some(Value::Asset { authored, resolved }) = file_value {
                     let token = |prim: &str, a: &str, d: &str| -> Result<String> {
-                        let v = match self.connection(prim, a)? {
-                            Some(p) => self.inner.attribute(p).get::<sdf::Value>().map_err(err)?.map(convert),
-                            None => self.value(prim, a)?,
-                        };
+                        let v = self.connected_value(prim, a)?;
                         Ok(v.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| d.to_string()))
                     };
                     // The st input reads a primvar through a UsdPrimvarReader_float2.
@@ -417,14 +418,9 @@ impl Stage {
                 }
                 return Ok(Input::Unset);
             }
-            // Connected to an interface input or a primvar reader with a value: read it there.
-            let v = self.inner.attribute(source).get::<sdf::Value>().map_err(err)?.map(convert);
-            return Ok(match v.as_ref().and_then(Value::numbers) {
-                Some(v) if v.len() >= n => Input::Value(v.to_vec()),
-                _ => Input::Unset,
-            });
         }
-        Ok(match self.value(shader, &attr)?.as_ref().and_then(Value::numbers) {
+        // Authored here, or on the interface input it is connected to.
+        Ok(match self.connected_value(shader, &attr)?.as_ref().and_then(Value::numbers) {
             Some(v) if v.len() >= n => Input::Value(v.to_vec()),
             _ => Input::Unset,
         })
