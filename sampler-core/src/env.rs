@@ -340,7 +340,15 @@ impl<'a> EnvHierarchy<'a> {
     #[inline]
     #[must_use]
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let (x, y) = self.texel_at(self.square_of(dir));
+        self.radiance_at(self.square_of(dir))
+    }
+
+    /// RGB radiance at a point of the square (nearest texel): for samplers that drew the point,
+    /// no round trip through the direction.
+    #[inline]
+    #[must_use]
+    pub fn radiance_at(&self, uv: Vec2) -> Vec3 {
+        let (x, y) = self.texel_at(uv);
         self.radiance_texel(x, y)
     }
 

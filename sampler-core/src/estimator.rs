@@ -6,6 +6,7 @@
 use crate::brdf::Brdf;
 use crate::env::EnvHierarchy;
 use crate::frame::Frame;
+use crate::mapping::SPHERE_AREA;
 use crate::sampler::ProductSampler;
 use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
@@ -89,7 +90,7 @@ pub fn product<B: Brdf + ?Sized>(
     let Some(s) = sampler.sample(u) else {
         return Contribution::default();
     };
-    let f = times(sampler.env().radiance(s.dir), sp.eval(s.dir));
+    let f = times(sampler.env().radiance_at(s.uv), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
@@ -103,7 +104,7 @@ pub fn env<B: Brdf + ?Sized>(
     let Some(s) = env.sample(u) else {
         return Contribution::default();
     };
-    let f = times(env.radiance(s.dir), sp.eval(s.dir));
+    let f = times(env.radiance_at(s.uv), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
@@ -132,8 +133,8 @@ pub fn mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let drawn = env_h.sample(u_env).map(|s| (s.dir, s.pdf));
-    mis_with_brdf(env_h, sp, drawn, |d| env_h.pdf(d), u_brdf, vis)
+    let drawn = env_h.sample(u_env).map(|s| (s.dir, s.uv, s.pdf));
+    mis_with_brdf(env_h, sp, drawn, |uv| env_h.pdf_square(uv), u_brdf, vis)
 }
 
 /// MIS of product sampling and BRDF sampling, balance heuristic, one sample each: the product
@@ -147,30 +148,32 @@ pub fn product_mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let drawn = sampler.sample(u_product).map(|s| (s.dir, s.pdf));
-    mis_with_brdf(sampler.env(), sp, drawn, |d| sampler.pdf(d), u_brdf, vis)
+    let drawn = sampler.sample(u_product).map(|s| (s.dir, s.uv, s.pdf));
+    mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
 }
 
-/// Balance-heuristic MIS of one direction `drawn` by a technique whose density is `pdf`, and
-/// one BRDF sample.
+/// Balance-heuristic MIS of one direction `drawn` (direction, point of the square, density) by
+/// a technique whose density per unit square area is `pdf_square`, and one BRDF sample. The
+/// BRDF sample's point of the square is computed once, for its radiance and the other density.
 fn mis_with_brdf<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
-    drawn: Option<(Vec3, f32)>,
-    pdf: impl Fn(Vec3) -> f32,
+    drawn: Option<(Vec3, Vec2, f32)>,
+    pdf_square: impl Fn(Vec2) -> f32,
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
     let mut out = [Contribution::default(); 2];
-    if let Some((dir, p)) = drawn {
+    if let Some((dir, uv, p)) = drawn {
         let p_brdf = sp.brdf_pdf(dir);
-        let f = times(env_h.radiance(dir), sp.eval(dir));
+        let f = times(env_h.radiance_at(uv), sp.eval(dir));
         out[0] = Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf };
     }
     if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
         let dir = sp.frame.to_world(s.wi);
-        let p_other = pdf(dir);
-        let f = times(env_h.radiance(dir), s.value);
+        let uv = env_h.square_of(dir);
+        let p_other = pdf_square(uv) / SPHERE_AREA;
+        let f = times(env_h.radiance_at(uv), s.value);
         out[1] = Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other };
     }
     out

@@ -12,6 +12,10 @@ use host_std::{default_scene, output, scene_json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// Largest visibility-sample count per pixel accepted (2^26: converging single techniques on
+/// sharp highlights takes millions; pixel counters are u64, per-point indices u32).
+const MAX_SPP: i64 = 1 << 26;
+
 #[derive(Parser)]
 #[command(
     name = "ppis",
@@ -42,13 +46,13 @@ struct ReportArgs {
     #[arg(long, default_value = "product,env,brdf,mis,product-mis,ris,two-stage,auto", value_delimiter = ',', value_parser = parse_method)]
     methods: Vec<Method>,
     /// Comma-separated visibility samples per pixel.
-    #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     spp: Vec<u32>,
     /// Reference image (linear EXR of the same size); otherwise one is rendered.
     #[arg(long, conflicts_with = "reference_spp")]
     reference: Option<PathBuf>,
     /// Visibility samples per pixel of the rendered reference.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     reference_spp: u32,
     /// Visibility samples per shading point: primary rays per pixel then grow as spp / V
     /// (instead of the fixed --shading-points), so the pixel-footprint integration converges too.
@@ -92,7 +96,7 @@ struct RenderArgs {
     #[arg(long, default_value = "product", value_parser = parse_method)]
     method: Method,
     /// Visibility samples (shadow rays) per pixel.
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     spp: u32,
     #[command(flatten)]
     sampling: SamplingArgs,

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Converge the single techniques (env, brdf, two-stage) against Mitsuba 3 where 4096 samples per
+# pixel at 256×256 are not enough (docs/stability.md). The same scenes at a lower resolution
+# (same camera, box-filtered over larger pixels) cost fewer samples in all, so each pixel can get
+# 10⁵–10⁶ of them. Needs what docs/compare_all.sh needs.
+# Usage: docs/converge_single.sh OUT_DIR [RES] [SPP] [SCENE...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:?output folder}"
+res="${2:-32}"
+spp="${3:-1048576}"
+shift $(($# < 3 ? $# : 3))
+scenes=("$@")
+if [ ${#scenes[@]} -eq 0 ]; then
+    scenes=(../shared/scenes/s1_forest_spheres.json ../shared/scenes/s2_courtyard_glossy.json
+            ../shared/scenes/s3_sunset_sharp.json docs/scenes/sharp_sun.json)
+fi
+methods=(${METHODS:-env brdf two-stage})
+mkdir -p "$out"
+python3 docs/scenes/make_scenes.py > /dev/null
+cargo build --release -p host-std --bin ppis
+for scene in "${scenes[@]}"; do
+    name="$(basename "$scene" .json)_${res}"
+    # The scene at RES×RES, its map path made absolute so the copy can live in OUT_DIR.
+    python3 - "$scene" "$res" "$out/$name.json" <<'PY'
+import json, os, sys
+src, res, dst = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+scene = json.load(open(src))
+scene["camera"]["width"] = scene["camera"]["height"] = res
+env = scene["envmap"]["file"]
+scene["envmap"]["file"] = os.path.abspath(os.path.join(os.path.dirname(src), env))
+json.dump(scene, open(dst, "w"), indent=1)
+PY
+    if [ ! -f "$out/${name}_mts.exr" ]; then
+        python3 ../shared/reference/mitsuba_ref.py "$out/$name.json" --spp "$spp" --passes 4 \
+            --out "$out/${name}_mts.exr" --stderr-out "$out/${name}_mts_se.exr" \
+            --coverage-out "$out/${name}_cov.exr" | tail -1
+    fi
+    for m in "${methods[@]}"; do
+        "${PPIS:-./target/release/ppis}" render "$out/$name.json" --method "$m" --spp "$spp" \
+            --shading-points 1024 -o "$out/${name}_$m.exr" 2>&1 | tail -1 | sed 's/; wrote.*//'
+        printf '%s %s: ' "$name" "$m"
+        python3 docs/compare_mitsuba.py "$out/${name}_$m.exr" "$out/${name}_mts.exr" \
+            "$out/${name}_cov.exr" "$out/${name}_mts_se.exr" | tr '\n' ' '
+        echo
+    done
+done
