@@ -1,5 +1,5 @@
 //! The stability cases through the renderer with their variance and time (issue 5): every
-//! method × every material of the suite × four lightings, each rendered with 16 seeds. Writes
+//! method × every material of the suite × five lightings, each rendered with 16 seeds. Writes
 //! `target/stability_render_table.md` (copied to docs/reports/). Asserts: no non-finite pixel;
 //! the white furnace (Lambert ρ = 1 under a constant map) within 3 SE of the analytic 1 for
 //! every method; ρ = 0 exactly black; every method's mean within 5 SE of a high-spp MIS
@@ -125,6 +125,12 @@ fn every_case_through_the_renderer_with_its_variance_and_time() {
             "1e6× one-texel sun, 1024² sky",
             env_from("sun", n, |x, y| {
                 if (x, y) == (700, 300) { [1e6; 3] } else { [0.3 + 0.5 * y as f32 / n as f32, 0.5, 0.8] }
+            }),
+        ),
+        (
+            "1e7× one-texel sun, 4096² sky",
+            env_from("sun4k", 4096, |x, y| {
+                if (x, y) == (2900, 1300) { [1e7; 3] } else { [0.3 + 0.5 * y as f32 / 4096.0, 0.5, 0.8] }
             }),
         ),
         (
