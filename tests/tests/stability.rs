@@ -1,45 +1,16 @@
-//! End-to-end stability on extreme inputs (issue 5, first slice): every method renders without
+//! End-to-end stability on extreme inputs (issue 5): every method renders without
 //! panic and without a non-finite value, and where the answer is analytic it is met.
 
+mod common;
+
+use common::{env_from, materials};
 use glam::Vec3;
 use host_std::bvh::Bvh;
-use host_std::environment::{EnvSource, Environment, Placement};
+use host_std::environment::Environment;
 use host_std::integrator::Method;
 use host_std::render::{Rendered, Settings, render};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
-use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
-use std::path::PathBuf;
-
-fn scratch() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ppis-stability-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Writes an equal-area `n`×`n` EXR whose texel (x, y) is `f(x, y)`, and builds it.
-fn env_from(name: &str, n: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) -> Environment {
-    let path = scratch().join(format!("{name}.exr"));
-    exr::prelude::write_rgb_file(&path, n, n, |x, y| {
-        let c = f(x, y);
-        (c[0], c[1], c[2])
-    })
-    .unwrap();
-    Environment::build(&EnvSource::File(path), Placement::default()).unwrap()
-}
-
-fn materials() -> Vec<(&'static str, Bsdf)> {
-    vec![
-        ("lambert ρ=1", Bsdf::Diffuse(Lambert::new(Vec3::ONE))),
-        ("lambert ρ=0", Bsdf::Diffuse(Lambert::new(Vec3::ZERO))),
-        ("ggx α=1e-4", Bsdf::Conductor(RoughConductor::new(1e-4, Vec3::ONE))),
-        ("ggx α=1e-3", Bsdf::Conductor(RoughConductor::new(1e-3, Vec3::ONE))),
-        ("ggx α=1", Bsdf::Conductor(RoughConductor::new(1.0, Vec3::ONE))),
-        ("phong n=1", Bsdf::Phong(Phong::new(Vec3::splat(0.3), Vec3::splat(0.6), 1.0))),
-        ("phong n=1e4", Bsdf::Phong(Phong::new(Vec3::ZERO, Vec3::ONE, 1e4))),
-        ("phong n=1e6", Bsdf::Phong(Phong::new(Vec3::ZERO, Vec3::ONE, 1e6))),
-        ("carpaint", Bsdf::CarPaint(CarPaint::default())),
-    ]
-}
+use sampler_core::brdf::Lambert;
 
 /// A unit sphere of `bsdf` alone, seen from `dir` (8×8 pixels, the sphere fills the frame).
 fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {

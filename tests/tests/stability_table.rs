@@ -6,44 +6,20 @@
 //! reference (single techniques only from above: a missed sun or needle lobe reads low until
 //! found, see docs/stability.md).
 
+mod common;
+
+use common::{env_from, materials};
 use glam::Vec3;
 use host_std::bvh::Bvh;
-use host_std::environment::{EnvSource, Environment, Placement};
+use host_std::environment::Environment;
 use host_std::integrator::Method;
 use host_std::render::{Settings, render};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use rayon::prelude::*;
-use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 use std::fmt::Write;
 
 const SEEDS: u64 = 16;
 const SPP: usize = 32;
-
-fn env_from(name: &str, n: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) -> Environment {
-    let dir = std::env::temp_dir().join(format!("ppis-stability-table-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.exr"));
-    exr::prelude::write_rgb_file(&path, n, n, |x, y| {
-        let c = f(x, y);
-        (c[0], c[1], c[2])
-    })
-    .unwrap();
-    Environment::build(&EnvSource::File(path), Placement::default()).unwrap()
-}
-
-fn materials() -> Vec<(&'static str, Bsdf)> {
-    vec![
-        ("lambert ρ=1", Bsdf::Diffuse(Lambert::new(Vec3::ONE))),
-        ("lambert ρ=0", Bsdf::Diffuse(Lambert::new(Vec3::ZERO))),
-        ("ggx α=1e-4", Bsdf::Conductor(RoughConductor::new(1e-4, Vec3::ONE))),
-        ("ggx α=1e-3", Bsdf::Conductor(RoughConductor::new(1e-3, Vec3::ONE))),
-        ("ggx α=1", Bsdf::Conductor(RoughConductor::new(1.0, Vec3::ONE))),
-        ("phong n=1", Bsdf::Phong(Phong::new(Vec3::splat(0.3), Vec3::splat(0.6), 1.0))),
-        ("phong n=1e4", Bsdf::Phong(Phong::new(Vec3::ZERO, Vec3::ONE, 1e4))),
-        ("phong n=1e6", Bsdf::Phong(Phong::new(Vec3::ZERO, Vec3::ONE, 1e6))),
-        ("carpaint", Bsdf::CarPaint(CarPaint::default())),
-    ]
-}
 
 /// A unit sphere filling an 8×8 frame, seen from a direction that is none of the mapping's
 /// special ones (so its normals sweep a whole hemisphere of the map).
