@@ -197,10 +197,11 @@ pub fn ris<B: Brdf + ?Sized>(
     let mut total = 0.0f64;
     let mut chosen: Option<(Vec3, DVec3, f64, f32)> = None; // (dir, f, target, source pdf)
     for c in candidates {
-        let (dir, source) = if c.x < 0.5 {
+        // (direction, its point of the square, mixture density)
+        let (dir, uv, source) = if c.x < 0.5 {
             let u = DVec2::new(2.0 * c.x, c.y);
             match env_h.sample(u) {
-                Some(s) => (s.dir, 0.5 * (s.pdf + sp.brdf_pdf(s.dir))),
+                Some(s) => (s.dir, s.uv, 0.5 * (s.pdf + sp.brdf_pdf(s.dir))),
                 None => continue,
             }
         } else {
@@ -208,12 +209,13 @@ pub fn ris<B: Brdf + ?Sized>(
             match sp.brdf.sample(wo_local, u) {
                 Some(s) => {
                     let dir = sp.frame.to_world(s.wi);
-                    (dir, 0.5 * (s.pdf + env_h.pdf(dir)))
+                    let uv = env_h.square_of(dir);
+                    (dir, uv, 0.5 * (s.pdf + env_h.pdf_square(uv) / SPHERE_AREA))
                 }
                 None => continue,
             }
         };
-        let f = times(env_h.radiance(dir), sp.eval(dir));
+        let f = times(env_h.radiance_at(uv), sp.eval(dir));
         let target = luminance64(f);
         if !(target > 0.0 && source > 0.0 && target.is_finite()) {
             continue;
@@ -245,6 +247,6 @@ pub fn two_stage<B: Brdf + ?Sized, const R: usize>(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let Some(s) = sampler.sample(u) else { return Contribution::default() };
-    let f = times(env_h.radiance(s.dir), sp.eval(s.dir));
+    let f = times(env_h.radiance_at(s.uv), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
