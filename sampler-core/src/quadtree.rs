@@ -4,7 +4,8 @@
 //! * Points are quantised to 24 bits per axis and sorted by Morton code, so every node is a
 //!   contiguous run of samples and its four children split that run by the next two bits.
 //! * A leaf with samples takes the mean of their B·cos (luminance) — one sample unless the depth
-//!   cap or the node capacity stopped the split (e.g. coincident samples).
+//!   cap or the node capacity stopped the split (e.g. coincident samples) — or, with
+//!   `probe_leaves`, B at its centre where that is larger.
 //! * An empty leaf takes its non-empty siblings' mean shrunk by the sample counts (see
 //!   `TreeBuilder::node`): a guess from its neighbourhood instead of 0, so the product does not
 //!   starve the regions between samples of a smooth lobe, yet small where many samples chose
@@ -110,6 +111,8 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize>
     pub max_depth: u32,
     pub kind: ProductKind,
     pub eval: F,
+    /// Also probe B at the centre of every leaf that holds samples (see `node`).
+    pub probe_leaves: bool,
 }
 
 impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
@@ -134,7 +137,17 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || depth >= self.max_depth || !room {
             let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
-            let b = sum / (hi - lo) as f32;
+            let mut b = sum / (hi - lo) as f32;
+            // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
+            // unknown): a sample can sit on the dim side of its leaf, and a B̃ that understates
+            // the leaf makes B/B̃ large wherever the light sends the product's samples in it,
+            // while one that overstates it only spends a few samples (docs/perf.md).
+            if self.probe_leaves {
+                let probe = self.probe(depth, x, y);
+                if probe.is_finite() {
+                    b = b.max(probe);
+                }
+            }
             let product = b * env;
             set(&mut self.nodes[index], 0, product);
             return (b, product);

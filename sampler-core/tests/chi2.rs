@@ -100,10 +100,10 @@ fn env_sampler_matches_its_pdf() {
     }
 }
 
-fn product_cases(kind: ProductKind) -> Vec<String> {
+fn product_cases(kind: ProductKind, probe_leaves: bool) -> Vec<String> {
     let envs = [("smooth", TestEnv::random_smooth(6, 2)), ("sun 1e6", TestEnv::sun(7, (90, 40), 1e6))];
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let params = ProductParams { kind, ..ProductParams::default() };
+    let params = ProductParams { kind, probe_leaves, ..ProductParams::default() };
     let cases = envs.len() * brdfs().len() * views().len();
     let alpha = sidak(cases);
     let mut failures = Vec::new();
@@ -145,13 +145,19 @@ fn product_cases(kind: ProductKind) -> Vec<String> {
 
 #[test]
 fn quadtree_product_sampler_matches_its_pdf() {
-    let f = product_cases(ProductKind::Quadtree);
+    let f = product_cases(ProductKind::Quadtree, false);
+    assert!(f.is_empty(), "{}", f.join("\n"));
+}
+
+#[test]
+fn quadtree_product_sampler_with_probed_leaves_matches_its_pdf() {
+    let f = product_cases(ProductKind::Quadtree, true);
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
 #[test]
 fn wavelet_product_sampler_matches_its_pdf() {
-    let f = product_cases(ProductKind::Wavelet);
+    let f = product_cases(ProductKind::Wavelet, false);
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 

@@ -170,8 +170,8 @@ fn run(estimator: &str) {
                 };
                 (0..n).map(|_| lum(estimator::env(&e, &sp, u(), &mut vis).value)).collect()
             }
-            "product-mis" => {
-                let params = ProductParams::default();
+            "product-mis" | "product-mis probed" => {
+                let params = ProductParams { probe_leaves: estimator.ends_with("probed"), ..ProductParams::default() };
                 (0..600u64)
                     .map(|seed| {
                         let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
@@ -225,6 +225,11 @@ fn wavelet_product_estimator_is_unbiased() {
 #[test]
 fn product_mis_estimator_is_unbiased() {
     run("product-mis");
+}
+
+#[test]
+fn product_mis_estimator_with_probed_leaves_is_unbiased() {
+    run("product-mis probed");
 }
 
 #[test]
