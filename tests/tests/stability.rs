@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{env_from, materials};
+use common::{env_from, materials, sphere_scene};
 use glam::Vec3;
 use host_std::bvh::Bvh;
 use host_std::environment::Environment;
@@ -11,27 +11,6 @@ use host_std::integrator::Method;
 use host_std::render::{Rendered, Settings, render};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::Lambert;
-
-/// A unit sphere of `bsdf` alone, seen from `dir` (8×8 pixels, the sphere fills the frame).
-fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {
-    let up = if dir.cross(Vec3::Y).length() < 1e-3 { Vec3::Z } else { Vec3::Y };
-    Scene {
-        name: "sphere".into(),
-        camera: CameraSpec {
-            origin: dir * 4.0,
-            target: Vec3::ZERO,
-            up,
-            fov_y_deg: 10.0,
-            width: 8,
-            height: 8,
-            near_clip: 1e-3,
-        },
-        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material::new(bsdf, false)],
-        env: None,
-        hide_emitters: true,
-    }
-}
 
 fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_samples: usize) -> Rendered {
     let bvh = Bvh::build(scene);

@@ -8,13 +8,13 @@
 
 mod common;
 
-use common::{env_from, materials};
+use common::{env_from, materials, sphere_scene};
 use glam::Vec3;
 use host_std::bvh::Bvh;
 use host_std::environment::Environment;
 use host_std::integrator::Method;
 use host_std::render::{Settings, render};
-use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::scene::{Bsdf, Scene};
 use rayon::prelude::*;
 use std::fmt::Write;
 
@@ -24,22 +24,7 @@ const SPP: usize = 32;
 /// A unit sphere filling an 8×8 frame, seen from a direction that is none of the mapping's
 /// special ones (so its normals sweep a whole hemisphere of the map).
 fn sphere(bsdf: Bsdf) -> Scene {
-    Scene {
-        name: "sphere".into(),
-        camera: CameraSpec {
-            origin: Vec3::new(0.3, 0.5, 0.8).normalize() * 4.0,
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 10.0,
-            width: 8,
-            height: 8,
-            near_clip: 1e-3,
-        },
-        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material::new(bsdf, false)],
-        env: None,
-        hide_emitters: true,
-    }
+    sphere_scene(bsdf, Vec3::new(0.3, 0.5, 0.8).normalize())
 }
 
 /// Green channel of every pixel, for `seeds` seeds, and the summed render time.

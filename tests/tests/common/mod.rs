@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use host_std::environment::{EnvSource, Environment, Placement};
-use host_std::scene::Bsdf;
+use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 
 /// Writes an equal-area `n`×`n` EXR whose texel (x, y) is `f(x, y)`, and builds it.
@@ -32,4 +32,25 @@ pub fn materials() -> Vec<(&'static str, Bsdf)> {
         ("phong n=1e6", Bsdf::Phong(Phong::new(Vec3::ZERO, Vec3::ONE, 1e6))),
         ("carpaint", Bsdf::CarPaint(CarPaint::default())),
     ]
+}
+
+/// A unit sphere of `bsdf` alone, seen from `dir` (8×8 pixels, the sphere fills the frame).
+pub fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {
+    let up = if dir.cross(Vec3::Y).length() < 1e-3 { Vec3::Z } else { Vec3::Y };
+    Scene {
+        name: "sphere".into(),
+        camera: CameraSpec {
+            origin: dir * 4.0,
+            target: Vec3::ZERO,
+            up,
+            fov_y_deg: 10.0,
+            width: 8,
+            height: 8,
+            near_clip: 1e-3,
+        },
+        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
+        materials: vec![Material::new(bsdf, false)],
+        env: None,
+        hide_emitters: true,
+    }
 }
