@@ -4,6 +4,7 @@
 # fast llvm variant, `apt-get install libllvm19`. Usage: docs/compare_all.sh OUT_DIR [SPP]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source docs/compare_scene.sh
 out="${1:?output folder}"
 spp="${2:-4096}"
 mkdir -p "$out"
@@ -13,18 +14,5 @@ scenes=(../shared/scenes/s1_forest_spheres.json ../shared/scenes/s2_courtyard_gl
         ../shared/scenes/s3_sunset_sharp.json docs/scenes/furnace.json docs/scenes/sharp_sun.json)
 methods=(product wavelet env brdf mis product-mis ris two-stage auto)
 for scene in "${scenes[@]}"; do
-    name="$(basename "$scene" .json)"
-    if [ ! -f "$out/${name}_mts.exr" ]; then
-        python3 ../shared/reference/mitsuba_ref.py "$scene" --spp 4096 --passes 4 \
-            --out "$out/${name}_mts.exr" --stderr-out "$out/${name}_mts_se.exr" \
-            --coverage-out "$out/${name}_cov.exr" | tail -1
-    fi
-    for m in "${methods[@]}"; do
-        ./target/release/ppis render "$scene" --method "$m" --spp "$spp" --shading-points 64 \
-            -o "$out/${name}_$m.exr" 2>&1 | tail -1 | sed 's/; wrote.*//'
-        printf '%s %s: ' "$name" "$m"
-        python3 docs/compare_mitsuba.py "$out/${name}_$m.exr" "$out/${name}_mts.exr" \
-            "$out/${name}_cov.exr" "$out/${name}_mts_se.exr" | tr '\n' ' '
-        echo
-    done
+    compare_scene "$out" "$scene" "$(basename "$scene" .json)" 4096 "$spp" 64 "${methods[@]}"
 done

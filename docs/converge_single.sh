@@ -6,6 +6,7 @@
 # Usage: docs/converge_single.sh OUT_DIR [RES] [SPP] [SCENE...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source docs/compare_scene.sh
 out="${1:?output folder}"
 res="${2:-32}"
 spp="${3:-1048576}"
@@ -31,17 +32,5 @@ env = scene["envmap"]["file"]
 scene["envmap"]["file"] = os.path.abspath(os.path.join(os.path.dirname(src), env))
 json.dump(scene, open(dst, "w"), indent=1)
 PY
-    if [ ! -f "$out/${name}_mts.exr" ]; then
-        python3 ../shared/reference/mitsuba_ref.py "$out/$name.json" --spp "$spp" --passes 4 \
-            --out "$out/${name}_mts.exr" --stderr-out "$out/${name}_mts_se.exr" \
-            --coverage-out "$out/${name}_cov.exr" | tail -1
-    fi
-    for m in "${methods[@]}"; do
-        "${PPIS:-./target/release/ppis}" render "$out/$name.json" --method "$m" --spp "$spp" \
-            --shading-points 1024 -o "$out/${name}_$m.exr" 2>&1 | tail -1 | sed 's/; wrote.*//'
-        printf '%s %s: ' "$name" "$m"
-        python3 docs/compare_mitsuba.py "$out/${name}_$m.exr" "$out/${name}_mts.exr" \
-            "$out/${name}_cov.exr" "$out/${name}_mts_se.exr" | tr '\n' ' '
-        echo
-    done
+    compare_scene "$out" "$out/$name.json" "$name" "$spp" "$spp" 1024 "${methods[@]}"
 done
