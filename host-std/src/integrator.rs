@@ -149,12 +149,16 @@ pub fn shade<B: Brdf + ?Sized>(
     sp: &ShadingPoint<'_, B>,
     budget: usize,
     seed: u64,
+    block: usize,
     technique: &Technique<'_, '_>,
     vis: &mut impl Visibility,
 ) -> DVec3 {
     let budget = budget.max(1);
     let pairs = (budget / 2).max(1);
     let n = if matches!(method, Method::Mis | Method::ProductMis) { pairs } else { budget };
+    // This shading point's run of the pixel's sequence: the pixel's shading points together
+    // draw one (0,2)-net per technique, stratified over the whole pixel, not per point.
+    let first = (block * n) as u32;
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
     let mut sum = DVec3::ZERO;
@@ -162,10 +166,10 @@ pub fn shade<B: Brdf + ?Sized>(
     let mut done = 0;
     while done < n {
         let m = (n - done).min(64);
-        sobol02(hash_combine(seed, 1), done as u32, &mut points[..m]);
+        sobol02(hash_combine(seed, 1), first + done as u32, &mut points[..m]);
         // The second technique's points, for the MIS methods only.
         if matches!(method, Method::Mis | Method::ProductMis) {
-            sobol02(hash_combine(seed, 2), done as u32, &mut others[..m]);
+            sobol02(hash_combine(seed, 2), first + done as u32, &mut others[..m]);
         }
         for k in 0..m {
             let u = points[k];
@@ -184,7 +188,7 @@ pub fn shade<B: Brdf + ?Sized>(
                 }
                 (Method::Ris, _) => {
                     let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
-                    sobol02(hash_combine(seed, 3 + (done + k) as u64), 0, &mut candidates);
+                    sobol02(hash_combine(seed, 3 + first as u64 + (done + k) as u64), 0, &mut candidates);
                     estimator::ris(env, sp, &candidates, u.x, vis).value
                 }
                 _ => DVec3::ZERO,

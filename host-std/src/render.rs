@@ -14,7 +14,7 @@ use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
 use sampler_core::frame::Frame;
 use sampler_core::glam::{DVec2, DVec3, Vec3};
-use sampler_core::points::sobol02;
+use sampler_core::points::{permutation_element, sobol02};
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::ProductArena;
 use sampler_core::two_stage::TwoStageSampler;
@@ -249,13 +249,14 @@ fn pixel(
                     let origin = h.origin;
                     let mut vis =
                         CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
-                    let sp_seed = hash_combine(seed, (h.index + 1) as u64);
+                    let sp_seed = hash_combine(seed, 0x11647);
                     sum += integrator::shade(
                         h.method,
                         env,
                         &shading_point(scene, h),
                         budget,
                         sp_seed,
+                        permutation_element(h.index as u32, p as u32, sp_seed as u32) as usize,
                         &technique,
                         &mut vis,
                     );

@@ -160,6 +160,45 @@ pub fn sobol02_shifted(seed: u64, first: u32, out: &mut [Vec2]) {
     }
 }
 
+/// Element `i` of a pseudo-random permutation of `0 .. n` chosen by `seed` (Kensler 2013,
+/// "Correlated multi-jittered sampling": an invertible hash on the next power of two, walked
+/// until it lands below `n`). Pairs the runs of one sequence with the points of another
+/// without the digit correlation that equal indices into two (0,2)-sequences would have.
+#[must_use]
+pub fn permutation_element(mut i: u32, n: u32, seed: u32) -> u32 {
+    debug_assert!(i < n);
+    let mut w = n.wrapping_sub(1);
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    let p = seed;
+    loop {
+        i ^= p;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | p >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < n {
+            return (i.wrapping_add(p)) % n;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +232,24 @@ mod tests {
                 !core::mem::replace(&mut seen[cell], true)
             })
         })
+    }
+
+    #[test]
+    fn permutation_element_is_a_permutation() {
+        for n in [1u32, 2, 3, 7, 16, 64, 100, 1000] {
+            for seed in [0u32, 1, 0xdead_beef] {
+                let mut seen = [false; 1000];
+                for i in 0..n {
+                    let j = permutation_element(i, n, seed) as usize;
+                    assert!(j < n as usize && !seen[j], "n {n} seed {seed} i {i} -> {j}");
+                    seen[j] = true;
+                }
+            }
+        }
+        // Different seeds give different orders.
+        let a: [u32; 8] = core::array::from_fn(|i| permutation_element(i as u32, 8, 1));
+        let b: [u32; 8] = core::array::from_fn(|i| permutation_element(i as u32, 8, 2));
+        assert_ne!(a, b);
     }
 
     #[test]
