@@ -66,12 +66,14 @@ impl Method {
         }
     }
 
-    /// `auto`: product-MIS (its sampler shared by the pixel's shading points) for every
-    /// material, unless the lighting is smooth. Measured with `ppis report --samples-per-point
-    /// 16` on the default and the three shared scenes (docs/perf.md): at equal time it is the
-    /// best method on the whole image in three scenes and within 4% of MIS in the fourth; per
-    /// region never more than ~14% behind MIS, up to 1.7× ahead on glossy and car paint. (An
-    /// earlier rule — MIS for Lambert and needle lobes — was 30% behind it on s1 and s2.)
+    /// `auto`: MIS of env and BRDF sampling for every material, unless the lighting is smooth.
+    /// Measured with `ppis report --samples-per-point 16` on the default, the three shared and
+    /// the studio scene (docs/perf.md) once the light samples were stratified over the whole
+    /// pixel: MIS is then the best method at equal time on every scene's whole image and on
+    /// every diffuse and car-paint region, and within 5% of product-MIS on glossy conductors
+    /// at 1024 spp except s1 (product-MIS 0.73×) — while product-MIS's per-pixel builds put it
+    /// 2.4–5× behind at 64 spp and 1.1–2.5× at 256. (Before that change product-MIS was the
+    /// better choice: a per-point sequence left MIS's samples less stratified.)
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
     /// [`SMOOTH_LIGHTING_PEAK`]): the product is the lobe within that factor, so BRDF sampling
@@ -82,7 +84,7 @@ impl Method {
         if self != Method::Auto {
             return self;
         }
-        if env_peak < SMOOTH_LIGHTING_PEAK { Method::Brdf } else { Method::ProductMis }
+        if env_peak < SMOOTH_LIGHTING_PEAK { Method::Brdf } else { Method::Mis }
     }
 }
 
@@ -209,8 +211,8 @@ mod tests {
     fn auto_samples_the_brdf_only_under_smooth_lighting() {
         let b = Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5)));
         assert_eq!(Method::Auto.for_material(&b, 1.6), Method::Brdf);
-        assert_eq!(Method::Auto.for_material(&b, 21.0), Method::ProductMis);
-        assert_eq!(Method::Auto.for_material(&b, f32::MAX), Method::ProductMis);
+        assert_eq!(Method::Auto.for_material(&b, 21.0), Method::Mis);
+        assert_eq!(Method::Auto.for_material(&b, f32::MAX), Method::Mis);
         for m in Method::ALL.into_iter().filter(|&m| m != Method::Auto) {
             assert_eq!(m.for_material(&b, 1.0), m, "fixed methods stay");
         }
