@@ -163,6 +163,7 @@ pub fn shade<B: Brdf + ?Sized>(
     let first = (block * n) as u32;
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
+    let mut drawn = [None; 64];
     let mut sum = DVec3::ZERO;
     // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
@@ -173,6 +174,10 @@ pub fn shade<B: Brdf + ?Sized>(
         if matches!(method, Method::Mis | Method::ProductMis) {
             sobol02(hash_combine(seed, 2), first + done as u32, &mut others[..m]);
         }
+        // The batch's env samples drawn together: their descents overlap.
+        if matches!(method, Method::Mis | Method::Env) {
+            env.sample_many(&points[..m], &mut drawn[..m]);
+        }
         for k in 0..m {
             let u = points[k];
             sum += match (method, technique) {
@@ -182,10 +187,10 @@ pub fn shade<B: Brdf + ?Sized>(
                     a.value + b.value
                 }
                 (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
-                (Method::Env, _) => estimator::env(env, sp, u, vis).value,
+                (Method::Env, _) => estimator::env_drawn(env, sp, drawn[k], vis).value,
                 (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
                 (Method::Mis, _) => {
-                    let [a, b] = estimator::mis(env, sp, u, others[k].as_vec2(), vis);
+                    let [a, b] = estimator::mis_drawn(env, sp, drawn[k], others[k].as_vec2(), vis);
                     a.value + b.value
                 }
                 (Method::Ris, _) => {

@@ -12,7 +12,7 @@
 //! sampling densities are built from, so radiance cancels exactly in the product estimator.
 
 use crate::mapping::{SPHERE_AREA, sphere_to_square, square_to_sphere, texel_of};
-use crate::warp::{child_offset, choose_child, choose_grandchild, point_in_cell};
+use crate::warp::{child_offset, choose_child, choose_grandchild, choose_grandchild_branchless, point_in_cell};
 use glam::{DVec2, Mat3, Vec2, Vec3};
 
 /// Finest level supported: 2^14 = 16384² texels.
@@ -402,11 +402,104 @@ impl<'a> EnvHierarchy<'a> {
         let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
         Some(EnvSample { dir: self.dir_of(uv), uv, pdf })
     }
+
+    /// Env samples for many points, four descents side by side (each level's loads and
+    /// arithmetic of the four are independent, so they overlap), branch-free within a level.
+    /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
+    /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
+    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<EnvSample>]) {
+        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
+            if self.is_black() {
+                os.fill(None);
+                continue;
+            }
+            let n = us.len().min(os.len());
+            let mut xi = [DVec2::ZERO; 4];
+            let mut at = [(0u32, 0u32, 0usize); 4]; // (x, y, Morton index) of each descent
+            let mut alive = [false; 4];
+            for k in 0..n {
+                xi[k] = us[k].clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
+                alive[k] = true;
+            }
+            let mut l = 0;
+            while l + 2 <= self.finest {
+                let offset = level_offset(l + 2);
+                for k in 0..n {
+                    let (x, y, m) = at[k];
+                    let g: &[f32; 16] = self.pyramid[offset + 16 * m..offset + 16 * m + 16].try_into().unwrap();
+                    match choose_grandchild_branchless(g, &mut xi[k]) {
+                        Some((c, gx, gy)) => at[k] = (4 * x + gx, 4 * y + gy, 16 * m + c),
+                        None => alive[k] = false,
+                    }
+                }
+                l += 2;
+            }
+            if l < self.finest {
+                let offset = level_offset(l + 1);
+                for k in 0..n {
+                    let (x, y, m) = at[k];
+                    let q = &self.pyramid[offset + 4 * m..offset + 4 * m + 4];
+                    match choose_child([q[0], q[1], q[2], q[3]], &mut xi[k]) {
+                        Some(c) => {
+                            let (dx, dy) = child_offset(c);
+                            at[k] = (2 * x + dx, 2 * y + dy, 4 * m + c);
+                        }
+                        None => alive[k] = false,
+                    }
+                }
+            }
+            for k in 0..n {
+                os[k] = alive[k].then(|| {
+                    let (x, y, _) = at[k];
+                    let uv = point_in_cell(x, y, self.finest, xi[k]);
+                    let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
+                    EnvSample { dir: self.dir_of(uv), uv, pdf }
+                });
+            }
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sample_many_draws_what_sample_draws() {
+        let mut rgb = [[0.0f32; 3]; 32 * 32];
+        for (i, t) in rgb.iter_mut().enumerate() {
+            *t = [(i * 7 % 13) as f32, (i % 3) as f32, if i == 300 { 1e6 } else { 0.5 }];
+        }
+        rgb[17] = [0.0; 3];
+        for level in [4u32, 5] {
+            let n = 1usize << level;
+            let texels = &rgb[..n * n];
+            let mut p = [0.0f32; 1365];
+            let p = &mut p[..pyramid_len(level)];
+            build_pyramid(level, texels, p).unwrap();
+            let e = EnvHierarchy::new(level, p, texels).unwrap();
+            let mut u = [DVec2::ZERO; 4099];
+            crate::points::sobol02(level as u64, 0, &mut u);
+            u[3] = DVec2::new(1.0, 0.0); // clamped like `sample` clamps
+            let mut out = [None; 4099];
+            e.sample_many(&u, &mut out);
+            let mut moved = 0;
+            for (a, b) in u.iter().zip(&out) {
+                let (a, b) = (e.sample(*a).unwrap(), b.unwrap());
+                // Same cell; the point inside may differ in the last bits.
+                moved += usize::from(e.texel_at(a.uv) != e.texel_at(b.uv));
+                assert!((a.uv - b.uv).abs().max_element() < 1e-5, "{a:?} {b:?}");
+                assert_eq!(b.pdf, e.pdf_square(b.uv) / SPHERE_AREA);
+            }
+            assert!(moved <= 2, "{moved} of 4099 in another texel");
+        }
+        let black = [[0.0f32; 3]; 4];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &black, &mut p).unwrap();
+        let mut out = [Some(EnvSample { dir: Vec3::Z, uv: Vec2::ZERO, pdf: 1.0 }); 5];
+        EnvHierarchy::new(1, &p, &black).unwrap().sample_many(&[DVec2::splat(0.5); 5], &mut out);
+        assert!(out.iter().all(Option::is_none));
+    }
 
     #[test]
     fn pyramid_layout() {

@@ -4,7 +4,7 @@
 //! Visibility is asked only for directions whose unoccluded contribution is non-zero.
 
 use crate::brdf::Brdf;
-use crate::env::EnvHierarchy;
+use crate::env::{EnvHierarchy, EnvSample};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
 use crate::sampler::ProductSampler;
@@ -101,7 +101,17 @@ pub fn env<B: Brdf + ?Sized>(
     u: DVec2,
     vis: &mut impl Visibility,
 ) -> Contribution {
-    let Some(s) = env.sample(u) else {
+    env_drawn(env, sp, env.sample(u), vis)
+}
+
+/// [`env`] with its sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
+pub fn env_drawn<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<EnvSample>,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = drawn else {
         return Contribution::default();
     };
     let f = times(env.radiance_at(s.uv), sp.eval(s.dir));
@@ -133,7 +143,18 @@ pub fn mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let drawn = env_h.sample(u_env).map(|s| (s.dir, s.uv, s.pdf));
+    mis_drawn(env_h, sp, env_h.sample(u_env), u_brdf, vis)
+}
+
+/// [`mis`] with its environment sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
+pub fn mis_drawn<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<EnvSample>,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
+    let drawn = drawn.map(|s| (s.dir, s.uv, s.pdf));
     mis_with_brdf(env_h, sp, drawn, |uv| env_h.pdf_square(uv), u_brdf, vis)
 }
 

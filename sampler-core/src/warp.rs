@@ -74,6 +74,42 @@ fn pick<const N: usize>(w: [f64; N], x: f64) -> Option<(usize, f64, f64)> {
     Some((last, t - last_acc, w[last]))
 }
 
+/// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
+/// every input with some mass), for interleaving several descents: alone, its chain of
+/// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
+#[inline(always)]
+pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
+    let m = mass.map(f64::from);
+    let at = |x: usize, y: usize| (x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3;
+    let cols: [f64; 4] = core::array::from_fn(|x| (m[at(x, 0)] + m[at(x, 1)]) + (m[at(x, 2)] + m[at(x, 3)]));
+    let (x, ox, wx) = pick_branchless(cols, xi.x)?;
+    let rows: [f64; 4] = core::array::from_fn(|y| m[at(x, y)]);
+    let (y, oy, wy) = pick_branchless(rows, xi.y)?;
+    rescale(xi, ox, wx, oy, wy);
+    Some((at(x, y), x as u32, y as u32))
+}
+
+#[inline(always)]
+fn pick_branchless(w: [f64; 4], x: f64) -> Option<(usize, f64, f64)> {
+    let p1 = w[0];
+    let p2 = p1 + w[1];
+    let p3 = p2 + w[2];
+    let total = p3 + w[3];
+    if total.is_nan() || total <= 0.0 {
+        return None;
+    }
+    let t = x * total;
+    let i = (t >= p1) as usize + (t >= p2) as usize + (t >= p3) as usize;
+    let prefix = [0.0, p1, p2, p3];
+    if w[i] > 0.0 {
+        Some((i, t - prefix[i], w[i]))
+    } else {
+        // Rounding put t at the total with trailing empty sides: the last side with mass.
+        let i = (0..4).rev().find(|&j| w[j] > 0.0)?;
+        Some((i, t - prefix[i], w[i]))
+    }
+}
+
 /// `xi = (ox / wx, oy / wy)` clamped to [0, 1) — with one division instead of two.
 #[inline(always)]
 fn rescale(xi: &mut DVec2, ox: f64, wx: f64, oy: f64, wy: f64) {

@@ -89,6 +89,23 @@ fn env_sampler_matches_its_pdf() {
             |uv| e.pdf_square(uv),
         );
         assert!(r.p_value >= alpha && r.impossible == 0, "{name}: {r:?}");
+        // The batched, branch-free descent: same distribution, same pdf.
+        let r = chi_square_dyadic(
+            SAMPLES,
+            3,
+            40.0,
+            |u| {
+                let mut out = [None];
+                e.sample_many(&[u], &mut out);
+                out[0].map(|s: sampler_core::env::EnvSample| {
+                    assert_eq!(s.pdf, e.pdf_square(s.uv) / sampler_core::mapping::SPHERE_AREA);
+                    s.uv
+                })
+            },
+            |_| e.finest_level(),
+            |uv| e.pdf_square(uv),
+        );
+        assert!(r.p_value >= alpha && r.impossible == 0, "{name}, sample_many: {r:?}");
         // The direction-level pdf agrees with the one returned.
         let mut mismatch = 0;
         let mut rng = sampler_core::rng::Pcg32::new(5, 5);
