@@ -155,6 +155,35 @@ fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError
     Ok(())
 }
 
+/// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
+#[derive(Clone, Copy, Debug, Default)]
+struct WarpLane {
+    level: u32,
+    x: u32,
+    y: u32,
+    /// Morton index of (x, y) within its level.
+    morton: usize,
+    xi: DVec2,
+    /// False once the descent met a node without mass (or never started).
+    alive: bool,
+}
+
+impl WarpLane {
+    /// A descent from node (x, y) of `level` with the point `u` (clamped into [0, 1)²).
+    fn new(level: u32, x: u32, y: u32, u: DVec2) -> Self {
+        let xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
+        Self { level, x, y, morton: morton2(x, y), xi, alive: true }
+    }
+
+    #[inline(always)]
+    fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
+        self.level += levels;
+        self.x = (self.x << levels) + dx;
+        self.y = (self.y << levels) + dy;
+        self.morton = (self.morton << (2 * levels)) + child;
+    }
+}
+
 /// A direction drawn from the environment alone (density ∝ importance).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnvSample {
@@ -409,52 +438,54 @@ impl<'a> EnvHierarchy<'a> {
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
     pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<EnvSample>]) {
         for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
-            if self.is_black() {
-                os.fill(None);
-                continue;
-            }
             let n = us.len().min(os.len());
-            let mut xi = [DVec2::ZERO; 4];
-            let mut at = [(0u32, 0u32, 0usize); 4]; // (x, y, Morton index) of each descent
-            let mut alive = [false; 4];
-            for k in 0..n {
-                xi[k] = us[k].clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
-                alive[k] = true;
+            let mut lanes = [WarpLane::default(); 4];
+            for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
+                *lane = WarpLane::new(0, 0, 0, *u);
             }
-            let mut l = 0;
-            while l + 2 <= self.finest {
-                let offset = level_offset(l + 2);
-                for k in 0..n {
-                    let (x, y, m) = at[k];
-                    let g: &[f32; 16] = self.pyramid[offset + 16 * m..offset + 16 * m + 16].try_into().unwrap();
-                    match choose_grandchild_branchless(g, &mut xi[k]) {
-                        Some((c, gx, gy)) => at[k] = (4 * x + gx, 4 * y + gy, 16 * m + c),
-                        None => alive[k] = false,
-                    }
-                }
-                l += 2;
-            }
-            if l < self.finest {
-                let offset = level_offset(l + 1);
-                for k in 0..n {
-                    let (x, y, m) = at[k];
-                    let q = &self.pyramid[offset + 4 * m..offset + 4 * m + 4];
-                    match choose_child([q[0], q[1], q[2], q[3]], &mut xi[k]) {
-                        Some(c) => {
-                            let (dx, dy) = child_offset(c);
-                            at[k] = (2 * x + dx, 2 * y + dy, 4 * m + c);
-                        }
-                        None => alive[k] = false,
-                    }
-                }
-            }
-            for k in 0..n {
-                os[k] = alive[k].then(|| {
-                    let (x, y, _) = at[k];
-                    let uv = point_in_cell(x, y, self.finest, xi[k]);
-                    let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
+            self.warp_down_lanes(&mut lanes[..n]);
+            for (o, lane) in os.iter_mut().zip(&lanes[..n]) {
+                *o = lane.alive.then(|| {
+                    let uv = point_in_cell(lane.x, lane.y, self.finest, lane.xi);
+                    let pdf = self.node_relative(self.finest, lane.x, lane.y) / SPHERE_AREA;
                     EnvSample { dir: self.dir_of(uv), uv, pdf }
                 });
+            }
+        }
+    }
+
+    /// [`warp_down`](Self::warp_down) for up to a few descents at once, each from its own node,
+    /// advanced level by level side by side. A lane that meets a node without mass dies.
+    fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
+        if self.is_black() {
+            lanes.iter_mut().for_each(|l| l.alive = false);
+            return;
+        }
+        loop {
+            let mut busy = false;
+            for lane in lanes.iter_mut().filter(|l| l.alive && l.level < self.finest) {
+                busy = true;
+                if lane.level + 2 <= self.finest {
+                    let base = level_offset(lane.level + 2) + 16 * lane.morton;
+                    let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().unwrap();
+                    match choose_grandchild_branchless(g, &mut lane.xi) {
+                        Some((c, gx, gy)) => lane.step(2, gx, gy, c),
+                        None => lane.alive = false,
+                    }
+                } else {
+                    let base = level_offset(lane.level + 1) + 4 * lane.morton;
+                    let q = &self.pyramid[base..base + 4];
+                    match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
+                        Some(c) => {
+                            let (dx, dy) = child_offset(c);
+                            lane.step(1, dx, dy, c);
+                        }
+                        None => lane.alive = false,
+                    }
+                }
+            }
+            if !busy {
+                return;
             }
         }
     }
