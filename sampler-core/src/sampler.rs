@@ -234,16 +234,17 @@ impl<'e> ProductSampler<'_, 'e> {
             (uv, self.pdf_square(uv))
         } else {
             xi.x = ((xi.x - eps) / (1.0 - eps)).clamp(0.0, ONE_MINUS_EPSILON);
-            let (uv, product) = self.warp_product(&mut xi)?;
-            // The warp knows its path: no second descent for the pdf.
-            (uv, self.mixture(product, self.env.pdf_square(uv)))
+            let (uv, product, texel) = self.warp_product(&mut xi)?;
+            // The warp knows its path and its texel: no second descent, no lookup for the pdf.
+            (uv, self.mixture(product, texel))
         };
         Some(DirectionSample { dir: self.env.dir_of(uv), uv, pdf: pdf_square / SPHERE_AREA })
     }
 
     /// Warps through the product tree, then below the leaf through the environment's levels.
-    /// Returns the point and the product's density per unit square area there.
-    fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f64)> {
+    /// Returns the point, the product's density per unit square area there and the relative
+    /// importance of its texel (the env's density per unit square area).
+    fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f64, f32)> {
         let (mut i, mut depth, mut x, mut y) = (0usize, 0u32, 0u32, 0u32);
         let mut path = 1.0f64;
         while !self.nodes[i].is_leaf() {
@@ -256,13 +257,20 @@ impl<'e> ProductSampler<'_, 'e> {
             (i, depth, x, y) = (first + child, depth + 1, 2 * x + dx, 2 * y + dy);
         }
         let finest = self.env.finest_level();
-        let uv = if depth < finest {
-            let texel = self.env.warp_down(depth, x, y, xi)?;
-            point_in_cell(texel.0, texel.1, finest, *xi)
+        if depth < finest {
+            // `point_in_cell` keeps the point in the texel the descent chose, so the texel is
+            // known: `leaf_density`'s result without its lookups.
+            let (tx, ty) = self.env.warp_down(depth, x, y, xi)?;
+            let uv = point_in_cell(tx, ty, finest, *xi);
+            let texel = self.env.node_relative(finest, tx, ty);
+            let leaf = self.env.node_relative(depth, x, y) as f64;
+            let area = f64::from_bits((1023 + 2 * depth as u64) << 52);
+            let density = if leaf > 0.0 { path * area * texel as f64 / leaf } else { 0.0 };
+            Some((uv, density, texel))
         } else {
-            point_in_cell(x, y, depth, *xi)
-        };
-        Some((uv, self.leaf_density(path, depth, x, y, uv)))
+            let uv = point_in_cell(x, y, depth, *xi);
+            Some((uv, self.leaf_density(path, depth, x, y, uv), self.env.pdf_square(uv)))
+        }
     }
 
     /// Density per unit square area at `uv` inside the leaf (depth, x, y) reached with
