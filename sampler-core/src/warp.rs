@@ -39,6 +39,23 @@ pub fn choose_child(mass: [f32; 4], xi: &mut DVec2) -> Option<usize> {
 /// chain of dependent steps is half as long as two [`choose_child`] calls.
 #[inline]
 pub fn choose_grandchild(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
+    grandchild_by(mass, xi, pick::<4>)
+}
+
+/// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
+/// every input with some mass), for interleaving several descents: alone, its chain of
+/// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
+#[inline(always)]
+pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
+    grandchild_by(mass, xi, pick_branchless)
+}
+
+/// A side chooser: (weights, ξ) → (side, ξ's offset into it, its weight).
+type Pick = fn([f64; 4], f64) -> Option<(usize, f64, f64)>;
+
+/// The column, then the row within it, each by `pick`; see [`choose_grandchild`].
+#[inline(always)]
+fn grandchild_by(mass: &[f32; 16], xi: &mut DVec2, pick: Pick) -> Option<(usize, u32, u32)> {
     let m = mass.map(f64::from);
     let at = |x: usize, y: usize| (x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3;
     let cols: [f64; 4] = core::array::from_fn(|x| (m[at(x, 0)] + m[at(x, 1)]) + (m[at(x, 2)] + m[at(x, 3)]));
@@ -72,21 +89,6 @@ fn pick<const N: usize>(w: [f64; N], x: f64) -> Option<(usize, f64, f64)> {
         acc += wi;
     }
     Some((last, t - last_acc, w[last]))
-}
-
-/// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
-/// every input with some mass), for interleaving several descents: alone, its chain of
-/// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
-#[inline(always)]
-pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
-    let m = mass.map(f64::from);
-    let at = |x: usize, y: usize| (x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3;
-    let cols: [f64; 4] = core::array::from_fn(|x| (m[at(x, 0)] + m[at(x, 1)]) + (m[at(x, 2)] + m[at(x, 3)]));
-    let (x, ox, wx) = pick_branchless(cols, xi.x)?;
-    let rows: [f64; 4] = core::array::from_fn(|y| m[at(x, y)]);
-    let (y, oy, wy) = pick_branchless(rows, xi.y)?;
-    rescale(xi, ox, wx, oy, wy);
-    Some((at(x, y), x as u32, y as u32))
 }
 
 #[inline(always)]
