@@ -427,9 +427,15 @@ impl<'a> EnvHierarchy<'a> {
         }
         let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
         let (x, y) = self.warp_down(0, 0, 0, &mut xi)?;
+        Some(self.sample_in_texel(x, y, xi))
+    }
+
+    /// The sample at point `xi` of finest-level texel (x, y), with its density.
+    #[inline]
+    fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> EnvSample {
         let uv = point_in_cell(x, y, self.finest, xi);
         let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
-        Some(EnvSample { dir: self.dir_of(uv), uv, pdf })
+        EnvSample { dir: self.dir_of(uv), uv, pdf }
     }
 
     /// Env samples for many points, four descents side by side (each level's loads and
@@ -445,11 +451,7 @@ impl<'a> EnvHierarchy<'a> {
             }
             self.warp_down_lanes(&mut lanes[..n]);
             for (o, lane) in os.iter_mut().zip(&lanes[..n]) {
-                *o = lane.alive.then(|| {
-                    let uv = point_in_cell(lane.x, lane.y, self.finest, lane.xi);
-                    let pdf = self.node_relative(self.finest, lane.x, lane.y) / SPHERE_AREA;
-                    EnvSample { dir: self.dir_of(uv), uv, pdf }
-                });
+                *o = lane.alive.then(|| self.sample_in_texel(lane.x, lane.y, lane.xi));
             }
         }
     }

@@ -263,28 +263,23 @@ impl<'e> ProductSampler<'_, 'e> {
             let (tx, ty) = self.env.warp_down(depth, x, y, xi)?;
             let uv = point_in_cell(tx, ty, finest, *xi);
             let texel = self.env.node_relative(finest, tx, ty);
-            let leaf = self.env.node_relative(depth, x, y) as f64;
-            let area = f64::from_bits((1023 + 2 * depth as u64) << 52);
-            let density = if leaf > 0.0 { path * area * texel as f64 / leaf } else { 0.0 };
-            Some((uv, density, texel))
+            Some((uv, self.leaf_density(path, depth, x, y, texel), texel))
         } else {
             let uv = point_in_cell(x, y, depth, *xi);
-            Some((uv, self.leaf_density(path, depth, x, y, uv), self.env.pdf_square(uv)))
+            let texel = self.env.pdf_square(uv);
+            Some((uv, self.leaf_density(path, depth, x, y, texel), texel))
         }
     }
 
-    /// Density per unit square area at `uv` inside the leaf (depth, x, y) reached with
-    /// probability `path`: the leaf's share spread over its area, and below it the environment's
-    /// texels in proportion to their importance.
-    fn leaf_density(&self, path: f64, depth: u32, x: u32, y: u32, uv: Vec2) -> f64 {
+    /// Density per unit square area inside the leaf (depth, x, y) reached with probability
+    /// `path`, at a point whose texel has relative importance `texel`: the leaf's share spread
+    /// over its area, and below it the environment's texels in proportion to their importance.
+    fn leaf_density(&self, path: f64, depth: u32, x: u32, y: u32, texel: f32) -> f64 {
         // 4^depth exactly (no_std has no powi): the inverse of the leaf's area.
         let area = f64::from_bits((1023 + 2 * depth as u64) << 52);
-        let finest = self.env.finest_level();
-        if depth < finest {
-            let (tx, ty) = self.env.texel_at(uv);
+        if depth < self.env.finest_level() {
             let leaf_env = self.env.node_relative(depth, x, y) as f64;
-            let texel_env = self.env.node_relative(finest, tx, ty) as f64;
-            if leaf_env > 0.0 { path * area * texel_env / leaf_env } else { 0.0 }
+            if leaf_env > 0.0 { path * area * texel as f64 / leaf_env } else { 0.0 }
         } else {
             path * area
         }
@@ -293,8 +288,9 @@ impl<'e> ProductSampler<'_, 'e> {
     /// The product's density per unit square area at `uv`, as the product of the branch
     /// probabilities the warp takes to reach it: exactly the density the warp realises, however
     /// the node values were computed (the Haar product's cancellation makes its node values
-    /// differ from the means of their children at extreme dynamic range).
-    fn product_density(&self, uv: Vec2) -> f64 {
+    /// differ from the means of their children at extreme dynamic range). `texel`: the env's
+    /// relative importance at `uv` (`EnvHierarchy::pdf_square`), which the caller has already.
+    fn product_density(&self, uv: Vec2, texel: f32) -> f64 {
         let Some(root) = self.nodes.first() else { return 0.0 };
         let (qx, qy) = (quantize(uv.x), quantize(uv.y));
         let (mut node, mut depth, mut x, mut y, mut path) = (*root, 0u32, 0u32, 0u32, 1.0f64);
@@ -307,7 +303,7 @@ impl<'e> ProductSampler<'_, 'e> {
             node = c[k];
             (depth, x, y) = (depth + 1, 2 * x + dx, 2 * y + dy);
         }
-        self.leaf_density(path, depth, x, y, uv)
+        self.leaf_density(path, depth, x, y, texel)
     }
 
     /// The mixture density per unit square area, from the product's density and the texel's
@@ -351,7 +347,7 @@ impl<'e> ProductSampler<'_, 'e> {
         if self.defensive >= 1.0 {
             return env_relative;
         }
-        self.mixture(self.product_density(uv), env_relative)
+        self.mixture(self.product_density(uv, env_relative), env_relative)
     }
 
     /// Density with respect to solid angle of world direction `dir`.
