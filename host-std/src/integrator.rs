@@ -69,11 +69,12 @@ impl Method {
     /// `auto`: MIS of env and BRDF sampling for every material, unless the lighting is smooth.
     /// Measured with `ppis report --samples-per-point 16` on the default, the three shared and
     /// the studio scene (docs/perf.md) once the light samples were stratified over the whole
-    /// pixel: MIS is then the best method at equal time on every scene's whole image and on
-    /// every diffuse and car-paint region, and within 5% of product-MIS on glossy conductors
-    /// at 1024 spp except s1 (product-MIS 0.73×) — while product-MIS's per-pixel builds put it
-    /// 2.4–5× behind at 64 spp and 1.1–2.5× at 256. (Before that change product-MIS was the
-    /// better choice: a per-point sequence left MIS's samples less stratified.)
+    /// pixel and env sampling batched: at product-MIS's 1024-spp time MIS is the best method on
+    /// every scene's whole image (product-MIS 0.42–0.87× as good) and on every car-paint region;
+    /// product-MIS leads only on s1's rough conductor (1.36×) and is level on studio's (1.03×),
+    /// while its per-pixel builds put it far behind at 64–256 spp. Env-only sampling wins on
+    /// studio's and s2's diffuse pixels but is 3–5× behind MIS on diffuse under the default sky.
+    /// (Before the pixel-wide sequences product-MIS was the better choice.)
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
     /// [`SMOOTH_LIGHTING_PEAK`]): the product is the lobe within that factor, so BRDF sampling

@@ -154,6 +154,9 @@ fn pixel(
     stats: &mut [u64; 4],
 ) -> [f32; 3] {
     let seed = hash_combine(s.seed, (y * camera.width as usize + x) as u64);
+    // The seed of the pixel's light-sample sequences, shared by its shading points (each takes
+    // its own run of them, see `integrator::shade`).
+    let light_seed = hash_combine(seed, 0x11647);
     let p = s.shading_points.max(1);
     let budget = (s.spp / p).max(1);
     let mut film = [DVec2::ZERO; 64];
@@ -249,14 +252,13 @@ fn pixel(
                     let origin = h.origin;
                     let mut vis =
                         CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
-                    let sp_seed = hash_combine(seed, 0x11647);
                     sum += integrator::shade(
                         h.method,
                         env,
                         &shading_point(scene, h),
                         budget,
-                        sp_seed,
-                        permutation_element(h.index as u32, p as u32, sp_seed as u32) as usize,
+                        light_seed,
+                        permutation_element(h.index as u32, p as u32, light_seed as u32) as usize,
                         &technique,
                         &mut vis,
                     );
