@@ -132,12 +132,15 @@ pub enum Technique<'s, 'e> {
     TwoStage(&'s TwoStageSampler<'s, 'e>),
 }
 
-/// The product-sampler settings of a method.
+/// The product-sampler settings of a method: product-MIS takes the core's preset for use beside
+/// BRDF sampling (probed and refined leaves, ε = 0.25; docs/perf.md); plain product and wavelet
+/// stay the paper's estimators.
 pub fn product_params(method: Method, brdf_samples: usize) -> ProductParams {
-    let kind = if method == Method::Wavelet { ProductKind::Wavelet } else { ProductKind::Quadtree };
-    // Probed leaves for product-MIS only: measured 1.03–1.8× lower error on glossy pixels there
-    // (docs/perf.md); plain product and wavelet stay the paper's estimators.
-    ProductParams { brdf_samples, kind, probe_leaves: method == Method::ProductMis, ..ProductParams::default() }
+    match method {
+        Method::ProductMis => ProductParams::for_mis(brdf_samples),
+        Method::Wavelet => ProductParams { brdf_samples, kind: ProductKind::Wavelet, ..ProductParams::default() },
+        _ => ProductParams { brdf_samples, ..ProductParams::default() },
+    }
 }
 
 /// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`

@@ -35,8 +35,8 @@ impl Measurement {
     }
 }
 
-/// Pixels grouped by the kind of material their centre ray hits ("diffuse", "roughconductor",
-/// "phong", "carpaint"); misses belong to no region.
+/// Pixels grouped by the material their centre ray hits, named by kind and lobe width
+/// ("diffuse", "roughconductor α=0.05", "phong n=200", "carpaint"); misses belong to no region.
 pub struct Regions {
     pub names: Vec<String>,
     /// Per pixel, the index into `names`, or `None`.
@@ -53,9 +53,9 @@ impl Regions {
             for x in 0..w {
                 let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
                 of_pixel.push(bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY).map(|hit| {
-                    let kind = scene.materials[hit.material as usize].bsdf.kind();
-                    names.iter().position(|n| n == kind).unwrap_or_else(|| {
-                        names.push(kind.to_string());
+                    let label = scene.materials[hit.material as usize].bsdf.label();
+                    names.iter().position(|n| *n == label).unwrap_or_else(|| {
+                        names.push(label);
                         names.len() - 1
                     })
                 }));
@@ -198,7 +198,7 @@ pub fn csv(measurements: &[Measurement]) -> String {
 /// image and for each region.
 pub fn markdown(scene: &str, measurements: &[Measurement], threads: usize, reference_note: &str) -> String {
     let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
-    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind.\n\n");
+    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
     let regions: Vec<String> =
         measurements.first().map(|m| m.regions.iter().map(|r| r.0.clone()).collect()).unwrap_or_default();
     s.push_str("| method | spp | seconds | RMSE | relMSE |");

@@ -100,6 +100,17 @@ impl Bsdf {
             Bsdf::CarPaint(_) => "carpaint",
         }
     }
+
+    /// The kind with its lobe width where the kind has one ("roughconductor α=0.05",
+    /// "phong n=200"): reports group pixels by it, since a product sampler's gain depends on
+    /// how sharp the lobe is against the lighting.
+    pub fn label(&self) -> String {
+        match self {
+            Bsdf::Conductor(c) => format!("roughconductor α={}", c.ggx.alpha()),
+            Bsdf::Phong(p) => format!("phong n={}", p.exponent),
+            _ => self.kind().to_string(),
+        }
+    }
 }
 
 /// One shape and the index of its material.

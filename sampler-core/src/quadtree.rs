@@ -11,6 +11,9 @@
 //!   starve the regions between samples of a smooth lobe, yet small where many samples chose
 //!   a sibling (the chain above a needle lobe). Regions where B̃ is still 0 are covered by the
 //!   sampler's defensive mixture.
+//! * Optionally (`refine_share`, product-MIS's preset) leaves holding more than that share of
+//!   the product's mass are split further, B probed at each new child's centre: the samples
+//!   place leaves where B is large, the refinement where B̃·L is (a sun in a lobe's tail).
 //! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
 //!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
 //!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`).
@@ -113,6 +116,9 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize>
     pub eval: F,
     /// Also probe B at the centre of every leaf that holds samples (see `node`).
     pub probe_leaves: bool,
+    /// Split leaves holding more than this share of the product's mass, B probed at each new
+    /// child's centre (see `refine`); 0 turns it off.
+    pub refine_share: f32,
 }
 
 impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
@@ -124,8 +130,50 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         }
         let _ = self.nodes.push(Node::default());
         let root_env = self.env.cell_relative(0, 0, 0);
-        self.node(0, 0, 0, 0, root_env, 0, self.keys.len());
+        let (_, total) = self.node(0, 0, 0, 0, root_env, 0, self.keys.len());
+        if self.refine_share > 0.0 && total > 0.0 && total.is_finite() {
+            self.refine(0, 0, 0, 0, root_env, self.refine_share * total);
+        }
         true
+    }
+
+    /// Splits every leaf whose mass (mean product × area) exceeds `limit`, children's B̃
+    /// probed at their centres, recursively; returns the node's (possibly new) product mean.
+    ///
+    /// Why: the BRDF samples place leaves where B is large, but the product's mass also sits
+    /// where L is large — a sun in the lobe's tail lands in a coarse tail leaf whose B̃ is one
+    /// sample's value from elsewhere in the leaf, off by orders of magnitude at the sun, and
+    /// every product sample of the sun then carries that ratio B/B̃. Splitting the heavy leaves
+    /// brings B̃ close to B where the light is.
+    fn refine(&mut self, index: usize, depth: u32, x: u32, y: u32, env: f32, limit: f32) -> f32 {
+        let node = self.nodes[index];
+        // A node's mass: its mean over the cell times the cell's area 4^-depth.
+        let mass = node.product * f32::from_bits((127 - 2 * depth.min(63)) << 23);
+        if node.is_leaf() && (mass <= limit || depth >= self.max_depth || self.nodes.len() + 4 > NODES) {
+            return node.product;
+        }
+        let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
+        let first = if node.is_leaf() {
+            let first = self.nodes.len();
+            for c in 0..4 {
+                let (dx, dy) = child_offset(c);
+                let probe = self.probe(depth + 1, 2 * x + dx, 2 * y + dy);
+                // NaN (unknown) keeps the parent's B̃.
+                let b = if probe.is_finite() { probe } else { node.product / env.max(f32::MIN_POSITIVE) };
+                let _ = self.nodes.push(Node { child: 0, product: b * l[c] });
+            }
+            first
+        } else {
+            node.child as usize
+        };
+        let mut p = [0.0f32; 4];
+        for (c, pc) in p.iter_mut().enumerate() {
+            let (dx, dy) = child_offset(c);
+            *pc = self.refine(first + c, depth + 1, 2 * x + dx, 2 * y + dy, l[c], limit);
+        }
+        let product = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
+        set(&mut self.nodes[index], first as u32, product);
+        product
     }
 
     /// Fills node `index` covering cell `(x, y)` at `depth` and samples `lo..hi` (non-empty);

@@ -117,10 +117,9 @@ fn env_sampler_matches_its_pdf() {
     }
 }
 
-fn product_cases(kind: ProductKind, probe_leaves: bool) -> Vec<String> {
+fn product_cases(params: ProductParams) -> Vec<String> {
     let envs = [("smooth", TestEnv::random_smooth(6, 2)), ("sun 1e6", TestEnv::sun(7, (90, 40), 1e6))];
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let params = ProductParams { kind, probe_leaves, ..ProductParams::default() };
     let cases = envs.len() * brdfs().len() * views().len();
     let alpha = sidak(cases);
     let mut failures = Vec::new();
@@ -162,19 +161,27 @@ fn product_cases(kind: ProductKind, probe_leaves: bool) -> Vec<String> {
 
 #[test]
 fn quadtree_product_sampler_matches_its_pdf() {
-    let f = product_cases(ProductKind::Quadtree, false);
+    let f = product_cases(ProductParams::default());
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
 #[test]
 fn quadtree_product_sampler_with_probed_leaves_matches_its_pdf() {
-    let f = product_cases(ProductKind::Quadtree, true);
+    let f = product_cases(ProductParams { probe_leaves: true, ..ProductParams::default() });
+    assert!(f.is_empty(), "{}", f.join("\n"));
+}
+
+/// Refined heavy leaves (`ProductParams::for_mis`, the host's product-MIS settings): the new leaves below the samples'
+/// tree, some deeper than the map's finest level, are sampled as their pdf says.
+#[test]
+fn quadtree_product_sampler_with_refined_leaves_matches_its_pdf() {
+    let f = product_cases(ProductParams::for_mis(256));
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
 #[test]
 fn wavelet_product_sampler_matches_its_pdf() {
-    let f = product_cases(ProductKind::Wavelet, false);
+    let f = product_cases(ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() });
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 

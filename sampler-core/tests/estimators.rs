@@ -183,8 +183,12 @@ fn run(estimator: &str) {
                     })
                     .collect()
             }
-            "product-mis" | "product-mis probed" => {
-                let params = ProductParams { probe_leaves: estimator.ends_with("probed"), ..ProductParams::default() };
+            "product-mis" | "product-mis probed" | "product-mis for_mis" => {
+                let params = match estimator {
+                    "product-mis probed" => ProductParams { probe_leaves: true, ..ProductParams::default() },
+                    "product-mis for_mis" => ProductParams::for_mis(256),
+                    _ => ProductParams::default(),
+                };
                 (0..600u64)
                     .map(|seed| {
                         let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
@@ -246,6 +250,12 @@ fn product_mis_estimator_is_unbiased() {
 #[test]
 fn product_mis_estimator_with_probed_leaves_is_unbiased() {
     run("product-mis probed");
+}
+
+/// The preset hosts use beside BRDF sampling: probed and refined leaves, ε = 0.25.
+#[test]
+fn product_mis_estimator_with_the_mis_preset_is_unbiased() {
+    run("product-mis for_mis");
 }
 
 #[test]

@@ -210,7 +210,12 @@ fn every_estimator_on_every_extreme_case() {
                                     sampler_core::quadtree::ProductKind::Quadtree
                                 };
                                 let brdf_samples = if *method == "product K=1" { 1 } else { 256 };
-                                let params = ProductParams { kind, brdf_samples, ..ProductParams::default() };
+                                // product-MIS with the preset the renderer uses beside BRDF sampling.
+                                let params = if *method == "product-mis" {
+                                    ProductParams::for_mis(256)
+                                } else {
+                                    ProductParams { kind, brdf_samples, ..ProductParams::default() }
+                                };
                                 let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed);
                                 for i in 0..32 {
                                     push(if *method == "product-mis" {

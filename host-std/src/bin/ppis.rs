@@ -121,7 +121,7 @@ struct SamplingArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
     threads: Option<u32>,
     /// Image width, overriding the scene's camera.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
