@@ -1,7 +1,7 @@
 //! Per-sample and per-net variance of the product estimators against BRDF sampling and MIS on
 //! GGX lobes of several widths under a smooth sky (no sun): how far B̃'s piecewise-constant
 //! leaves are from B, and what the (0,2)-nets gain on each estimator. Knobs: EPS (defensive
-//! fraction), REFINE (refine_share).
+//! fraction), REFINE (refine_share), BILINEAR (set: bilinear B̃).
 //! `cargo run --release -p sampler-core --example product_variance`
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::RoughConductor;
@@ -29,14 +29,20 @@ fn main() {
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let eps: f32 = std::env::var("EPS").ok().and_then(|v| v.parse().ok()).unwrap_or(0.02);
     let refine: f32 = std::env::var("REFINE").ok().and_then(|v| v.parse().ok()).unwrap_or(0.0);
+    let bilinear = std::env::var("BILINEAR").is_ok();
     for alpha in [0.01f32, 0.02, 0.05, 0.1, 0.3] {
         let brdf = RoughConductor::new(alpha, Vec3::ONE);
         let frame = Frame::from_normal(Vec3::new(0.1, 0.2, 1.0).normalize());
         let wo = frame.to_world(Vec3::new(-0.3, -0.4, 0.87).normalize());
         let sp = ShadingPoint { frame, wo, brdf: &brdf };
         for probe in [false, true] {
-            let params =
-                ProductParams { defensive: eps, probe_leaves: probe, refine_share: refine, ..ProductParams::default() };
+            let params = ProductParams {
+                defensive: eps,
+                probe_leaves: probe,
+                refine_share: refine,
+                bilinear,
+                ..ProductParams::default()
+            };
             // Relative variance per sample (over builds) and of 64-point net means (×64: 1 = no gain).
             let mut stats = [[0.0f64; 3]; 4];
             let mut net = [[0.0f64; 3]; 4];

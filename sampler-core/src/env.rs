@@ -275,6 +275,16 @@ impl<'a> EnvHierarchy<'a> {
         self.pyramid[pyramid_index(level, x, y)] * self.inv_mean
     }
 
+    /// The 16 grandchildren of node `(x, y)` of `level` (which must be < K − 1), as stored
+    /// (not relative to the mean: for ratios), in the Morton order of
+    /// [`crate::warp::choose_grandchild`] — one cache line.
+    #[inline]
+    #[must_use]
+    pub fn grandchildren_raw(&self, level: u32, x: u32, y: u32) -> &[f32; 16] {
+        let base = level_offset(level + 2) + 16 * morton2(x, y);
+        self.pyramid[base..base + 16].try_into().expect("16 grandchildren")
+    }
+
     /// The four children of node `(x, y)` of `level` (which must be < K), relative to the mean,
     /// in [`child_offset`] order.
     #[inline]

@@ -41,6 +41,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod bilinear;
 pub mod brdf;
 pub mod env;
 pub mod estimator;

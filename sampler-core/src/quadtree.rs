@@ -18,6 +18,7 @@
 //!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
 //!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`).
 
+use crate::bilinear::{self, Corners};
 use crate::env::EnvHierarchy;
 use crate::warp::child_offset;
 use crate::wavelet::haar_product_mean;
@@ -119,16 +120,25 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize>
     /// Split leaves holding more than this share of the product's mass, B probed at each new
     /// child's centre (see `refine`); 0 turns it off.
     pub refine_share: f32,
+    /// B̃ bilinear in each leaf between B at its corners (`corners[i]` for node i, every node),
+    /// instead of constant: the samples then only decide where to split.
+    pub bilinear: bool,
+    pub corners: &'b mut Vec<Corners, NODES>,
 }
 
 impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
     /// Builds the whole tree; the root is node 0. Returns false when there are no samples.
     pub fn build(&mut self) -> bool {
         self.nodes.clear();
+        self.corners.clear();
         if self.keys.is_empty() {
             return false;
         }
         let _ = self.nodes.push(Node::default());
+        if self.bilinear {
+            let w = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE].map(|p| self.eval_at(p));
+            let _ = self.corners.push(w);
+        }
         let root_env = self.env.cell_relative(0, 0, 0);
         let (_, total) = self.node(0, 0, 0, 0, root_env, 0, self.keys.len());
         if self.refine_share > 0.0 && total > 0.0 && total.is_finite() {
@@ -154,13 +164,17 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         }
         let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
         let first = if node.is_leaf() {
-            let first = self.nodes.len();
+            let first = self.push_children(index, depth, x, y);
             for c in 0..4 {
-                let (dx, dy) = child_offset(c);
-                let probe = self.probe(depth + 1, 2 * x + dx, 2 * y + dy);
-                // NaN (unknown) keeps the parent's B̃.
-                let b = if probe.is_finite() { probe } else { node.product / env.max(f32::MIN_POSITIVE) };
-                let _ = self.nodes.push(Node { child: 0, product: b * l[c] });
+                let b = if self.bilinear {
+                    bilinear::mean(&self.corners[first + c])
+                } else {
+                    let (dx, dy) = child_offset(c);
+                    let probe = self.probe(depth + 1, 2 * x + dx, 2 * y + dy);
+                    // NaN (unknown) keeps the parent's B̃.
+                    if probe.is_finite() { probe } else { node.product / env.max(f32::MIN_POSITIVE) }
+                };
+                set(&mut self.nodes[first + c], 0, b * l[c]);
             }
             first
         } else {
@@ -184,6 +198,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
     fn node(&mut self, index: usize, depth: u32, x: u32, y: u32, env: f32, lo: usize, hi: usize) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || depth >= self.max_depth || !room {
+            if self.bilinear {
+                let b = bilinear::mean(&self.corners[index]);
+                set(&mut self.nodes[index], 0, b * env);
+                return (b, b * env);
+            }
             let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
             let mut b = sum / (hi - lo) as f32;
             // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
@@ -200,10 +219,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
             set(&mut self.nodes[index], 0, product);
             return (b, product);
         }
-        let first = self.nodes.len();
-        for _ in 0..4 {
-            let _ = self.nodes.push(Node::default());
-        }
+        let first = self.push_children(index, depth, x, y);
         // Split lo..hi by the next two Morton bits: the run is sorted, so counting each digit
         // gives the child boundaries (cheaper than three binary searches for the short runs
         // that make up most of the tree).
@@ -243,7 +259,9 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         let count_fill = sum_b * FILL_PRIOR / (n + filled as f32 * FILL_PRIOR);
         for c in 0..4 {
             if bounds[c + 1] == bounds[c] {
-                let fill = if hi - lo >= EVAL_EMPTY_FROM {
+                let fill = if self.bilinear {
+                    bilinear::mean(&self.corners[first + c])
+                } else if hi - lo >= EVAL_EMPTY_FROM {
                     let (dx, dy) = child_offset(c);
                     count_fill.min(self.probe(depth + 1, 2 * x + dx, 2 * y + dy))
                 } else {
@@ -265,6 +283,33 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
 }
 
 impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
+    /// Appends the four children of node `index` (cell `(x, y)` at `depth`) and, for a bilinear
+    /// B̃, their corner values: the parent's corners, B at the four edge midpoints and at the
+    /// centre — five evaluations, shared by the children so that B̃ is continuous across them.
+    fn push_children(&mut self, index: usize, depth: u32, x: u32, y: u32) -> usize {
+        let first = self.nodes.len();
+        for _ in 0..4 {
+            let _ = self.nodes.push(Node::default());
+        }
+        if self.bilinear {
+            let w = self.corners[index];
+            let inv = 1.0 / (1u64 << depth) as f32;
+            let mut at = |s: f32, t: f32| self.eval_at(Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv));
+            let (b, l, c, r, t) = (at(0.5, 0.0), at(0.0, 0.5), at(0.5, 0.5), at(1.0, 0.5), at(0.5, 1.0));
+            for q in [[w[0], b, l, c], [b, w[1], c, r], [l, c, w[2], t], [c, r, t, w[3]]] {
+                let _ = self.corners.push(q);
+            }
+        }
+        first
+    }
+
+    /// B·cos at a point of the square for a bilinear corner: NaN or negative reads as 0 (the
+    /// defensive mixture covers what B̃ misses), infinity as the largest finite value.
+    fn eval_at(&mut self, uv: Vec2) -> f32 {
+        let v = (self.eval)(uv);
+        if v.is_nan() || v <= 0.0 { 0.0 } else { v.min(f32::MAX) }
+    }
+
     /// B·cos at the centre of cell `(x, y)` at `depth`; where that is 0 (e.g. below the
     /// surface), the largest of its four corners (inset by 1/64 of the cell), so that a cell
     /// straddling the horizon is not zeroed. NaN reads as unknown (+∞: keep the count fill).
