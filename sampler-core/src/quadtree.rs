@@ -159,7 +159,10 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
         let node = self.nodes[index];
         // A node's mass: its mean over the cell times the cell's area 4^-depth.
         let mass = node.product * f32::from_bits((127 - 2 * depth.min(63)) << 23);
-        if node.is_leaf() && (mass <= limit || depth >= self.max_depth || self.nodes.len() + 4 > NODES) {
+        // Not below the map's finest level: there L is one texel's, and where B varies faster
+        // than that the samples have split already.
+        let deepest = self.max_depth.min(self.env.finest_level());
+        if node.is_leaf() && (mass <= limit || depth >= deepest || self.nodes.len() + 4 > NODES) {
             return node.product;
         }
         let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
