@@ -66,28 +66,41 @@ impl Method {
         }
     }
 
-    /// `auto`: MIS of env and BRDF sampling for every material, unless the lighting is smooth.
-    /// Measured with `ppis report --samples-per-point 16` on the default, the three shared and
-    /// the studio scene (docs/perf.md) once the light samples were stratified over the whole
-    /// pixel and env sampling batched: at product-MIS's 1024-spp time MIS is the best method on
-    /// every scene's whole image (product-MIS 0.42–0.87× as good) and on every car-paint region;
-    /// product-MIS leads only on s1's rough conductor (1.36×) and is level on studio's (1.03×),
-    /// while its per-pixel builds put it far behind at 64–256 spp. Env-only sampling wins on
-    /// studio's and s2's diffuse pixels but is 3–5× behind MIS on diffuse under the default sky.
-    /// (Before the pixel-wide sequences product-MIS was the better choice.)
+    /// `auto`: per material, the method measured best at equal time (`ppis report
+    /// --samples-per-point 16`, default, three shared and studio scenes, per material region;
+    /// docs/perf.md, session 5):
+    ///
+    /// * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is
+    ///   wide enough to span bright detail of the map and narrow enough that one B̃ per pixel fits
+    ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time: s1 α = 0.05
+    ///   2.05× (MIS), studio α = 0.05 1.74× (MIS), s2 α = 0.1 1.00×.
+    /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: MIS 1.2–2.6×
+    ///   ahead), wider ones (α ≥ 0.15: MIS or env-only ahead), car paint (MIS 2.1×), diffuse.
+    ///   Env-only sampling wins on diffuse and α = 0.3 under soft boxes (studio, s2, s1's forest)
+    ///   but is 3–6× behind MIS under the default sky's sun, so it is not picked.
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
-    /// [`SMOOTH_LIGHTING_PEAK`]): the product is the lobe within that factor, so BRDF sampling
-    /// draws nearly the product without building it. Measured on McUsd (peak 1.6): product-MIS
-    /// 2.6–8× and MIS 2.3× behind BRDF sampling at equal time; the shared maps have peaks 21
-    /// (courtyard), 29 (sunset), 67 (forest), the built-in sky 713.
-    pub fn for_material(self, _bsdf: &Bsdf, env_peak: f32) -> Method {
+    /// [`SMOOTH_LIGHTING_PEAK`]): BRDF sampling for every material — the product is the lobe
+    /// within that factor, so BRDF sampling draws nearly the product without building it.
+    /// Measured on McUsd (peak 1.6): product-MIS 2.6–8× and MIS 2.3× behind BRDF sampling at
+    /// equal time; the shared maps have peaks 21 (courtyard), 29 (sunset), 67 (forest), the
+    /// built-in sky 713.
+    pub fn for_material(self, bsdf: &Bsdf, env_peak: f32) -> Method {
         if self != Method::Auto {
             return self;
         }
-        if env_peak < SMOOTH_LIGHTING_PEAK { Method::Brdf } else { Method::Mis }
+        if env_peak < SMOOTH_LIGHTING_PEAK {
+            return Method::Brdf;
+        }
+        match bsdf {
+            Bsdf::Conductor(c) if PRODUCT_ALPHA.contains(&c.ggx.alpha()) => Method::ProductMis,
+            _ => Method::Mis,
+        }
     }
 }
+
+/// GGX roughness range where `auto` samples the product (with BRDF sampling, MIS).
+pub const PRODUCT_ALPHA: std::ops::RangeInclusive<f32> = 0.03..=0.1;
 
 /// Below this peak (max / mean of the map over 32×32 blocks) `auto` samples the BRDF only.
 pub const SMOOTH_LIGHTING_PEAK: f32 = 4.0;
@@ -215,6 +228,17 @@ mod tests {
     use super::*;
     use sampler_core::brdf::Lambert;
     use sampler_core::glam::Vec3;
+
+    #[test]
+    fn auto_samples_the_product_on_moderately_glossy_conductors_only() {
+        use sampler_core::brdf::RoughConductor;
+        let conductor = |alpha| Bsdf::Conductor(RoughConductor::new(alpha, Vec3::ONE));
+        assert_eq!(Method::Auto.for_material(&conductor(0.05), 67.0), Method::ProductMis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.1), 67.0), Method::ProductMis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.01), 67.0), Method::Mis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.3), 67.0), Method::Mis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.05), 1.6), Method::Brdf, "smooth light");
+    }
 
     #[test]
     fn auto_samples_the_brdf_only_under_smooth_lighting() {
