@@ -26,7 +26,7 @@ fn main() {
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
-    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    let mut arena: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
     let eps: f32 = std::env::var("EPS").ok().and_then(|v| v.parse().ok()).unwrap_or(0.02);
     let refine: f32 = std::env::var("REFINE").ok().and_then(|v| v.parse().ok()).unwrap_or(0.0);
     let bilinear = std::env::var("BILINEAR").is_ok();

@@ -107,7 +107,7 @@ fn digit(key: u64, depth: u32) -> usize {
 /// Builds the tree over `keys` (sorted) whose sample values are `values[key & 0xFFFF]`;
 /// `eval(uv)` gives B·cos (luminance) at a point of the square, for empty cells where the
 /// sample counts say B is small.
-pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize> {
+pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> {
     pub keys: &'b [u64],
     pub values: &'b [f32],
     pub env: &'b EnvHierarchy<'e>,
@@ -123,10 +123,10 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize>
     /// B̃ bilinear in each leaf between B at its corners (`corners[i]` for node i, every node),
     /// instead of constant: the samples then only decide where to split.
     pub bilinear: bool,
-    pub corners: &'b mut Vec<Corners, NODES>,
+    pub corners: &'b mut Vec<Corners, CORNERS>,
 }
 
-impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
+impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, NODES, CORNERS> {
     /// Builds the whole tree; the root is node 0. Returns false when there are no samples.
     pub fn build(&mut self) -> bool {
         self.nodes.clear();
@@ -285,7 +285,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
     }
 }
 
-impl<F: FnMut(Vec2) -> f32, const NODES: usize> TreeBuilder<'_, '_, F, NODES> {
+impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, NODES, CORNERS> {
     /// Appends the four children of node `index` (cell `(x, y)` at `depth`) and, for a bilinear
     /// B̃, their corner values: the parent's corners, B at the four edge midpoints and at the
     /// centre — five evaluations, shared by the children so that B̃ is continuous across them.

@@ -26,7 +26,7 @@ use crate::frame::Frame;
 use crate::mapping::{SPHERE_AREA, sphere_to_square_batch, square_to_sphere};
 use crate::points::sobol02_shifted;
 use crate::quadtree::{COORD_BITS, Node, ProductKind, TreeBuilder, quantize, sort_key};
-use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild, point_in_cell};
+use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild, grandchild_index, point_in_cell};
 use glam::{DVec2, Mat3, Vec2, Vec3};
 use heapless::Vec;
 
@@ -108,7 +108,11 @@ impl ProductParams {
 /// 48·K + 8·NODES bytes (28 688 bytes for the default 256 / 2048). 256 samples make ~650–760 nodes
 /// on average and at most 1497 in 30 000 measured shading points (GGX α = 1e-3); when NODES is
 /// exhausted, splitting stops and leaves keep the mean of their samples (still exact sampling).
-pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048> {
+/// A bilinear B̃ (`ProductParams::bilinear`) also stores four corner values per node and needs
+/// CORNERS ≥ NODES (`ProductArena<256, 2048, 2048>`: +16·NODES bytes, 61 464 in all); with the
+/// default CORNERS = 0 nobody pays for it and B̃ stays piecewise constant
+/// ([`ProductSampler::is_bilinear`] says which was built).
+pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const CORNERS: usize = 0> {
     /// BRDF sample points, then the samples' points of the equal-area square.
     points: [Vec2; K],
     /// The BRDF's draws (shading frame).
@@ -119,17 +123,17 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048> {
     values: [f32; K],
     keys: Vec<u64, K>,
     nodes: Vec<Node, NODES>,
-    /// B̃ at each node's corners (bilinear B̃ only).
-    corners: Vec<Corners, NODES>,
+    /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
+    corners: Vec<Corners, CORNERS>,
 }
 
-impl<const K: usize, const NODES: usize> Default for ProductArena<K, NODES> {
+impl<const K: usize, const NODES: usize, const CORNERS: usize> Default for ProductArena<K, NODES, CORNERS> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
+impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, NODES, CORNERS> {
     const CAPACITY_OK: () = assert!(K >= 1 && K <= 1 << 16 && NODES >= 1);
 
     /// An empty arena (large: place it in a `static`, a `Box` or a thread's stack).
@@ -196,7 +200,7 @@ impl<const K: usize, const NODES: usize> ProductArena<K, NODES> {
             eval,
             probe_leaves: params.probe_leaves,
             refine_share: if params.kind == ProductKind::Quadtree { params.refine_share } else { 0.0 },
-            bilinear: params.bilinear && params.kind == ProductKind::Quadtree,
+            bilinear: params.bilinear && params.kind == ProductKind::Quadtree && CORNERS >= NODES,
             corners: &mut self.corners,
         };
         builder.build();
@@ -315,6 +319,12 @@ impl<'e> ProductSampler<'_, 'e> {
         self.brdf_samples
     }
 
+    /// True when B̃ is bilinear in the leaves (asked for, quadtree kind, arena with corners).
+    #[must_use]
+    pub fn is_bilinear(&self) -> bool {
+        !self.corners.is_empty()
+    }
+
     /// Effective defensive fraction ε (1 when the product has no mass).
     #[must_use]
     pub fn defensive(&self) -> f32 {
@@ -427,7 +437,7 @@ impl<'e> ProductSampler<'_, 'e> {
             let t = centre(cell.t, gy);
             let (row, slope) = (a + c * t, b + d * t);
             for gx in 0..4u32 {
-                let k = (gx & 1 | (gy & 1) << 1 | (gx >> 1) << 2 | (gy >> 1) << 3) as usize;
+                let k = grandchild_index(gx, gy);
                 mass[k] = g[k] * (row + slope * centre(cell.s, gx));
             }
         }
@@ -463,8 +473,7 @@ impl<'e> ProductSampler<'_, 'e> {
         while cell.level + 2 <= finest {
             let mass = self.bilinear_grandchild_masses(w, &cell);
             let (gx, gy) = bits(cell.level, 2);
-            let k = (gx & 1 | (gy & 1) << 1 | (gx >> 1) << 2 | (gy >> 1) << 3) as usize;
-            path *= grandchild_probability(&mass, k);
+            path *= grandchild_probability(&mass, grandchild_index(gx, gy));
             cell.descend_two(gx, gy);
         }
         if cell.level < finest {

@@ -42,6 +42,14 @@ pub fn choose_grandchild(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32
     grandchild_by(mass, xi, pick::<4>)
 }
 
+/// Index of grandchild (column x, row y) ∈ [0, 4)² in the Morton order of
+/// [`choose_grandchild`]: `x0 | y0 << 1 | x1 << 2 | y1 << 3`.
+#[inline(always)]
+#[must_use]
+pub fn grandchild_index(x: u32, y: u32) -> usize {
+    ((x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3) as usize
+}
+
 /// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
 /// every input with some mass), for interleaving several descents: alone, its chain of
 /// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
@@ -57,7 +65,7 @@ type Pick = fn([f64; 4], f64) -> Option<(usize, f64, f64)>;
 #[inline(always)]
 fn grandchild_by(mass: &[f32; 16], xi: &mut DVec2, pick: Pick) -> Option<(usize, u32, u32)> {
     let m = mass.map(f64::from);
-    let at = |x: usize, y: usize| (x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3;
+    let at = |x: usize, y: usize| grandchild_index(x as u32, y as u32);
     let cols: [f64; 4] = core::array::from_fn(|x| (m[at(x, 0)] + m[at(x, 1)]) + (m[at(x, 2)] + m[at(x, 3)]));
     let (x, ox, wx) = pick(cols, xi.x)?;
     let rows: [f64; 4] = core::array::from_fn(|y| m[at(x, y)]);

@@ -120,7 +120,8 @@ fn env_sampler_matches_its_pdf() {
 
 fn product_cases(params: ProductParams) -> Vec<String> {
     let envs = [("smooth", TestEnv::random_smooth(6, 2)), ("sun 1e6", TestEnv::sun(7, (90, 40), 1e6))];
-    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    // With room for a bilinear B̃'s corners.
+    let mut arena: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
     let cases = envs.len() * brdfs().len() * views().len();
     let alpha = sidak(cases);
     let mut failures = Vec::new();
@@ -131,6 +132,7 @@ fn product_cases(params: ProductParams) -> Vec<String> {
                 let frame = Frame::from_normal(normal);
                 let wo = frame.to_world(wo_local);
                 let sampler = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed as u64);
+                assert_eq!(sampler.is_bilinear(), params.bilinear && sampler.node_count() > 0);
                 let r = chi_square_dyadic(
                     SAMPLES,
                     11 + seed as u64,
@@ -192,6 +194,22 @@ fn quadtree_product_sampler_with_refined_leaves_matches_its_pdf() {
 fn quadtree_product_sampler_with_bilinear_leaves_matches_its_pdf() {
     let f = product_cases(ProductParams { bilinear: true, ..ProductParams::default() });
     assert!(f.is_empty(), "{}", f.join("\n"));
+}
+
+/// A bilinear B̃ needs an arena with room for corners; the default arena builds the
+/// piecewise-constant B̃ instead (nobody pays for corners they do not use).
+#[test]
+fn bilinear_needs_an_arena_with_corners() {
+    let env = TestEnv::random_smooth(5, 4);
+    let e = env.view();
+    let brdf = Lambert::new(Vec3::splat(0.5));
+    let frame = Frame::from_normal(Vec3::Z);
+    let wo = Vec3::new(0.0, 0.6, 0.8);
+    let params = ProductParams { bilinear: true, ..ProductParams::default() };
+    let mut plain: Box<ProductArena> = Box::new(ProductArena::new());
+    assert!(!plain.build(&e, &brdf, &frame, wo, &params, 1).is_bilinear());
+    let mut with_corners: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
+    assert!(with_corners.build(&e, &brdf, &frame, wo, &params, 1).is_bilinear());
 }
 
 #[test]

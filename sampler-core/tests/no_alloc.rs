@@ -52,7 +52,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
-    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    // With room for a bilinear B̃'s corners: every other quadtree build uses the MIS preset
+    // with a bilinear B̃.
+    let mut arena: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
     let brdfs: [&dyn Brdf; 4] = [
         &Lambert::new(Vec3::splat(0.5)),
         &Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e4),
@@ -70,8 +72,11 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let frame = Frame::from_normal(normal);
         let wo = frame.to_world(Vec3::new(0.3, 0.1, 0.9).normalize());
         let brdf = brdfs[(i % 4) as usize];
-        let kind = if i % 2 == 0 { ProductKind::Quadtree } else { ProductKind::Wavelet };
-        let params = ProductParams { kind, ..ProductParams::default() };
+        let params = match i % 4 {
+            0 => ProductParams::default(),
+            2 => ProductParams { bilinear: true, ..ProductParams::for_mis(256) },
+            _ => ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() },
+        };
         let sampler = arena.build(&env, brdf, &frame, wo, &params, i);
         let mut points = [DVec2::ZERO; 4];
         sobol02(i, 0, &mut points);
