@@ -122,8 +122,11 @@ pub fn shading_points_for(spp: usize, requested: usize) -> usize {
     gcd(spp, requested.max(1)).max(1)
 }
 
-/// Renders every (method, spp) pair and measures it against `reference`. `progress` is told
-/// about each finished render.
+/// Renders every (method, spp) pair and measures it against `reference`. With `bracket`
+/// (the base method of the equal-time tables), every faster method is then rendered on at
+/// doubling spp — at most [`BRACKET_DOUBLINGS`] times — until its time reaches the base's at
+/// its largest spp, so that the tables interpolate its error there instead of extrapolating.
+/// `progress` is told about each finished render.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep(
     scene: &Scene,
@@ -134,28 +137,53 @@ pub fn sweep(
     base: &Settings,
     per_point: Option<usize>,
     reference: &[[f32; 3]],
+    bracket: Option<Method>,
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
+    let mut measure = |method: Method, spp: usize| {
+        let settings = Settings {
+            method,
+            spp,
+            shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
+            ..*base
+        };
+        let image = render::render(scene, bvh, env, &settings);
+        let (rmse, relmse) = errors(&image.pixels, reference);
+        let regions = regions.errors(&image.pixels, reference);
+        let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions };
+        progress(&m);
+        m
+    };
     let mut out = Vec::new();
     for &method in methods {
         for &spp in spps {
-            let settings = Settings {
-                method,
-                spp,
-                shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
-                ..*base
-            };
-            let image = render::render(scene, bvh, env, &settings);
-            let (rmse, relmse) = errors(&image.pixels, reference);
-            let regions = regions.errors(&image.pixels, reference);
-            let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions };
-            progress(&m);
-            out.push(m);
+            out.push(measure(method, spp));
+        }
+    }
+    let Some(target) = bracket else { return out };
+    let slowest = |out: &[Measurement], m: Method| {
+        out.iter().filter(|x| x.method == m).max_by_key(|x| x.spp).map(|x| (x.spp, x.seconds))
+    };
+    let Some((_, goal)) = slowest(&out, target) else { return out };
+    for &method in methods.iter().filter(|&&m| m != target) {
+        for _ in 0..BRACKET_DOUBLINGS {
+            match slowest(&out, method) {
+                Some((spp, seconds)) if seconds < goal && spp <= MAX_BRACKET_SPP / 2 => {
+                    out.push(measure(method, 2 * spp));
+                }
+                _ => break,
+            }
         }
     }
     out
 }
+
+/// Most extra doublings of a method's spp when bracketing the base's time (8× its largest).
+pub const BRACKET_DOUBLINGS: usize = 3;
+
+/// No bracketing render goes beyond this many visibility samples per pixel.
+const MAX_BRACKET_SPP: usize = 1 << 20;
 
 /// relMSE over `region` of `method` at time `t`, interpolated log-log between its
 /// measurements (outside their range: extended along the nearest segment; flagged).
@@ -194,9 +222,15 @@ pub fn csv(measurements: &[Measurement]) -> String {
     s
 }
 
-/// `report.md`: the measurements, then equal-time tables against `product` for the whole
-/// image and for each region.
-pub fn markdown(scene: &str, measurements: &[Measurement], threads: usize, reference_note: &str) -> String {
+/// `report.md`: the measurements, then equal-time tables against `base` (e.g. `product`) for
+/// the whole image and for each region.
+pub fn markdown(
+    scene: &str,
+    measurements: &[Measurement],
+    base: Method,
+    threads: usize,
+    reference_note: &str,
+) -> String {
     let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
     s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
     let regions: Vec<String> =
@@ -217,19 +251,22 @@ pub fn markdown(scene: &str, measurements: &[Measurement], threads: usize, refer
     }
     let mut others: Vec<Method> = Vec::new();
     for m in measurements {
-        if m.method != Method::Product && !others.contains(&m.method) {
+        if m.method != base && !others.contains(&m.method) {
             others.push(m.method);
         }
     }
-    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == Method::Product).collect();
+    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == base).collect();
     if product.is_empty() || others.is_empty() {
         return s;
     }
-    s.push_str("\n## Equal time\n\nFor the time product sampling takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to product's (> 1: product is better).\n");
+    let _ = write!(
+        s,
+        "\n## Equal time\n\nFor the time {base} takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to {base}'s (> 1: {base} is better).\n"
+    );
     for region in std::iter::once("all".to_string()).chain(regions) {
         let _ = write!(
             s,
-            "\n### {}\n\n| product spp | seconds | product relMSE |",
+            "\n### {}\n\n| {base} spp | seconds | {base} relMSE |",
             if region == "all" { "whole image".to_string() } else { format!("pixels on {region}") }
         );
         for o in &others {
@@ -347,7 +384,7 @@ mod tests {
         assert!((e - 0.2).abs() < 1e-9 && !outside); // error ∝ 1/t between the points
         let (e, outside) = relmse_at(&ms, Method::Env, "all", 8.0).unwrap();
         assert!((e - 0.05).abs() < 1e-9 && outside);
-        let md = markdown("t", &ms, 2, "test");
+        let md = markdown("t", &ms, Method::Product, 2, "test");
         assert!(md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"), "{md}");
         assert!(md.contains("### pixels on carpaint"), "{md}");
         assert!(md.contains("| 4 | 2.000 | 2.5000e-2 | 1.0000e-1 | 4.00 |"), "{md}");

@@ -142,5 +142,62 @@ fn report_writes_csv_plots_and_table() {
     let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
     assert!(md.contains("## Equal time") && md.contains("env relMSE"), "{md}");
     fails(&dir, &["report", "--out", "rep2", "--methods", "product,nope"], "nope");
+    fails(&dir, &["report", "--out", "rep3", "--methods", "product,mis", "--base", "env"], "--base env");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--base` keys the equal-time tables; `--bracket` renders the faster methods on until they
+/// reach the base's time or have doubled their spp three times.
+#[test]
+fn report_brackets_the_base_time() {
+    let dir = scratch("bracket");
+    let out = ppis()
+        .current_dir(&dir)
+        .args([
+            "report",
+            "--samples-per-point",
+            "2",
+            "--width",
+            "24",
+            "--height",
+            "14",
+            "--spp",
+            "4",
+            "--reference-spp",
+            "16",
+            "--methods",
+            "mis,product-mis",
+            "--base",
+            "product-mis",
+            "--bracket",
+            "--out",
+            "rep",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
+    let rows: Vec<(String, usize, f64)> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.contains(",all,"))
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].to_string(), f[1].parse().unwrap(), f[2].parse().unwrap())
+        })
+        .collect();
+    let base_time = rows.iter().filter(|r| r.0 == "product-mis").map(|r| r.2).fold(0.0, f64::max);
+    let mis: Vec<&(String, usize, f64)> = rows.iter().filter(|r| r.0 == "mis").collect();
+    assert_eq!(rows.iter().filter(|r| r.0 == "product-mis").count(), 1, "{csv}");
+    // Either MIS reached the base's time or it doubled three times (4 → 32 spp); every extra
+    // render doubles the last one.
+    let last = mis.last().unwrap();
+    assert!(last.2 >= base_time || last.1 == 32, "{csv}");
+    for (k, r) in mis.iter().enumerate() {
+        assert_eq!(r.1, 4 << k, "{csv}");
+    }
+    let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
+    assert!(md.contains("For the time product-mis takes") && md.contains("| product-mis spp |"), "{md}");
     let _ = std::fs::remove_dir_all(&dir);
 }
