@@ -72,11 +72,12 @@ impl Method {
     ///
     /// * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is
     ///   wide enough to span bright detail of the map and narrow enough that one B̃ per pixel fits
-    ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time: s1 α = 0.05
-    ///   2.05× (MIS), studio α = 0.05 1.74× (MIS), s2 α = 0.1 1.00×.
-    /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: MIS 1.2–2.6×
-    ///   ahead), wider ones (α ≥ 0.15: MIS or env-only ahead), car paint (MIS 2.1×), diffuse.
-    ///   Env-only sampling wins on diffuse and α = 0.3 under soft boxes (studio, s2, s1's forest)
+    ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time (`ppis
+    ///   report --base product-mis --bracket`): s1 α = 0.05 2.01× (MIS), studio α = 0.05 2.32×
+    ///   (MIS), s2 α = 0.1 1.23× (MIS).
+    /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: MIS 1.1–1.6×
+    ///   ahead), wider ones (α ≥ 0.15: MIS or env-only ahead), car paint (MIS 1.7×), diffuse.
+    ///   Env-only sampling wins on studio's and s2's diffuse and on α = 0.3 (studio, s1's forest)
     ///   but is 3–6× behind MIS under the default sky's sun, so it is not picked.
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
