@@ -107,32 +107,20 @@ fn a_small_render_writes_exr_png_and_stats() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Runs `ppis report` on a tiny image (24×14, 2 samples per shading point, a 16-spp rendered
+/// reference) into `dir/rep` with `args` added; asserts success and returns stderr.
+fn tiny_report(dir: &Path, args: &[&str]) -> String {
+    let common = ["report", "--samples-per-point", "2", "--width", "24", "--height", "14", "--reference-spp", "16"];
+    let out = ppis().current_dir(dir).args(common).args(args).args(["--out", "rep"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    stderr
+}
+
 #[test]
 fn report_writes_csv_plots_and_table() {
     let dir = scratch("report");
-    let out = ppis()
-        .current_dir(&dir)
-        .args([
-            "report",
-            "--samples-per-point",
-            "2",
-            "--width",
-            "24",
-            "--height",
-            "14",
-            "--spp",
-            "2,4",
-            "--reference-spp",
-            "16",
-            "--methods",
-            "product,env,mis",
-            "--out",
-            "rep",
-        ])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let stderr = tiny_report(&dir, &["--spp", "2,4", "--methods", "product,env,mis"]);
     for f in ["error_vs_time.csv", "error_vs_time.svg", "error_vs_time.png", "report.md", "reference.exr"] {
         assert!(dir.join("rep").join(f).is_file(), "{f} missing: {stderr}");
     }
@@ -151,32 +139,7 @@ fn report_writes_csv_plots_and_table() {
 #[test]
 fn report_brackets_the_base_time() {
     let dir = scratch("bracket");
-    let out = ppis()
-        .current_dir(&dir)
-        .args([
-            "report",
-            "--samples-per-point",
-            "2",
-            "--width",
-            "24",
-            "--height",
-            "14",
-            "--spp",
-            "4",
-            "--reference-spp",
-            "16",
-            "--methods",
-            "mis,product-mis",
-            "--base",
-            "product-mis",
-            "--bracket",
-            "--out",
-            "rep",
-        ])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    tiny_report(&dir, &["--spp", "4", "--methods", "mis,product-mis", "--base", "product-mis", "--bracket"]);
     let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
     let rows: Vec<(String, usize, f64)> = csv
         .lines()
