@@ -5,8 +5,8 @@
 //! Corner values are in child order (see `warp::child_offset`): (0,0), (1,0), (0,1), (1,1), in
 //! the cell's own coordinates s, t ∈ [0, 1].
 
-use crate::warp::ONE_MINUS_EPSILON;
-use glam::DVec2;
+use crate::warp::{ONE_MINUS_EPSILON, child_offset, inverse_area};
+use glam::{DVec2, Vec2};
 
 /// The values at a cell's four corners.
 pub type Corners = [f32; 4];
@@ -69,6 +69,54 @@ fn sample_linear(u: f64, a: f64, b: f64) -> f64 {
         return u;
     }
     (u * (a + b) / denom).min(ONE_MINUS_EPSILON)
+}
+
+/// The masses a step of the bilinear walk chooses from.
+pub(crate) enum Masses<'m> {
+    /// The 16 grandchildren, Morton order.
+    Sixteen(&'m [f32; 16]),
+    /// The four children.
+    Four([f32; 4]),
+}
+
+/// A cell of the environment's levels inside a bilinear leaf: its position in the pyramid and
+/// its lower corner (s, t) and side in the leaf's own coordinates.
+pub(crate) struct BilinearCell {
+    pub level: u32,
+    pub x: u32,
+    pub y: u32,
+    pub s: f32,
+    pub t: f32,
+    pub size: f32,
+}
+
+impl BilinearCell {
+    /// To grandchild (gx, gy) ∈ [0, 4)².
+    #[inline(always)]
+    pub fn descend_two(&mut self, gx: u32, gy: u32) {
+        self.size *= 0.25;
+        self.s += gx as f32 * self.size;
+        self.t += gy as f32 * self.size;
+        (self.level, self.x, self.y) = (self.level + 2, 4 * self.x + gx, 4 * self.y + gy);
+    }
+
+    #[inline(always)]
+    pub fn descend(&mut self, child: usize) {
+        let (dx, dy) = child_offset(child);
+        self.size *= 0.5;
+        self.s += dx as f32 * self.size;
+        self.t += dy as f32 * self.size;
+        (self.level, self.x, self.y) = (self.level + 1, 2 * self.x + dx, 2 * self.y + dy);
+    }
+
+    /// Density per unit square area at `uv` in this final cell (reached with probability
+    /// `path`, B̃ bilinear between `corners` inside it).
+    #[inline]
+    pub fn density(&self, path: f64, corners: &Corners, uv: Vec2) -> f64 {
+        let scale = (1u64 << self.level) as f64;
+        let p = DVec2::new(uv.x as f64 * scale - self.x as f64, uv.y as f64 * scale - self.y as f64);
+        path * inverse_area(self.level) * pdf(corners, p.clamp(DVec2::ZERO, DVec2::ONE))
+    }
 }
 
 #[cfg(test)]

@@ -19,14 +19,17 @@
 //! variance against ε = 0: ε = 0.02 → +3.0% (Lambert), +3.5% (GGX α = 0.1), +6.5% (car paint);
 //! ε = 0.05 → +4.5%, +11%, +16%. The default is ε = 0.02.
 
-use crate::bilinear::{self, Corners};
+use crate::bilinear::{self, BilinearCell, Corners, Masses};
 use crate::brdf::{Brdf, BrdfDraw};
 use crate::env::{EnvHierarchy, luminance};
 use crate::frame::Frame;
 use crate::mapping::{SPHERE_AREA, sphere_to_square_batch, square_to_sphere};
 use crate::points::sobol02_shifted;
 use crate::quadtree::{COORD_BITS, Node, ProductKind, TreeBuilder, quantize, sort_key};
-use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild, grandchild_index, point_in_cell};
+use crate::warp::{
+    ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild, grandchild_index, grandchild_probability,
+    inverse_area, point_in_cell,
+};
 use glam::{DVec2, Mat3, Vec2, Vec3};
 use heapless::Vec;
 
@@ -225,59 +228,6 @@ fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
     (column / total) * (m[dx + 2 * dy] / column)
 }
 
-/// 4^depth exactly (no_std has no powi): the inverse of a depth-`depth` cell's area.
-#[inline(always)]
-fn inverse_area(depth: u32) -> f64 {
-    f64::from_bits((1023 + 2 * depth as u64) << 52)
-}
-
-/// A cell of the environment's levels inside a bilinear leaf: its position in the pyramid and
-/// its lower corner (s, t) and side in the leaf's own coordinates.
-struct BilinearCell {
-    level: u32,
-    x: u32,
-    y: u32,
-    s: f32,
-    t: f32,
-    size: f32,
-}
-
-impl BilinearCell {
-    /// To grandchild (gx, gy) ∈ [0, 4)².
-    #[inline(always)]
-    fn descend_two(&mut self, gx: u32, gy: u32) {
-        self.size *= 0.25;
-        self.s += gx as f32 * self.size;
-        self.t += gy as f32 * self.size;
-        (self.level, self.x, self.y) = (self.level + 2, 4 * self.x + gx, 4 * self.y + gy);
-    }
-
-    #[inline(always)]
-    fn descend(&mut self, child: usize) {
-        let (dx, dy) = child_offset(child);
-        self.size *= 0.5;
-        self.s += dx as f32 * self.size;
-        self.t += dy as f32 * self.size;
-        (self.level, self.x, self.y) = (self.level + 1, 2 * self.x + dx, 2 * self.y + dy);
-    }
-
-    /// Density per unit square area at `uv` in this final cell (reached with probability
-    /// `path`, B̃ bilinear between `corners` inside it).
-    #[inline]
-    fn density(&self, path: f64, corners: &Corners, uv: Vec2) -> f64 {
-        let scale = (1u64 << self.level) as f64;
-        let p = DVec2::new(uv.x as f64 * scale - self.x as f64, uv.y as f64 * scale - self.y as f64);
-        path * inverse_area(self.level) * bilinear::pdf(corners, p.clamp(DVec2::ZERO, DVec2::ONE))
-    }
-}
-
-/// Probability that `choose_grandchild` picks grandchild `k` of masses `mass`.
-#[inline]
-fn grandchild_probability(mass: &[f32; 16], k: usize) -> f64 {
-    let total: f64 = mass.iter().map(|&m| f64::from(m)).sum();
-    if total > 0.0 { f64::from(mass[k]) / total } else { 0.0 }
-}
-
 /// A direction drawn by a sampler, with its density.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DirectionSample {
@@ -395,33 +345,56 @@ impl<'e> ProductSampler<'_, 'e> {
     fn warp_bilinear(
         &self,
         leaf: usize,
-        mut path: f64,
+        path: f64,
         depth: u32,
         x: u32,
         y: u32,
         xi: &mut DVec2,
     ) -> Option<(Vec2, f64, f32)> {
         let w = &self.corners[leaf];
-        let finest = self.env.finest_level();
-        let mut cell = BilinearCell { level: depth, x, y, s: 0.0, t: 0.0, size: 1.0 };
-        // Two levels per step over the 16 grandchildren (one cache line), then one if left.
-        while cell.level + 2 <= finest {
-            let mass = self.bilinear_grandchild_masses(w, &cell);
-            let (k, gx, gy) = choose_grandchild(&mass, xi)?;
-            path *= grandchild_probability(&mass, k);
-            cell.descend_two(gx, gy);
-        }
-        if cell.level < finest {
-            let mass = self.bilinear_masses(w, &cell);
-            let child = choose_child(mass, xi)?;
-            path *= branch_probability(mass, child);
-            cell.descend(child);
-        }
+        let (cell, path) = self.walk_bilinear(w, path, depth, x, y, |masses, _| match masses {
+            Masses::Sixteen(m) => choose_grandchild(m, xi).map(|(k, _, _)| k),
+            Masses::Four(m) => choose_child(m, xi),
+        })?;
         let corners = bilinear::sub_corners(w, cell.s, cell.t, cell.size);
         let uv = point_in_cell(cell.x, cell.y, cell.level, bilinear::sample(&corners, *xi));
         let texel = self.env.cell_relative(cell.level, cell.x, cell.y);
         // The density at the point as stored (f32), as `pdf_square` will find it.
         Some((uv, cell.density(path, &corners, uv), texel))
+    }
+
+    /// The walk below a bilinear leaf (cell (depth, x, y), reached with probability `path`)
+    /// down to the finest level: two levels per step over the 16 grandchildren (one cache
+    /// line), then one if left, each cell weighed by L·B̃ at its centre. `pick` chooses the
+    /// next cell from the masses (`warp_bilinear` by its point, `bilinear_density` by the
+    /// bits of `uv`) — one walk, so the warp and its pdf weigh every cell alike. Returns the
+    /// final cell and the probability of reaching it; `None` when `pick` finds no mass.
+    fn walk_bilinear(
+        &self,
+        w: &Corners,
+        mut path: f64,
+        depth: u32,
+        x: u32,
+        y: u32,
+        mut pick: impl FnMut(Masses<'_>, &BilinearCell) -> Option<usize>,
+    ) -> Option<(BilinearCell, f64)> {
+        let finest = self.env.finest_level();
+        let mut cell = BilinearCell { level: depth, x, y, s: 0.0, t: 0.0, size: 1.0 };
+        while cell.level + 2 <= finest {
+            let mass = self.bilinear_grandchild_masses(w, &cell);
+            let k = pick(Masses::Sixteen(&mass), &cell)?;
+            path *= grandchild_probability(&mass, k);
+            // Morton index → (column, row) of the grandchild.
+            let (gx, gy) = ((k & 1 | (k >> 1) & 2) as u32, ((k >> 1) & 1 | (k >> 2) & 2) as u32);
+            cell.descend_two(gx, gy);
+        }
+        if cell.level < finest {
+            let mass = self.bilinear_masses(w, &cell);
+            let child = pick(Masses::Four(mass), &cell)?;
+            path *= branch_probability(mass, child);
+            cell.descend(child);
+        }
+        Some((cell, path))
     }
 
     /// The environment's 16 grandchildren of `cell` (Morton order, see `choose_grandchild`),
@@ -460,29 +433,26 @@ impl<'e> ProductSampler<'_, 'e> {
 
     /// The bilinear product's density at `uv` inside leaf `leaf` (cell (depth, x, y), reached
     /// with probability `path`): the walk `warp_bilinear` takes, replayed by `uv`'s bits.
-    fn bilinear_density(&self, leaf: usize, mut path: f64, depth: u32, x: u32, y: u32, uv: Vec2) -> f64 {
+    fn bilinear_density(&self, leaf: usize, path: f64, depth: u32, x: u32, y: u32, uv: Vec2) -> f64 {
         let w = &self.corners[leaf];
-        let finest = self.env.finest_level();
         let (qx, qy) = (quantize(uv.x), quantize(uv.y));
-        let mut cell = BilinearCell { level: depth, x, y, s: 0.0, t: 0.0, size: 1.0 };
+        // The bits of `uv` that choose among the 2^n × 2^n cells below a cell of `level`.
         let bits = |level: u32, n: u32| {
             let shift = COORD_BITS - level - n;
             let mask = (1 << n) - 1;
             ((qx >> shift) & mask, (qy >> shift) & mask)
         };
-        while cell.level + 2 <= finest {
-            let mass = self.bilinear_grandchild_masses(w, &cell);
-            let (gx, gy) = bits(cell.level, 2);
-            path *= grandchild_probability(&mass, grandchild_index(gx, gy));
-            cell.descend_two(gx, gy);
-        }
-        if cell.level < finest {
-            let mass = self.bilinear_masses(w, &cell);
-            let (dx, dy) = bits(cell.level, 1);
-            let child = (dx + 2 * dy) as usize;
-            path *= branch_probability(mass, child);
-            cell.descend(child);
-        }
+        let walked = self.walk_bilinear(w, path, depth, x, y, |masses, cell| match masses {
+            Masses::Sixteen(_) => {
+                let (gx, gy) = bits(cell.level, 2);
+                Some(grandchild_index(gx, gy))
+            }
+            Masses::Four(_) => {
+                let (dx, dy) = bits(cell.level, 1);
+                Some((dx + 2 * dy) as usize)
+            }
+        });
+        let Some((cell, path)) = walked else { return 0.0 };
         cell.density(path, &bilinear::sub_corners(w, cell.s, cell.t, cell.size), uv)
     }
 

@@ -50,6 +50,13 @@ pub fn grandchild_index(x: u32, y: u32) -> usize {
     ((x & 1) | (y & 1) << 1 | (x >> 1) << 2 | (y >> 1) << 3) as usize
 }
 
+/// Probability that `choose_grandchild` picks grandchild `k` of masses `mass`.
+#[inline]
+pub(crate) fn grandchild_probability(mass: &[f32; 16], k: usize) -> f64 {
+    let total: f64 = mass.iter().map(|&m| f64::from(m)).sum();
+    if total > 0.0 { f64::from(mass[k]) / total } else { 0.0 }
+}
+
 /// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
 /// every input with some mass), for interleaving several descents: alone, its chain of
 /// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
@@ -126,6 +133,12 @@ fn rescale(xi: &mut DVec2, ox: f64, wx: f64, oy: f64, wy: f64) {
     let r = 1.0 / (wx * wy);
     xi.x = (ox * wy * r).clamp(0.0, ONE_MINUS_EPSILON);
     xi.y = (oy * wx * r).clamp(0.0, ONE_MINUS_EPSILON);
+}
+
+/// 4^depth exactly (no_std has no powi): the inverse of a depth-`depth` cell's area.
+#[inline(always)]
+pub(crate) fn inverse_area(depth: u32) -> f64 {
+    f64::from_bits((1023 + 2 * depth as u64) << 52)
 }
 
 /// Places a uniform point `xi` ∈ [0,1)² inside cell `(x, y)` of a `2^level` grid, returning
