@@ -5,8 +5,8 @@
 use crate::scene::Bsdf;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
-use sampler_core::estimator::{self, ShadingPoint, Visibility};
-use sampler_core::glam::{DVec2, DVec3, Vec3};
+use sampler_core::estimator::{self, Contribution, ShadingPoint, Visibility};
+use sampler_core::glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::hash_combine;
@@ -182,6 +182,8 @@ pub fn shade<B: Brdf + ?Sized>(
     let mut points = [DVec2::ZERO; 64];
     let mut others = [DVec2::ZERO; 64];
     let mut drawn = [None; 64];
+    let mut product_drawn = [None; 64];
+    let mut pairs_out = [[Contribution::default(); 2]; 64];
     let mut sum = DVec3::ZERO;
     // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
@@ -196,14 +198,24 @@ pub fn shade<B: Brdf + ?Sized>(
         if matches!(method, Method::Mis | Method::Env) {
             env.sample_many(&points[..m], &mut drawn[..m]);
         }
+        match (method, technique) {
+            (Method::ProductMis, Technique::Product(p)) => {
+                let mut brdf_points = [Vec2::ZERO; 64];
+                for (b, o) in brdf_points.iter_mut().zip(&others[..m]) {
+                    *b = o.as_vec2();
+                }
+                estimator::product_mis_many(p, sp, &points[..m], &brdf_points[..m], vis, &mut pairs_out[..m]);
+            }
+            (_, Technique::Product(p)) => p.sample_many(&points[..m], &mut product_drawn[..m]),
+            _ => {}
+        }
         for k in 0..m {
             let u = points[k];
             sum += match (method, technique) {
-                (Method::Product | Method::Wavelet, Technique::Product(p)) => estimator::product(p, sp, u, vis).value,
-                (Method::ProductMis, Technique::Product(p)) => {
-                    let [a, b] = estimator::product_mis(p, sp, u, others[k].as_vec2(), vis);
-                    a.value + b.value
+                (Method::Product | Method::Wavelet, Technique::Product(p)) => {
+                    estimator::product_drawn(p, sp, product_drawn[k], vis).value
                 }
+                (Method::ProductMis, Technique::Product(_)) => pairs_out[k][0].value + pairs_out[k][1].value,
                 (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
                 (Method::Env, _) => estimator::env_drawn(env, sp, drawn[k], vis).value,
                 (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,

@@ -157,20 +157,20 @@ fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError
 
 /// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
 #[derive(Clone, Copy, Debug, Default)]
-struct WarpLane {
-    level: u32,
-    x: u32,
-    y: u32,
+pub(crate) struct WarpLane {
+    pub level: u32,
+    pub x: u32,
+    pub y: u32,
     /// Morton index of (x, y) within its level.
     morton: usize,
-    xi: DVec2,
+    pub xi: DVec2,
     /// False once the descent met a node without mass (or never started).
-    alive: bool,
+    pub alive: bool,
 }
 
 impl WarpLane {
     /// A descent from node (x, y) of `level` with the point `u` (clamped into [0, 1)²).
-    fn new(level: u32, x: u32, y: u32, u: DVec2) -> Self {
+    pub(crate) fn new(level: u32, x: u32, y: u32, u: DVec2) -> Self {
         let xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
         Self { level, x, y, morton: morton2(x, y), xi, alive: true }
     }
@@ -468,7 +468,7 @@ impl<'a> EnvHierarchy<'a> {
 
     /// [`warp_down`](Self::warp_down) for up to a few descents at once, each from its own node,
     /// advanced level by level side by side. A lane that meets a node without mass dies.
-    fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
+    pub(crate) fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
         if self.is_black() {
             lanes.iter_mut().for_each(|l| l.alive = false);
             return;

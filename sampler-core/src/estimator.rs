@@ -3,11 +3,11 @@
 //! there is one) and the densities it used, so hosts can average, inspect and test them.
 //! Visibility is asked only for directions whose unoccluded contribution is non-zero.
 
-use crate::brdf::Brdf;
+use crate::brdf::{Brdf, BrdfSample};
 use crate::env::{EnvHierarchy, EnvSample};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
-use crate::sampler::ProductSampler;
+use crate::sampler::{DirectionSample, ProductSampler};
 use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
@@ -87,7 +87,17 @@ pub fn product<B: Brdf + ?Sized>(
     u: DVec2,
     vis: &mut impl Visibility,
 ) -> Contribution {
-    let Some(s) = sampler.sample(u) else {
+    product_drawn(sampler, sp, sampler.sample(u), vis)
+}
+
+/// [`product`] with its sample already drawn (e.g. by [`ProductSampler::sample_many`]).
+pub fn product_drawn<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<DirectionSample>,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = drawn else {
         return Contribution::default();
     };
     let f = times(sampler.env().radiance_at(s.uv), sp.eval(s.dir));
@@ -169,7 +179,19 @@ pub fn product_mis<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let drawn = sampler.sample(u_product).map(|s| (s.dir, s.uv, s.pdf));
+    product_mis_drawn(sampler, sp, sampler.sample(u_product), u_brdf, vis)
+}
+
+/// [`product_mis`] with its product sample already drawn (e.g. by
+/// [`ProductSampler::sample_many`]).
+pub fn product_mis_drawn<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<DirectionSample>,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
+    let drawn = drawn.map(|s| (s.dir, s.uv, s.pdf));
     mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
 }
 
@@ -184,20 +206,75 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let mut out = [Contribution::default(); 2];
-    if let Some((dir, uv, p)) = drawn {
-        let p_brdf = sp.brdf_pdf(dir);
-        let f = times(env_h.radiance_at(uv), sp.eval(dir));
-        out[0] = Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf };
+    let first = mis_drawn_half(env_h, sp, drawn, vis);
+    let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) else { return [first, Contribution::default()] };
+    let dir = sp.frame.to_world(s.wi);
+    let uv = env_h.square_of(dir);
+    [first, mis_brdf_half(env_h, (dir, uv, s), pdf_square(uv) / SPHERE_AREA, vis)]
+}
+
+/// The balance-heuristic share of a direction drawn by the other technique (direction, point
+/// of the square, density).
+#[inline]
+fn mis_drawn_half<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: Option<(Vec3, Vec2, f32)>,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some((dir, uv, p)) = drawn else { return Contribution::default() };
+    let p_brdf = sp.brdf_pdf(dir);
+    let f = times(env_h.radiance_at(uv), sp.eval(dir));
+    Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf }
+}
+
+/// The balance-heuristic share of a BRDF sample (world direction, its point of the square, the
+/// draw), where the other technique's density is `p_other`.
+#[inline]
+fn mis_brdf_half(
+    env_h: &EnvHierarchy<'_>,
+    (dir, uv, s): (Vec3, Vec2, BrdfSample),
+    p_other: f32,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let f = times(env_h.radiance_at(uv), s.value);
+    Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other }
+}
+
+/// [`product_mis`] for up to 64 pairs at once (`out[k]` from `u_product[k]` and `u_brdf[k]`):
+/// the product samples drawn by [`ProductSampler::sample_many`] and the product's density at
+/// the BRDF samples by [`ProductSampler::pdf_square_many`], four tree descents side by side
+/// (the same values as one pair at a time, up to the last bits of a product sample's point).
+pub fn product_mis_many<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: &[DVec2],
+    u_brdf: &[Vec2],
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = u_product.len().min(u_brdf.len()).min(out.len()).min(64);
+    let env_h = sampler.env();
+    let mut drawn = [None; 64];
+    sampler.sample_many(&u_product[..n], &mut drawn[..n]);
+    let wo = sp.frame.to_local(sp.wo);
+    let mut brdf = [None; 64];
+    let mut uvs = [Vec2::ZERO; 64];
+    for k in 0..n {
+        if let Some(s) = sp.brdf.sample(wo, u_brdf[k]) {
+            let dir = sp.frame.to_world(s.wi);
+            uvs[k] = env_h.square_of(dir);
+            brdf[k] = Some((dir, uvs[k], s));
+        }
     }
-    if let Some(s) = sp.brdf.sample(sp.frame.to_local(sp.wo), u_brdf) {
-        let dir = sp.frame.to_world(s.wi);
-        let uv = env_h.square_of(dir);
-        let p_other = pdf_square(uv) / SPHERE_AREA;
-        let f = times(env_h.radiance_at(uv), s.value);
-        out[1] = Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other };
+    let mut p_other = [0.0f32; 64];
+    sampler.pdf_square_many(&uvs[..n], &mut p_other[..n]);
+    for k in 0..n {
+        let first = mis_drawn_half(env_h, sp, drawn[k].map(|s| (s.dir, s.uv, s.pdf)), vis);
+        let second =
+            brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
+        out[k] = [first, second];
     }
-    out
 }
 
 /// Resampled importance sampling (Talbot et al. 2005): `candidates.len()` candidates from the

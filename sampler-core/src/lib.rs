@@ -48,6 +48,7 @@ pub mod estimator;
 pub mod frame;
 pub mod mapping;
 pub mod points;
+mod product_lanes;
 pub mod quadtree;
 pub mod rng;
 pub mod sampler;

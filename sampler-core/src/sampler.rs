@@ -217,7 +217,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
 /// Probability that the warp picks child `k` among four of masses `mass`: the column, then the
 /// row — m_k / Σm, computed as the warp's own two ratios.
 #[inline]
-fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
+pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
     let m = mass.map(f64::from);
     let (dx, dy) = (k & 1, k >> 1);
     let total = m[0] + m[1] + m[2] + m[3];
@@ -242,11 +242,11 @@ pub struct DirectionSample {
 /// The product distribution of one shading point, borrowing its arena.
 #[derive(Clone, Copy, Debug)]
 pub struct ProductSampler<'a, 'e> {
-    env: &'a EnvHierarchy<'e>,
-    nodes: &'a [Node],
+    pub(crate) env: &'a EnvHierarchy<'e>,
+    pub(crate) nodes: &'a [Node],
     /// Per node, B̃ at its corners; empty unless B̃ is bilinear.
-    corners: &'a [Corners],
-    defensive: f32,
+    pub(crate) corners: &'a [Corners],
+    pub(crate) defensive: f32,
     brdf_samples: usize,
 }
 
@@ -459,7 +459,7 @@ impl<'e> ProductSampler<'_, 'e> {
     /// Density per unit square area inside the leaf (depth, x, y) reached with probability
     /// `path`, at a point whose texel has relative importance `texel`: the leaf's share spread
     /// over its area, and below it the environment's texels in proportion to their importance.
-    fn leaf_density(&self, path: f64, depth: u32, x: u32, y: u32, texel: f32) -> f64 {
+    pub(crate) fn leaf_density(&self, path: f64, depth: u32, x: u32, y: u32, texel: f32) -> f64 {
         let area = inverse_area(depth);
         if depth < self.env.finest_level() {
             let leaf_env = self.env.node_relative(depth, x, y) as f64;
@@ -497,7 +497,7 @@ impl<'e> ProductSampler<'_, 'e> {
     /// The mixture density per unit square area, from the product's density and the texel's
     /// relative importance.
     #[inline]
-    fn mixture(&self, product: f64, env_relative: f32) -> f32 {
+    pub(crate) fn mixture(&self, product: f64, env_relative: f32) -> f32 {
         if self.defensive >= 1.0 {
             return env_relative;
         }

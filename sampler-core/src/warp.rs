@@ -62,7 +62,18 @@ pub(crate) fn grandchild_probability(mass: &[f32; 16], k: usize) -> f64 {
 /// dependent arithmetic is slower than a predicted branch; four chains side by side are not.
 #[inline(always)]
 pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
-    grandchild_by(mass, xi, pick_branchless)
+    grandchild_by(mass, xi, pick_branchless::<4>)
+}
+
+/// [`choose_child`] without data-dependent branches (the same choice for every input with
+/// some mass; ξ may differ in its last bits), for descents run side by side.
+#[inline(always)]
+pub fn choose_child_branchless(mass: [f32; 4], xi: &mut DVec2) -> Option<usize> {
+    let m = mass.map(f64::from);
+    let (dx, ox, wx) = pick_branchless([m[0] + m[2], m[1] + m[3]], xi.x)?;
+    let (dy, oy, wy) = pick_branchless([m[dx], m[dx + 2]], xi.y)?;
+    rescale(xi, ox, wx, oy, wy);
+    Some(dx + 2 * dy)
 }
 
 /// A side chooser: (weights, ξ) → (side, ξ's offset into it, its weight).
@@ -106,23 +117,24 @@ fn pick<const N: usize>(w: [f64; N], x: f64) -> Option<(usize, f64, f64)> {
     Some((last, t - last_acc, w[last]))
 }
 
+/// [`pick`] by a count of prefix sums below t (N ≤ 4).
 #[inline(always)]
-fn pick_branchless(w: [f64; 4], x: f64) -> Option<(usize, f64, f64)> {
-    let p1 = w[0];
-    let p2 = p1 + w[1];
-    let p3 = p2 + w[2];
-    let total = p3 + w[3];
+fn pick_branchless<const N: usize>(w: [f64; N], x: f64) -> Option<(usize, f64, f64)> {
+    let mut prefix = [0.0; 4];
+    for i in 1..N {
+        prefix[i] = prefix[i - 1] + w[i - 1];
+    }
+    let total = prefix[N - 1] + w[N - 1];
     if total.is_nan() || total <= 0.0 {
         return None;
     }
     let t = x * total;
-    let i = (t >= p1) as usize + (t >= p2) as usize + (t >= p3) as usize;
-    let prefix = [0.0, p1, p2, p3];
+    let i = (1..N).map(|j| (t >= prefix[j]) as usize).sum::<usize>();
     if w[i] > 0.0 {
         Some((i, t - prefix[i], w[i]))
     } else {
         // Rounding put t at the total with trailing empty sides: the last side with mass.
-        let i = (0..4).rev().find(|&j| w[j] > 0.0)?;
+        let i = (0..N).rev().find(|&j| w[j] > 0.0)?;
         Some((i, t - prefix[i], w[i]))
     }
 }

@@ -5,12 +5,12 @@
 mod common;
 
 use common::*;
-use glam::{DVec2, Vec3};
+use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::SPHERE_AREA;
 use sampler_core::quadtree::ProductKind;
-use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
 
 const SAMPLES: usize = 100_000;
 
@@ -156,9 +156,10 @@ fn product_cases(params: ProductParams) -> Vec<String> {
                     assert_eq!(sampler.pdf_square(s.uv) / SPHERE_AREA, s.pdf);
                     mismatch += usize::from((sampler.pdf(s.dir) - s.pdf).abs() > tolerance * s.pdf);
                 }
-                if r.p_value < alpha || r.impossible > 0 || mismatch > 10 {
+                let moved = batched_matches_single(&sampler, seed as u64);
+                if r.p_value < alpha || r.impossible > 0 || mismatch > 10 || moved > 4 {
                     failures.push(format!(
-                        "{env_name} / {name} / {view}: nodes {}, {r:?}, pdf mismatches {mismatch}/10000",
+                        "{env_name} / {name} / {view}: nodes {}, {r:?}, pdf mismatches {mismatch}/10000, batched samples in another cell {moved}/4099",
                         sampler.node_count()
                     ));
                 }
@@ -166,6 +167,31 @@ fn product_cases(params: ProductParams) -> Vec<String> {
         }
     }
     failures
+}
+
+/// `sample_many` draws what `sample` draws (the same cell; the point inside may differ in the
+/// last bits, rarely across a cell edge — returns how often) with the density `pdf_square`
+/// gives at its point, and `pdf_square_many` is `pdf_square` bit for bit.
+fn batched_matches_single(sampler: &ProductSampler<'_, '_>, seed: u64) -> usize {
+    let mut u = vec![DVec2::ZERO; 4099];
+    sampler_core::points::sobol02(seed ^ 0x5a, 0, &mut u);
+    u[3] = DVec2::new(1.0, 0.0); // clamped like `sample` clamps
+    let mut many = vec![None; u.len()];
+    sampler.sample_many(&u, &mut many);
+    let mut moved = 0;
+    for (u, b) in u.iter().zip(&many) {
+        let (a, b) = (sampler.sample(*u).unwrap(), b.unwrap());
+        assert!((a.uv - b.uv).abs().max_element() < 1e-5, "{a:?} {b:?}");
+        assert_eq!(b.pdf, sampler.pdf_square(b.uv) / SPHERE_AREA);
+        moved += usize::from(a.pdf != b.pdf);
+    }
+    let uvs: Vec<Vec2> = many.iter().map(|s| s.unwrap().uv).chain(u.iter().map(|p| p.as_vec2())).collect();
+    let mut pdfs = vec![0.0f32; uvs.len()];
+    sampler.pdf_square_many(&uvs, &mut pdfs);
+    for (uv, p) in uvs.iter().zip(&pdfs) {
+        assert_eq!(*p, sampler.pdf_square(*uv), "{uv}");
+    }
+    moved
 }
 
 #[test]

@@ -195,6 +195,13 @@ fn run(estimator: &str) {
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts);
                         sobol02(seed ^ 0x123, 0, &mut qts);
+                        if estimator == "product-mis for_mis" {
+                            // The renderer's batched path.
+                            let mut pairs = [[estimator::Contribution::default(); 2]; 32];
+                            let q = qts.map(|q| q.as_vec2());
+                            estimator::product_mis_many(&s, &sp, &pts, &q, &mut vis, &mut pairs);
+                            return pairs.iter().map(|[a, b]| lum(a.value + b.value)).sum::<f64>() / 32.0;
+                        }
                         (0..32)
                             .map(|k| {
                                 let [a, b] = estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);

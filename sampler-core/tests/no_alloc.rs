@@ -98,6 +98,14 @@ fn ten_thousand_shading_points_allocate_nothing() {
                 sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
             sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x;
         }
+        // The batched paths the renderer takes.
+        let mut pairs = [[estimator::Contribution::default(); 2]; 4];
+        let brdf_points = points.map(|p| p.as_vec2());
+        estimator::product_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
+        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+        let mut many = [None; 4];
+        sampler.sample_many(&points, &mut many);
+        sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();
     }
     ARMED.with(|a| a.set(false));
     let count = COUNT.with(|c| c.get());
