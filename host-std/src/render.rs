@@ -71,6 +71,8 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     };
     let methods: Vec<Method> =
         scene.materials.iter().map(|m| settings.method.for_material(&m.bsdf, env_peak)).collect();
+    // Per material, the cosine of the angle within which a product-MIS sampler is reused.
+    let reuse: Vec<f32> = scene.materials.iter().map(|m| integrator::reuse_cosine(&m.bsdf)).collect();
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tiles: Vec<(usize, usize)> =
@@ -85,19 +87,19 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     let results: Vec<Vec<[f32; 3]>> = tiles
         .par_iter()
         .map(|&(tx, ty)| {
-            let mut arena: Option<Box<ProductArena>> = None;
-            // The pixel's primary hits, one buffer reused by every pixel of the tile.
-            let mut hits: Vec<Hit> = Vec::with_capacity(settings.shading_points.clamp(1, 64));
+            let mut scratch = Scratch {
+                arena: None,
+                hits: Vec::with_capacity(settings.shading_points.clamp(1, 64)),
+                shared: (0..scene.materials.len()).map(|_| None).collect(),
+                stats: [0; 4],
+            };
             let mut out = Vec::with_capacity(TILE * TILE);
-            let mut local = [0u64; 4];
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(
-                        scene, bvh, env, sat, &camera, settings, &methods, x, y, &mut arena, &mut hits, &mut local,
-                    ));
+                    out.push(pixel(scene, bvh, env, sat, &camera, settings, &methods, &reuse, x, y, &mut scratch));
                 }
             }
-            for (c, l) in counters.iter().zip(local) {
+            for (c, l) in counters.iter().zip(scratch.stats) {
                 c.fetch_add(l, Ordering::Relaxed);
             }
             if settings.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
@@ -135,9 +137,29 @@ struct Hit {
     index: usize,
 }
 
+/// A tile's scratch memory, reused from pixel to pixel.
+struct Scratch {
+    /// For the product samplers built per shading point.
+    arena: Option<Box<ProductArena>>,
+    /// The pixel's primary hits.
+    hits: Vec<Hit>,
+    /// Per material, the product-MIS sampler built last and where (see `SharedSampler`).
+    shared: Vec<Option<SharedSampler>>,
+    /// Shading points, shadow rays, camera rays and non-finite pixel values.
+    stats: [u64; 4],
+}
+
+/// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
+/// direction of the shading point it was built at.
+struct SharedSampler {
+    arena: Box<ProductArena>,
+    normal: Vec3,
+    mirror: Vec3,
+}
+
 /// One pixel: the mean over its shading points (product-MIS samplers shared per pixel and
-/// material, every other sampler built per shading point). `stats` counts shading points, shadow rays, camera rays and non-finite
-/// values.
+/// material, and reused by the tile's next pixels while their shading points stay within
+/// `reuse[material]`; every other sampler built per shading point).
 #[allow(clippy::too_many_arguments)]
 fn pixel(
     scene: &Scene,
@@ -147,12 +169,12 @@ fn pixel(
     camera: &Camera,
     s: &Settings,
     methods: &[Method],
+    reuse: &[f32],
     x: usize,
     y: usize,
-    arena: &mut Option<Box<ProductArena>>,
-    hits: &mut Vec<Hit>,
-    stats: &mut [u64; 4],
+    scratch: &mut Scratch,
 ) -> [f32; 3] {
+    let Scratch { arena, hits, shared: kept, stats } = scratch;
     let seed = hash_combine(s.seed, (y * camera.width as usize + x) as u64);
     // The seed of the pixel's light-sample sequences, shared by its shading points (each takes
     // its own run of them, see `integrator::shade`).
@@ -228,7 +250,25 @@ fn pixel(
                 let product;
                 let two_stage;
                 let technique = match lead.method {
-                    Method::Product | Method::Wavelet | Method::ProductMis => {
+                    Method::ProductMis => {
+                        let (normal, mirror) = (lead.frame.n, reflect(lead.wo, lead.frame.n));
+                        let cos = reuse[group];
+                        let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
+                        let slot = &mut kept[group];
+                        if lead.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
+                            let c = slot.get_or_insert_with(|| SharedSampler {
+                                arena: Box::new(ProductArena::new()),
+                                normal,
+                                mirror,
+                            });
+                            let params = integrator::product_params(lead.method, s.brdf_samples);
+                            c.arena.build(env, lead_sp.brdf, &lead_sp.frame, lead_sp.wo, &params, build_seed);
+                            (c.normal, c.mirror) = (normal, mirror);
+                        }
+                        product = slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above");
+                        Technique::Product(&product)
+                    }
+                    Method::Product | Method::Wavelet => {
                         let a = arena.get_or_insert_with(|| Box::new(ProductArena::new()));
                         let params = integrator::product_params(lead.method, s.brdf_samples);
                         product = a.build(env, lead_sp.brdf, &lead_sp.frame, lead_sp.wo, &params, build_seed);
@@ -277,6 +317,11 @@ fn pixel(
         stats[3] += 1;
         [0.0; 3]
     }
+}
+
+/// The mirror direction of `wo` about `n`.
+fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    2.0 * wo.dot(n) * n - wo
 }
 
 /// The hit's shading point: its own BRDF if its material is textured, the material's otherwise.

@@ -1,5 +1,6 @@
 //! Runs many shading-point builds in a loop, for profilers (`perf record`, callgrind).
-//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations]`
+//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations] [mis]`
+//! (`mis`: the product-MIS preset `ProductParams::for_mis`, probed and refined leaves).
 
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
@@ -14,6 +15,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("ggx", String::as_str);
     let iters: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(50_000);
+    let params =
+        if args.get(3).is_some_and(|a| a == "mis") { ProductParams::for_mis(256) } else { ProductParams::default() };
     let brdf: Box<dyn Brdf> = match which {
         "lambert" => Box::new(Lambert::new(Vec3::splat(0.5))),
         "phong" => Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),
@@ -36,7 +39,7 @@ fn main() {
         let normal = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
         let frame = Frame::from_normal(normal);
         let wo = frame.to_world(Vec3::new(0.2, 0.1, 1.0).normalize());
-        let s = arena.build(&env, brdf.as_ref(), &frame, wo, &ProductParams::default(), i);
+        let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, i);
         nodes += s.node_count();
         let mut pts = [DVec2::ZERO; 16];
         sobol02(i, 0, &mut pts);
@@ -69,13 +72,13 @@ fn main() {
     let t0 = std::time::Instant::now();
     for r in 0..reps {
         for (i, (frame, wo)) in frames.iter().enumerate() {
-            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &ProductParams::default(), r * 1000 + i as u64);
+            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, r * 1000 + i as u64);
             nodes += s.node_count();
         }
     }
     let b = per(t0);
     let t0 = std::time::Instant::now();
-    let s = arena.build(&env, brdf.as_ref(), &frames[0].0, frames[0].1, &ProductParams::default(), 1);
+    let s = arena.build(&env, brdf.as_ref(), &frames[0].0, frames[0].1, &params, 1);
     let mut p16 = [DVec2::ZERO; 16];
     for r in 0..reps * 1000 {
         sobol02(r, 0, &mut p16);

@@ -128,6 +128,8 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     nodes: Vec<Node, NODES>,
     /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
     corners: Vec<Corners, CORNERS>,
+    /// The last build's defensive fraction and usable BRDF samples (`None` before the first).
+    built: Option<(f32, usize)>,
 }
 
 impl<const K: usize, const NODES: usize, const CORNERS: usize> Default for ProductArena<K, NODES, CORNERS> {
@@ -151,6 +153,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             keys: Vec::new(),
             nodes: Vec::new(),
             corners: Vec::new(),
+            built: None,
         }
     }
 
@@ -210,7 +213,17 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
+        self.built = Some((defensive, count));
         ProductSampler { env, nodes: &self.nodes, corners: &self.corners, defensive, brdf_samples: count }
+    }
+
+    /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena
+    /// holds it until the next build): for hosts that reuse one B̃ at nearby shading points.
+    /// `env` must be the environment it was built on. `None` before the first build.
+    #[must_use]
+    pub fn last_built<'a, 'e>(&'a self, env: &'a EnvHierarchy<'e>) -> Option<ProductSampler<'a, 'e>> {
+        let (defensive, brdf_samples) = self.built?;
+        Some(ProductSampler { env, nodes: &self.nodes, corners: &self.corners, defensive, brdf_samples })
     }
 }
 
