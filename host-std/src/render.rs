@@ -34,6 +34,9 @@ pub struct Settings {
     pub seed: u64,
     /// Show a progress bar on stderr (after the first second).
     pub progress: bool,
+    /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
+    /// to tell the error that visibility adds from the error of sampling light × BRDF).
+    pub shadows: bool,
 }
 
 /// A rendered image and what it took.
@@ -290,8 +293,11 @@ fn pixel(
                 for (_, h) in members {
                     stats[0] += 1;
                     let origin = h.origin;
-                    let mut vis =
-                        CountingVisibility { test: |d: Vec3| !bvh.occluded(origin, d, 0.0, f32::INFINITY), rays: 0 };
+                    let shadows = s.shadows;
+                    let mut vis = CountingVisibility {
+                        test: |d: Vec3| !shadows || !bvh.occluded(origin, d, 0.0, f32::INFINITY),
+                        rays: 0,
+                    };
                     sum += integrator::shade(
                         h.method,
                         env,
@@ -302,7 +308,8 @@ fn pixel(
                         &technique,
                         &mut vis,
                     );
-                    stats[1] += vis.rays;
+                    // Only rays traced count.
+                    stats[1] += if shadows { vis.rays } else { 0 };
                 }
                 first += 1;
             }

@@ -11,7 +11,7 @@ use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, p: usize) -> Settings {
-    Settings { method, spp, shading_points: p, brdf_samples: 64, seed: 7, progress: false }
+    Settings { method, spp, shading_points: p, brdf_samples: 64, seed: 7, progress: false, shadows: true }
 }
 
 fn render_with_threads(scene: &Scene, env: &Environment, s: &Settings, threads: usize) -> Vec<[f32; 3]> {
@@ -76,4 +76,25 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
         assert!((mean - 1.0).abs() < 3.0 * se + 2e-3, "{method}: furnace mean {mean} (SE {se})");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unshadowed_renders_trace_no_shadow_rays_and_are_brighter() {
+    // The default scene's spheres shadow the ground: without visibility every pixel gains.
+    let mut scene = default_scene::scene();
+    scene.camera.width = 48;
+    scene.camera.height = 27;
+    let env = Environment::build(&EnvSource::Sky { level: 7 }, Placement::default()).unwrap();
+    let bvh = Bvh::build(&scene);
+    let h = env.hierarchy();
+    let mean = |s: &Settings| {
+        let image = render(&scene, &bvh, Some(&h), s);
+        let sum: f64 = image.pixels.iter().map(|p| p[1] as f64).sum();
+        (sum / image.pixels.len() as f64, image.shadow_rays)
+    };
+    let shadowed = settings(Method::Mis, 16, 4);
+    let (lit, rays) = mean(&shadowed);
+    let (open, none) = mean(&Settings { shadows: false, ..shadowed });
+    assert!(rays > 0 && none == 0, "{rays} / {none} shadow rays");
+    assert!(open > 1.05 * lit, "unshadowed mean {open} against {lit}");
 }

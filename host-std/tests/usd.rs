@@ -88,8 +88,15 @@ fn dome_light_orientation_matches_the_convention() {
         let (source, placement) = c.scene.env.clone().expect("a dome");
         let env = Environment::build(&source, placement).unwrap();
         let bvh = Bvh::build(&c.scene);
-        let settings =
-            Settings { method: Method::Mis, spp: 16, shading_points: 4, brdf_samples: 64, seed: 3, progress: false };
+        let settings = Settings {
+            method: Method::Mis,
+            spp: 16,
+            shading_points: 4,
+            brdf_samples: 64,
+            seed: 3,
+            progress: false,
+            shadows: true,
+        };
         let image = render(&c.scene, &bvh, Some(&env.hierarchy()), &settings);
         let got = highlight(&image.pixels, image.width as u32);
         let want = predicted_pixel(&Camera::new(&c.scene.camera), texel_direction(z_up, pole_to_z));
@@ -147,8 +154,15 @@ fn textures_are_looked_up_at_each_hit() {
     let (source, placement) = c.scene.env.clone().unwrap();
     let env = Environment::build(&source, placement).unwrap();
     let bvh = Bvh::build(&c.scene);
-    let settings =
-        Settings { method: Method::Auto, spp: 16, shading_points: 4, brdf_samples: 64, seed: 5, progress: false };
+    let settings = Settings {
+        method: Method::Auto,
+        spp: 16,
+        shading_points: 4,
+        brdf_samples: 64,
+        seed: 5,
+        progress: false,
+        shadows: true,
+    };
     let image = render(&c.scene, &bvh, Some(&env.hierarchy()), &settings);
     let at = |x: usize, y: usize| image.pixels[y * image.width + x];
     let dominant = |p: [f32; 3], k: usize| (0..3).all(|j| j == k || p[k] > 3.0 * p[j]);

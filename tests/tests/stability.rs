@@ -15,7 +15,7 @@ use sampler_core::brdf::Lambert;
 fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_samples: usize) -> Rendered {
     let bvh = Bvh::build(scene);
     let h = env.hierarchy();
-    let settings = Settings { method, spp, shading_points: 2, brdf_samples, seed: 3, progress: false };
+    let settings = Settings { method, spp, shading_points: 2, brdf_samples, seed: 3, progress: false, shadows: true };
     render(scene, &bvh, Some(&h), &settings)
 }
 

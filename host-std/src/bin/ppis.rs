@@ -137,6 +137,10 @@ struct SamplingArgs {
     /// Image height, overriding the scene's camera.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
+    /// No shadow rays: every light direction counts as visible (for analysis: the error of
+    /// sampling light × BRDF without the error visibility adds).
+    #[arg(long)]
+    unshadowed: bool,
 }
 
 impl SamplingArgs {
@@ -328,6 +332,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: true,
+        shadows: !args.sampling.unshadowed,
     };
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
     let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
@@ -347,6 +352,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
             "brdf_samples": args.sampling.brdf_samples,
             "threads": threads,
             "seed": args.sampling.seed,
+            "unshadowed": args.sampling.unshadowed,
             "width": image.width,
             "height": image.height,
             "load_seconds": load_seconds_scene + env_load,
@@ -428,6 +434,7 @@ fn report_command(args: ReportArgs) -> Result<()> {
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: false,
+        shadows: !args.sampling.unshadowed,
     };
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let (reference, note) = match &args.reference {
