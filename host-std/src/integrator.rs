@@ -68,17 +68,23 @@ impl Method {
 
     /// `auto`: per material, the method measured best at equal time (`ppis report
     /// --samples-per-point 16`, default, three shared and studio scenes, per material region;
-    /// docs/perf.md, session 5):
+    /// docs/perf.md, session 6):
     ///
     /// * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is
     ///   wide enough to span bright detail of the map and narrow enough that one B̃ per pixel fits
     ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time (`ppis
-    ///   report --base product-mis --bracket`): s1 α = 0.05 2.01× (MIS), studio α = 0.05 2.32×
-    ///   (MIS), s2 α = 0.1 1.23× (MIS).
-    /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: MIS 1.1–1.6×
-    ///   ahead), wider ones (α ≥ 0.15: MIS or env-only ahead), car paint (MIS 1.7×), diffuse.
-    ///   Env-only sampling wins on studio's and s2's diffuse and on α = 0.3 (studio, s1's forest)
-    ///   but is 3–6× behind MIS under the default sky's sun, so it is not picked.
+    ///   report --base product-mis --bracket`): s1 α = 0.05 2.2–2.6× (MIS), studio α = 0.05
+    ///   2.6–2.7× (MIS), s2 α = 0.1 1.76× (MIS) (two runs; timing noise).
+    /// * Under extended bright regions rather than a sun (`env_peak` below [`SUN_PEAK`]: the
+    ///   shared maps and studio, 21–67; the built-in sky 713), wider conductors too, α in
+    ///   [`PRODUCT_ALPHA_EXTENDED`]: product-MIS beats MIS there (studio α = 0.15 2.1–2.3×, α = 0.3
+    ///   1.6–1.8×, s1 α = 0.3 1.2–1.4× at equal time) — B varies across the bright region, which the
+    ///   product follows — while under the default sky's sun, which env sampling finds exactly,
+    ///   MIS stays ahead at α = 0.15 (product-MIS 0.84×).
+    /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: product-MIS
+    ///   0.72–0.95× MIS), car paint (0.69×), diffuse. Env-only sampling wins on studio's and s2's
+    ///   diffuse and on α = 0.3 (studio, s1's forest) but is 3–6× behind MIS under the default
+    ///   sky's sun, so it is not picked.
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
     /// [`SMOOTH_LIGHTING_PEAK`]): BRDF sampling for every material — the product is the lobe
@@ -93,8 +99,9 @@ impl Method {
         if env_peak < SMOOTH_LIGHTING_PEAK {
             return Method::Brdf;
         }
+        let range = if env_peak < SUN_PEAK { PRODUCT_ALPHA_EXTENDED } else { PRODUCT_ALPHA };
         match bsdf {
-            Bsdf::Conductor(c) if PRODUCT_ALPHA.contains(&c.ggx.alpha()) => Method::ProductMis,
+            Bsdf::Conductor(c) if range.contains(&c.ggx.alpha()) => Method::ProductMis,
             _ => Method::Mis,
         }
     }
@@ -102,6 +109,12 @@ impl Method {
 
 /// GGX roughness range where `auto` samples the product (with BRDF sampling, MIS).
 pub const PRODUCT_ALPHA: std::ops::RangeInclusive<f32> = 0.03..=0.1;
+
+/// The range under extended bright regions (`env_peak` below [`SUN_PEAK`]).
+pub const PRODUCT_ALPHA_EXTENDED: std::ops::RangeInclusive<f32> = 0.03..=0.3;
+
+/// Peak (max / mean of the map over 32×32 blocks) from which the light counts as a sun.
+pub const SUN_PEAK: f32 = 100.0;
 
 /// Below this peak (max / mean of the map over 32×32 blocks) `auto` samples the BRDF only.
 pub const SMOOTH_LIGHTING_PEAK: f32 = 4.0;
@@ -274,9 +287,12 @@ mod tests {
     #[test]
     fn auto_samples_the_product_on_moderately_glossy_conductors_only() {
         assert_eq!(Method::Auto.for_material(&conductor(0.05), 67.0), Method::ProductMis);
-        assert_eq!(Method::Auto.for_material(&conductor(0.1), 67.0), Method::ProductMis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.1), 713.0), Method::ProductMis);
         assert_eq!(Method::Auto.for_material(&conductor(0.01), 67.0), Method::Mis);
-        assert_eq!(Method::Auto.for_material(&conductor(0.3), 67.0), Method::Mis);
+        // Wider lobes only under extended light, not under a sun.
+        assert_eq!(Method::Auto.for_material(&conductor(0.3), 67.0), Method::ProductMis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.15), 713.0), Method::Mis);
+        assert_eq!(Method::Auto.for_material(&conductor(0.5), 67.0), Method::Mis);
         assert_eq!(Method::Auto.for_material(&conductor(0.05), 1.6), Method::Brdf, "smooth light");
     }
 
