@@ -106,18 +106,14 @@ impl ProductSampler<'_, '_> {
         if !t.alive || !e.alive {
             return None;
         }
-        let finest = self.env.finest_level();
         let (uv, pdf_square) = if t.defensive {
-            let uv = point_in_cell(e.x, e.y, finest, e.xi);
+            let uv = point_in_cell(e.x, e.y, self.env.finest_level(), e.xi);
             (uv, self.pdf_square(uv))
-        } else if t.depth < finest {
-            let uv = point_in_cell(e.x, e.y, finest, e.xi);
-            let texel = self.env.node_relative(finest, e.x, e.y);
-            (uv, self.mixture(self.leaf_density(t.path, t.depth, t.x, t.y, texel), texel))
         } else {
-            let uv = point_in_cell(t.x, t.y, t.depth, t.xi);
-            let texel = self.env.pdf_square(uv);
-            (uv, self.mixture(self.leaf_density(t.path, t.depth, t.x, t.y, texel), texel))
+            // Below a leaf finer than the map the env lane did not move: (e.x, e.y, e.xi) are
+            // the leaf's.
+            let (uv, product, texel) = self.land(t.path, t.depth, t.x, t.y, (e.x, e.y), e.xi);
+            (uv, self.mixture(product, texel))
         };
         Some(DirectionSample { dir: self.env.dir_of(uv), uv, pdf: pdf_square / SPHERE_AREA })
     }

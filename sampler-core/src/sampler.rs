@@ -338,18 +338,25 @@ impl<'e> ProductSampler<'_, 'e> {
         if !self.corners.is_empty() {
             return self.warp_bilinear(i, path, depth, x, y, xi);
         }
-        if depth < finest {
+        let texel = if depth < finest { self.env.warp_down(depth, x, y, xi)? } else { (x, y) };
+        Some(self.land(path, depth, x, y, texel, *xi))
+    }
+
+    /// Where a product sample that reached leaf (depth, x, y) with probability `path` lands,
+    /// with ξ uniform in the last cell: in `texel` (chosen below the leaf by the env's levels)
+    /// when the leaf is coarser than the map, in the leaf itself otherwise. Returns the point,
+    /// the product's density per unit area there and the texel's relative importance.
+    pub(crate) fn land(&self, path: f64, depth: u32, x: u32, y: u32, texel: (u32, u32), xi: DVec2) -> (Vec2, f64, f32) {
+        let finest = self.env.finest_level();
+        let (uv, importance) = if depth < finest {
             // `point_in_cell` keeps the point in the texel the descent chose, so the texel is
             // known: `leaf_density`'s result without its lookups.
-            let (tx, ty) = self.env.warp_down(depth, x, y, xi)?;
-            let uv = point_in_cell(tx, ty, finest, *xi);
-            let texel = self.env.node_relative(finest, tx, ty);
-            Some((uv, self.leaf_density(path, depth, x, y, texel), texel))
+            (point_in_cell(texel.0, texel.1, finest, xi), self.env.node_relative(finest, texel.0, texel.1))
         } else {
-            let uv = point_in_cell(x, y, depth, *xi);
-            let texel = self.env.pdf_square(uv);
-            Some((uv, self.leaf_density(path, depth, x, y, texel), texel))
-        }
+            let uv = point_in_cell(x, y, depth, xi);
+            (uv, self.env.pdf_square(uv))
+        };
+        (uv, self.leaf_density(path, depth, x, y, importance), importance)
     }
 
     /// Below leaf `leaf` (cell (depth, x, y), reached with probability `path`) with a bilinear

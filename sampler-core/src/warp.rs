@@ -24,11 +24,7 @@ pub fn child_offset(child: usize) -> (u32, u32) {
 /// Returns `None` when all four masses are zero. A child of zero mass is never chosen.
 #[inline]
 pub fn choose_child(mass: [f32; 4], xi: &mut DVec2) -> Option<usize> {
-    let m = mass.map(f64::from);
-    let (dx, ox, wx) = pick([m[0] + m[2], m[1] + m[3]], xi.x)?;
-    let (dy, oy, wy) = pick([m[dx], m[dx + 2]], xi.y)?;
-    rescale(xi, ox, wx, oy, wy);
-    Some(dx + 2 * dy)
+    child_by(mass, xi, pick::<2>)
 }
 
 /// Two levels in one step: picks one of the 16 grandchildren of a node (`mass` in Morton
@@ -69,19 +65,25 @@ pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<
 /// some mass; ξ may differ in its last bits), for descents run side by side.
 #[inline(always)]
 pub fn choose_child_branchless(mass: [f32; 4], xi: &mut DVec2) -> Option<usize> {
+    child_by(mass, xi, pick_branchless::<2>)
+}
+
+/// The column by ξ.x, then the row within it by ξ.y, each by `pick`; see [`choose_child`].
+#[inline(always)]
+fn child_by(mass: [f32; 4], xi: &mut DVec2, pick: Pick<2>) -> Option<usize> {
     let m = mass.map(f64::from);
-    let (dx, ox, wx) = pick_branchless([m[0] + m[2], m[1] + m[3]], xi.x)?;
-    let (dy, oy, wy) = pick_branchless([m[dx], m[dx + 2]], xi.y)?;
+    let (dx, ox, wx) = pick([m[0] + m[2], m[1] + m[3]], xi.x)?;
+    let (dy, oy, wy) = pick([m[dx], m[dx + 2]], xi.y)?;
     rescale(xi, ox, wx, oy, wy);
     Some(dx + 2 * dy)
 }
 
 /// A side chooser: (weights, ξ) → (side, ξ's offset into it, its weight).
-type Pick = fn([f64; 4], f64) -> Option<(usize, f64, f64)>;
+type Pick<const N: usize> = fn([f64; N], f64) -> Option<(usize, f64, f64)>;
 
 /// The column, then the row within it, each by `pick`; see [`choose_grandchild`].
 #[inline(always)]
-fn grandchild_by(mass: &[f32; 16], xi: &mut DVec2, pick: Pick) -> Option<(usize, u32, u32)> {
+fn grandchild_by(mass: &[f32; 16], xi: &mut DVec2, pick: Pick<4>) -> Option<(usize, u32, u32)> {
     let m = mass.map(f64::from);
     let at = |x: usize, y: usize| grandchild_index(x as u32, y as u32);
     let cols: [f64; 4] = core::array::from_fn(|x| (m[at(x, 0)] + m[at(x, 1)]) + (m[at(x, 2)] + m[at(x, 3)]));
