@@ -42,42 +42,35 @@ fn main() {
         ("for_mis norefine", ProductParams { refine_share: 0.0, ..ProductParams::for_mis(256) }),
         ("for_mis bilinear", ProductParams { bilinear: true, ..ProductParams::for_mis(256) }),
     ] {
-        let (mut s1, mut s2, mut t1, mut t2) = (0.0, 0.0, 0.0, 0.0);
-        for r in 0..reps {
+        report(name, reps, n, |r, a, b, out| {
             let s = arena.build(&env, &brdf, &frame, wo, &params, r);
-            let (mut a, mut b) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
-            sobol02(r ^ 77, 0, &mut a);
-            sobol02(r ^ 99, 0, &mut b);
-            let mut net = 0.0;
-            for k in 0..n {
+            for k in 0..a.len() {
                 let [x, y] = estimator::product_mis(&s, &sp, a[k], b[k].as_vec2(), &mut vis);
-                let v = lum(x.value + y.value);
-                s1 += v;
-                s2 += v * v;
-                net += v;
+                out.push(lum(x.value + y.value));
             }
-            net /= n as f64;
-            t1 += net;
-            t2 += net * net;
-        }
-        let c = (reps * n as u64) as f64;
-        let mean = s1 / c;
-        let mn = t1 / reps as f64;
-        println!(
-            "{name}: mean {mean:.5} relvar/sample {:.4} relvar/net {:.3e}",
-            (s2 / c - mean * mean) / (mean * mean),
-            (t2 / reps as f64 - mn * mn) / (mn * mn)
-        );
+        });
     }
+    report("mis", reps, n, |_, a, b, out| {
+        for k in 0..a.len() {
+            let [x, y] = estimator::mis(&env, &sp, a[k], b[k].as_vec2(), &mut vis);
+            out.push(lum(x.value + y.value));
+        }
+    });
+}
+
+/// Relative variance per sample and per `n`-point net over `reps` nets; `estimate(r, a, b, out)`
+/// pushes net r's values for its two point sets.
+fn report(name: &str, reps: u64, n: usize, mut estimate: impl FnMut(u64, &[DVec2], &[DVec2], &mut Vec<f64>)) {
     let (mut s1, mut s2, mut t1, mut t2) = (0.0, 0.0, 0.0, 0.0);
+    let mut values = Vec::with_capacity(n);
     for r in 0..reps {
         let (mut a, mut b) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
         sobol02(r ^ 77, 0, &mut a);
         sobol02(r ^ 99, 0, &mut b);
+        values.clear();
+        estimate(r, &a, &b, &mut values);
         let mut net = 0.0;
-        for k in 0..n {
-            let [x, y] = estimator::mis(&env, &sp, a[k], b[k].as_vec2(), &mut vis);
-            let v = lum(x.value + y.value);
+        for &v in &values {
             s1 += v;
             s2 += v * v;
             net += v;
@@ -90,7 +83,7 @@ fn main() {
     let mean = s1 / c;
     let mn = t1 / reps as f64;
     println!(
-        "mis: mean {mean:.5} relvar/sample {:.4} relvar/net {:.3e}",
+        "{name}: mean {mean:.5} relvar/sample {:.4} relvar/net {:.3e}",
         (s2 / c - mean * mean) / (mean * mean),
         (t2 / reps as f64 - mn * mn) / (mn * mn)
     );
