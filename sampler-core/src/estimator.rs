@@ -46,6 +46,13 @@ impl<B: Brdf + ?Sized> ShadingPoint<'_, B> {
     pub fn brdf_pdf(&self, dir: Vec3) -> f32 {
         self.brdf.pdf(self.frame.to_local(self.wo), self.frame.to_local(dir))
     }
+
+    /// [`eval`](Self::eval) and [`brdf_pdf`](Self::brdf_pdf) at once ([`Brdf::eval_pdf`]).
+    #[inline]
+    #[must_use]
+    pub fn eval_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+        self.brdf.eval_pdf(self.frame.to_local(self.wo), self.frame.to_local(dir))
+    }
 }
 
 /// One sample's share of an estimate.
@@ -223,8 +230,8 @@ fn mis_drawn_half<B: Brdf + ?Sized>(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let Some((dir, uv, p)) = drawn else { return Contribution::default() };
-    let p_brdf = sp.brdf_pdf(dir);
-    let f = times(env_h.radiance_at(uv), sp.eval(dir));
+    let (b, p_brdf) = sp.eval_pdf(dir);
+    let f = times(env_h.radiance_at(uv), b);
     Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf }
 }
 
@@ -295,11 +302,14 @@ pub fn ris<B: Brdf + ?Sized>(
     let mut total = 0.0f64;
     let mut chosen: Option<(Vec3, DVec3, f64, f32)> = None; // (dir, f, target, source pdf)
     for c in candidates {
-        // (direction, its point of the square, mixture density)
-        let (dir, uv, source) = if c.x < 0.5 {
+        // (direction, its point of the square, BRDF × cos, mixture density)
+        let (dir, uv, b, source) = if c.x < 0.5 {
             let u = DVec2::new(2.0 * c.x, c.y);
             match env_h.sample(u) {
-                Some(s) => (s.dir, s.uv, 0.5 * (s.pdf + sp.brdf_pdf(s.dir))),
+                Some(s) => {
+                    let (b, p_brdf) = sp.eval_pdf(s.dir);
+                    (s.dir, s.uv, b, 0.5 * (s.pdf + p_brdf))
+                }
                 None => continue,
             }
         } else {
@@ -308,12 +318,12 @@ pub fn ris<B: Brdf + ?Sized>(
                 Some(s) => {
                     let dir = sp.frame.to_world(s.wi);
                     let uv = env_h.square_of(dir);
-                    (dir, uv, 0.5 * (s.pdf + env_h.pdf_square(uv) / SPHERE_AREA))
+                    (dir, uv, s.value, 0.5 * (s.pdf + env_h.pdf_square(uv) / SPHERE_AREA))
                 }
                 None => continue,
             }
         };
-        let f = times(env_h.radiance_at(uv), sp.eval(dir));
+        let f = times(env_h.radiance_at(uv), b);
         let target = luminance64(f);
         if !(target > 0.0 && source > 0.0 && target.is_finite()) {
             continue;

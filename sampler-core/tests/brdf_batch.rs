@@ -36,3 +36,41 @@ fn batched_samples_match_single_samples() {
         }
     }
 }
+
+/// `eval_pdf` is `eval` and `pdf` bit for bit (MIS relies on the two agreeing), for directions
+/// all over the sphere, from views up to grazing ones, and on drawn directions where lobes peak.
+#[test]
+fn eval_pdf_is_eval_and_pdf() {
+    let brdfs: Vec<Box<dyn Brdf>> = vec![
+        Box::new(Lambert::new(Vec3::splat(0.7))),
+        Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.7), 300.0)),
+        Box::new(Phong::new(Vec3::ZERO, Vec3::splat(0.9), 1e5)),
+        Box::new(RoughConductor::new(0.2, Vec3::new(1.0, 0.8, 0.6))),
+        Box::new(RoughConductor::new(1e-4, Vec3::ONE)),
+        Box::new(CarPaint::default()),
+        Box::new(CarPaint { coat: 0.0, ..CarPaint::default() }),
+    ];
+    let mut rng = Pcg32::new(5, 7);
+    let mut sphere = || {
+        let z = 2.0 * rng.next_f32() - 1.0;
+        let phi = core::f32::consts::TAU * rng.next_f32();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let views: Vec<Vec3> = (0..40).map(|_| sphere()).chain([Vec3::Z, Vec3::new(1.0, 0.0, 1e-4).normalize()]).collect();
+    let mut checked = 0;
+    for brdf in &brdfs {
+        for &wo in &views {
+            let drawn = (0..32).filter_map(|k| brdf.sample(wo, Vec2::new((k as f32 + 0.5) / 32.0, 0.37)));
+            let wis: Vec<Vec3> = (0..64).map(|_| sphere()).chain(drawn.map(|s| s.wi)).chain([wo, -wo]).collect();
+            for wi in wis {
+                let (value, pdf) = brdf.eval_pdf(wo, wi);
+                let (e, p) = (brdf.eval(wo, wi), brdf.pdf(wo, wi));
+                assert_eq!(value.to_array().map(f32::to_bits), e.to_array().map(f32::to_bits), "{wo} {wi}");
+                assert_eq!(pdf.to_bits(), p.to_bits(), "{wo} {wi}");
+                checked += usize::from(pdf > 0.0 && value.max_element() > 0.0);
+            }
+        }
+    }
+    assert!(checked > 2000, "only {checked} directions where both are positive");
+}

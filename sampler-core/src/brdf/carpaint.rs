@@ -84,8 +84,37 @@ impl Brdf for CarPaint {
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
+        let (value, pdf) = self.eval_pdf(wo, wi);
+        (pdf > 0.0 && pdf.is_finite()).then_some(BrdfSample { wi, value, pdf })
+    }
+
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if wo.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let Some(h) = half_vector(wo, wi) else {
+            return (Vec3::ZERO, self.pdf(wo, wi));
+        };
+        // Each lobe's D(h) and G1(ωo) once for both, multiplied in `eval`'s and `pdf`'s order.
+        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
+        let (dc, df, gc_o, gf_o) = (c.d(h), f.d(h), c.g1(wo), f.g1(wo));
+        let value = if wi.z > 0.0 {
+            let coat = self.coat * fresnel_schlick(self.coat_f0, wo.dot(h)) * dc * c.g1(wi) * gc_o / (4.0 * wo.z);
+            let flake = df * f.g1(wi) * gf_o / (4.0 * wo.z);
+            let transmit = (1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z))
+                * (1.0 - self.coat * fresnel_schlick(self.coat_f0, wi.z));
+            Vec3::splat(coat) + transmit * (self.flake * flake + self.base * (FRAC_1_PI * wi.z))
+        } else {
+            Vec3::ZERO
+        };
+        let w = self.lobe_weights(wo);
+        let total = w[0] + w[1] + w[2];
+        if total.is_nan() || total <= 0.0 {
+            return (value, 0.0);
+        }
+        let (coat, flake) =
+            if wo.dot(h) > 0.0 { (gc_o * dc / (4.0 * wo.z), gf_o * df / (4.0 * wo.z)) } else { (0.0, 0.0) };
+        (value, (w[0] * coat + w[1] * flake + w[2] * square_to_cosine_hemisphere_pdf(wi)) / total)
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {

@@ -35,8 +35,8 @@ impl Brdf for RoughConductor {
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
+        let (value, pdf) = self.eval_pdf(wo, wi);
+        (pdf > 0.0 && pdf.is_finite()).then_some(BrdfSample { wi, value, pdf })
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -44,6 +44,21 @@ impl Brdf for RoughConductor {
             Some(h) => self.ggx.pdf_reflected(wo, h),
             None => 0.0,
         }
+    }
+
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if wo.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let Some(h) = half_vector(wo, wi) else {
+            return (Vec3::ZERO, 0.0);
+        };
+        // One D(h) and G1(ωo) for both, multiplied in `eval`'s and `pdf_reflected`'s order.
+        let g = &self.ggx;
+        let (d, g1_o) = (g.d(h), g.g1(wo));
+        let value = if wi.z > 0.0 { self.specular * (d * g.g1(wi) * g1_o / (4.0 * wo.z)) } else { Vec3::ZERO };
+        let pdf = if wo.dot(h) > 0.0 { g1_o * d / (4.0 * wo.z) } else { 0.0 };
+        (value, pdf)
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {

@@ -52,6 +52,13 @@ pub trait Brdf {
     /// Density of [`Brdf::sample`] at `wi` with respect to solid angle (over the whole sphere).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
 
+    /// [`Brdf::eval`] and [`Brdf::pdf`] at once, bit for bit the same values: MIS needs both at
+    /// every direction the other technique drew, and they share most of their work (for GGX the
+    /// half vector, D and G1(ωo)) — and behind `dyn Brdf` one call instead of two.
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        (self.eval(wo, wi), self.pdf(wo, wi))
+    }
+
     /// Draws one direction per point of `u` like [`Brdf::sample`], for building B̃: writes
     /// each successful draw's direction and the luminance of BRDF × cos into `out`, and returns how many were written (≤ `u.len()` ≤
     /// `out.len()`). One call per shading point, so implementations can hoist what depends only
@@ -83,6 +90,9 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         (**self).pdf(wo, wi)
+    }
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        (**self).eval_pdf(wo, wi)
     }
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         (**self).sample_batch(wo, u, out)

@@ -75,8 +75,30 @@ impl Brdf for Phong {
 
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
         let wi = self.sample_direction(wo, u)?;
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BrdfSample { wi, value: self.eval(wo, wi), pdf })
+        let (value, pdf) = self.eval_pdf(wo, wi);
+        (pdf > 0.0).then_some(BrdfSample { wi, value, pdf })
+    }
+
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if wo.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        // One evaluation of the lobe cosⁿα for both.
+        let lobe = self.lobe(reflect_z(wo), wi);
+        let value = if wi.z > 0.0 {
+            let spec = (self.exponent + 2.0) / TWO_PI * lobe;
+            (self.kd * FRAC_1_PI + self.ks * spec) * wi.z
+        } else {
+            Vec3::ZERO
+        };
+        let w = self.lobe_weights();
+        let total = w[0] + w[1];
+        if total.is_nan() || total <= 0.0 {
+            return (value, 0.0);
+        }
+        let diffuse = square_to_cosine_hemisphere_pdf(wi);
+        let spec = (self.exponent + 1.0) / TWO_PI * lobe;
+        (value, (w[0] * diffuse + w[1] * spec) / total)
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
