@@ -1,18 +1,16 @@
 //! The `ppis` binary on bad input: one clear error line naming the file or option, exit code 2,
 //! no panic, and no output file written.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 fn ppis() -> Command {
     Command::new(env!("CARGO_BIN_EXE_ppis"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ppis-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A folder removed when the test ends, pass or fail.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("ppis-cli-{name}-")).tempdir().unwrap()
 }
 
 /// Runs ppis in `dir` and checks the failure: exit code 2, one stderr line mentioning `needle`,
@@ -29,43 +27,44 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
 
 #[test]
 fn bad_input_fails_cleanly() {
-    let dir = scratch("bad");
-    fails(&dir, &["render", "missing.json"], "missing.json");
-    fails(&dir, &["render", "--method", "magic"], "magic");
-    fails(&dir, &["render", "--spp", "0"], "--spp");
-    fails(&dir, &["render", "--spp", "6", "--shading-points", "4"], "--shading-points");
-    fails(&dir, &["render", "--env", "nothere.exr"], "nothere.exr");
-    fails(&dir, &["render", "scene.txt"], "scene.txt");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
+    fails(dir, &["render", "missing.json"], "missing.json");
+    fails(dir, &["render", "--method", "magic"], "magic");
+    fails(dir, &["render", "--spp", "0"], "--spp");
+    fails(dir, &["render", "--spp", "6", "--shading-points", "4"], "--shading-points");
+    fails(dir, &["render", "--env", "nothere.exr"], "nothere.exr");
+    fails(dir, &["render", "scene.txt"], "scene.txt");
 
     // Broken files.
     std::fs::write(dir.join("bad.json"), "{ \"camera\": 3 }").unwrap();
-    fails(&dir, &["render", "bad.json"], "bad.json");
+    fails(dir, &["render", "bad.json"], "bad.json");
     std::fs::write(
         dir.join("typo.json"),
         r#"{"camera":{"origin":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov_y_deg":40,"width":8,"height":8},
         "shapes":[{"type":"sphere","center":[0,0,0],"radius":1,"material":{"type":"diffuse","albdo":[1,1,1]}}]}"#,
     )
     .unwrap();
-    fails(&dir, &["render", "typo.json"], "albdo");
+    fails(dir, &["render", "typo.json"], "albdo");
     std::fs::write(dir.join("truncated.exr"), b"v/1\x01\x02\x00\x00\x00channels").unwrap();
-    fails(&dir, &["render", "--env", "truncated.exr"], "truncated.exr");
+    fails(dir, &["render", "--env", "truncated.exr"], "truncated.exr");
     std::fs::write(dir.join("garbage.hdr"), b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n").unwrap();
-    fails(&dir, &["render", "--env", "garbage.hdr"], "garbage.hdr");
+    fails(dir, &["render", "--env", "garbage.hdr"], "garbage.hdr");
     std::fs::write(dir.join("noise.png"), b"\x89PNG\r\n\x1a\nnot really").unwrap();
-    fails(&dir, &["render", "--env", "noise.png"], "noise.png");
+    fails(dir, &["render", "--env", "noise.png"], "noise.png");
     // A valid image of the wrong shape.
     exr::prelude::write_rgb_file(dir.join("odd.exr"), 30, 20, |_, _| (1.0f32, 1.0f32, 1.0f32)).unwrap();
-    fails(&dir, &["render", "--env", "odd.exr"], "odd.exr");
+    fails(dir, &["render", "--env", "odd.exr"], "odd.exr");
     // An output folder that does not exist.
-    fails(&dir, &["render", "-o", "no/such/folder/out.exr"], "no/such/folder");
-    let _ = std::fs::remove_dir_all(&dir);
+    fails(dir, &["render", "-o", "no/such/folder/out.exr"], "no/such/folder");
 }
 
 #[test]
 fn a_small_render_writes_exr_png_and_stats() {
-    let dir = scratch("ok");
+    let tmp = scratch("ok");
+    let dir = tmp.path();
     let out = ppis()
-        .current_dir(&dir)
+        .current_dir(dir)
         .args([
             "render",
             "--width",
@@ -104,7 +103,6 @@ fn a_small_render_writes_exr_png_and_stats() {
         assert!(stats.get(key).is_some(), "stats.json lacks {key}");
     }
     assert_eq!(stats["non_finite_pixels"], 0);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Runs `ppis report` on a tiny image (24×14, 2 samples per shading point, a 16-spp rendered
@@ -119,8 +117,9 @@ fn tiny_report(dir: &Path, args: &[&str]) -> String {
 
 #[test]
 fn report_writes_csv_plots_and_table() {
-    let dir = scratch("report");
-    let stderr = tiny_report(&dir, &["--spp", "2,4", "--methods", "product,env,mis"]);
+    let tmp = scratch("report");
+    let dir = tmp.path();
+    let stderr = tiny_report(dir, &["--spp", "2,4", "--methods", "product,env,mis"]);
     for f in ["error_vs_time.csv", "error_vs_time.svg", "error_vs_time.png", "report.md", "reference.exr"] {
         assert!(dir.join("rep").join(f).is_file(), "{f} missing: {stderr}");
     }
@@ -129,17 +128,17 @@ fn report_writes_csv_plots_and_table() {
     assert!(csv.lines().any(|l| l.contains(",carpaint,")), "{csv}");
     let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
     assert!(md.contains("## Equal time") && md.contains("env relMSE"), "{md}");
-    fails(&dir, &["report", "--out", "rep2", "--methods", "product,nope"], "nope");
-    fails(&dir, &["report", "--out", "rep3", "--methods", "product,mis", "--base", "env"], "--base env");
-    let _ = std::fs::remove_dir_all(&dir);
+    fails(dir, &["report", "--out", "rep2", "--methods", "product,nope"], "nope");
+    fails(dir, &["report", "--out", "rep3", "--methods", "product,mis", "--base", "env"], "--base env");
 }
 
 /// `--base` keys the equal-time tables; `--bracket` renders the faster methods on until they
 /// reach the base's time or have doubled their spp three times.
 #[test]
 fn report_brackets_the_base_time() {
-    let dir = scratch("bracket");
-    tiny_report(&dir, &["--spp", "4", "--methods", "mis,product-mis", "--base", "product-mis", "--bracket"]);
+    let tmp = scratch("bracket");
+    let dir = tmp.path();
+    tiny_report(dir, &["--spp", "4", "--methods", "mis,product-mis", "--base", "product-mis", "--bracket"]);
     let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
     let rows: Vec<(String, usize, f64)> = csv
         .lines()
@@ -162,5 +161,4 @@ fn report_brackets_the_base_time() {
     }
     let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
     assert!(md.contains("For the time product-mis takes") && md.contains("| product-mis spp |"), "{md}");
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -45,8 +45,8 @@ fn valid_files() -> &'static [(&'static str, Vec<u8>)] {
 
 fn make_files() -> Vec<(&'static str, Vec<u8>)> {
     let (w, h) = (32u32, 16u32);
-    let dir = std::env::temp_dir().join(format!("ppis-loaders-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::Builder::new().prefix("ppis-loaders-").tempdir().unwrap();
+    let dir = tmp.path();
     let exr_path = dir.join("a.exr");
     exr::prelude::write_rgb_file(&exr_path, w as usize, h as usize, |x, y| (x as f32 * 0.1, y as f32, 0.5f32)).unwrap();
     let exr = std::fs::read(&exr_path).unwrap();
@@ -61,7 +61,6 @@ fn make_files() -> Vec<(&'static str, Vec<u8>)> {
         .to_rgb8()
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     vec![("x.exr", exr), ("x.hdr", hdr), ("x.png", png)]
 }
 

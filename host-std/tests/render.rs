@@ -46,8 +46,8 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
     // does not shadow itself, so every pixel on it converges to 0.5 · 2 = 1.
     let level = 5;
     let n = 1usize << level;
-    let dir = std::env::temp_dir().join(format!("ppis-furnace-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::Builder::new().prefix("ppis-furnace-").tempdir().unwrap();
+    let dir = tmp.path();
     let path = dir.join("white.exr");
     exr::prelude::write_rgb_file(&path, n, n, |_, _| (2.0f32, 2.0f32, 2.0f32)).unwrap();
     let env = Environment::build(&EnvSource::File(path), Placement::default()).unwrap();
@@ -75,7 +75,6 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
         let se = (var / pixels.len() as f64).sqrt();
         assert!((mean - 1.0).abs() < 3.0 * se + 2e-3, "{method}: furnace mean {mean} (SE {se})");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -122,8 +122,8 @@ fn a_scene_without_a_dome_builds_no_environment() {
 
 #[test]
 fn usd_errors_name_the_file_and_do_not_panic() {
-    let dir = std::env::temp_dir().join(format!("ppis-usd-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::Builder::new().prefix("ppis-usd-").tempdir().unwrap();
+    let dir = tmp.path();
     let missing = dir.join("missing.usda");
     let e = usd_scene::load(&missing, None).err().unwrap().to_string();
     assert!(e.contains("missing.usda") && e.contains("not found"), "{e}");

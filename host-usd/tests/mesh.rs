@@ -6,10 +6,8 @@ use glam::Vec3;
 use host_usd::UsdScene;
 
 fn import(body: &str) -> UsdScene {
-    let dir = std::env::temp_dir().join(format!("ppis-usd-mesh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let n = std::sync::atomic::AtomicUsize::new(0);
-    let file = dir.join(format!("m{}-{}.usda", n.fetch_add(1, std::sync::atomic::Ordering::Relaxed), body.len()));
+    let dir = tempfile::Builder::new().prefix("ppis-usd-mesh-").tempdir().unwrap();
+    let file = dir.path().join("m.usda");
     std::fs::write(&file, format!("#usda 1.0\n(\n    upAxis = \"Y\"\n)\n{body}\n")).unwrap();
     host_usd::load(&file).unwrap()
 }
@@ -102,9 +100,8 @@ fn invisible_guides_and_proxies_are_not_rendered() {
 
 #[test]
 fn bad_topology_is_an_error_naming_the_prim() {
-    let dir = std::env::temp_dir().join(format!("ppis-usd-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("bad.usda");
+    let dir = tempfile::Builder::new().prefix("ppis-usd-bad-").tempdir().unwrap();
+    let file = dir.path().join("bad.usda");
     let body = QUADS.replace("[0, 1, 4, 3, 1, 2, 5, 4]", "[0, 1, 4, 3, 1, 2, 5, 40]");
     std::fs::write(&file, format!("#usda 1.0\ndef Mesh \"Broken\"\n{{{body}\n}}\n")).unwrap();
     let e = host_usd::load(&file).unwrap_err().to_string();

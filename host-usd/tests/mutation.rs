@@ -6,7 +6,7 @@
 use proptest::prelude::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 struct PeakAlloc;
 
@@ -46,10 +46,9 @@ fn fixtures() -> Vec<(String, Vec<u8>)> {
         .collect()
 }
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ppis-usd-mutation-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A folder removed when the case ends, pass or fail.
+fn scratch() -> tempfile::TempDir {
+    tempfile::Builder::new().prefix("ppis-usd-mutation-").tempdir().unwrap()
 }
 
 proptest! {
@@ -71,7 +70,8 @@ proptest! {
                 bytes[i] ^= x;
             }
         }
-        let path = scratch().join(format!("{}-{name}", std::thread::current().name().unwrap_or("t").replace("::", "_")));
+        let dir = scratch();
+        let path = dir.path().join(&name);
         std::fs::write(&path, &bytes).unwrap();
         PEAK.with(|p| p.set(0));
         ARMED.with(|a| a.set(true));

@@ -8,9 +8,9 @@ use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 
 /// Writes an equal-area `n`×`n` EXR whose texel (x, y) is `f(x, y)`, and builds it.
 pub fn env_from(name: &str, n: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) -> Environment {
-    let dir = std::env::temp_dir().join(format!("ppis-stability-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.exr"));
+    // Removed (with the file) when this returns: the environment is in memory by then.
+    let dir = tempfile::Builder::new().prefix("ppis-stability-").tempdir().unwrap();
+    let path = dir.path().join(format!("{name}.exr"));
     exr::prelude::write_rgb_file(&path, n, n, |x, y| {
         let c = f(x, y);
         (c[0], c[1], c[2])
