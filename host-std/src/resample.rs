@@ -13,7 +13,7 @@ use sampler_core::glam::{Vec2, Vec3};
 use sampler_core::mapping::square_to_sphere;
 use std::f64::consts::PI;
 
-/// Continuous lat-long coordinates (u, v) ∈ [0,1)×[0,1] of a local direction (f64: an f32
+/// Continuous lat-long coordinates (u, v) ∈ \[0,1)×\[0,1\] of a local direction (f64: an f32
 /// atan2 rounds across pixel edges).
 #[inline]
 pub fn direction_to_latlong_uv(d: Vec3) -> (f64, f64) {

@@ -121,7 +121,7 @@ pub fn env<B: Brdf + ?Sized>(
     env_drawn(env, sp, env.sample(u), vis)
 }
 
-/// [`env`] with its sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
+/// [`env()`] with its sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
 pub fn env_drawn<B: Brdf + ?Sized>(
     env: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,

@@ -6,7 +6,7 @@
 //!
 //! Pipeline per shading point: K BRDF samples → points of the equal-area square ([`mapping`]) →
 //! a quadtree with one sample per leaf ([`quadtree`]) whose product with the environment's mip
-//! pyramid ([`env`]) is computed in the same traversal → hierarchical warping of uniform points
+//! pyramid ([`mod@env`]) is computed in the same traversal → hierarchical warping of uniform points
 //! ([`points`], [`warp`]) through the tree and on through the environment's levels, with the
 //! density of every direction available for MIS ([`sampler`]). [`estimator`] turns samples into
 //! radiance; [`brdf`] holds the BRDF interface and the built-in materials.

@@ -548,7 +548,7 @@ impl<'e> ProductSampler<'_, 'e> {
         leaf.max(self.env.finest_level())
     }
 
-    /// Density per unit area of the square at `uv` (the mixture; integrates to 1 over [0,1]²).
+    /// Density per unit area of the square at `uv` (the mixture; integrates to 1 over the unit square).
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
         let env_relative = self.env.pdf_square(uv);

@@ -34,7 +34,7 @@ pub const fn sat_len(level: u32) -> usize {
 }
 
 /// Fills `sat` ((N+1)², row-major, zero first row and column) with the summed importance of
-/// the map's finest level: sat[y][x] = Σ over texels (i < x, j < y).
+/// the map's finest level: `sat[y][x]` = Σ over texels (i < x, j < y).
 pub fn build_sat(env: &EnvHierarchy<'_>, sat: &mut [f64]) -> bool {
     let level = env.finest_level();
     let n = 1usize << level;
