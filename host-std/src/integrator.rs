@@ -225,14 +225,15 @@ pub fn shade<B: Brdf + ?Sized>(
         if matches!(method, Method::Mis | Method::Env) {
             env.sample_many(&points[..m], &mut drawn[..m]);
         }
+        let mut brdf_points = [Vec2::ZERO; 64];
+        for (b, o) in brdf_points.iter_mut().zip(&others[..m]) {
+            *b = o.as_vec2();
+        }
         match (method, technique) {
             (Method::ProductMis, Technique::Product(p)) => {
-                let mut brdf_points = [Vec2::ZERO; 64];
-                for (b, o) in brdf_points.iter_mut().zip(&others[..m]) {
-                    *b = o.as_vec2();
-                }
                 estimator::product_mis_many(p, sp, &points[..m], &brdf_points[..m], vis, &mut pairs_out[..m]);
             }
+            (Method::Mis, _) => estimator::mis_many(env, sp, &drawn[..m], &brdf_points[..m], vis, &mut pairs_out[..m]),
             (_, Technique::Product(p)) => p.sample_many(&points[..m], &mut product_drawn[..m]),
             _ => {}
         }
@@ -242,14 +243,12 @@ pub fn shade<B: Brdf + ?Sized>(
                 (Method::Product | Method::Wavelet, Technique::Product(p)) => {
                     estimator::product_drawn(p, sp, product_drawn[k], vis).value
                 }
-                (Method::ProductMis, Technique::Product(_)) => pairs_out[k][0].value + pairs_out[k][1].value,
+                (Method::ProductMis, Technique::Product(_)) | (Method::Mis, _) => {
+                    pairs_out[k][0].value + pairs_out[k][1].value
+                }
                 (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
                 (Method::Env, _) => estimator::env_drawn(env, sp, drawn[k], vis).value,
                 (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
-                (Method::Mis, _) => {
-                    let [a, b] = estimator::mis_drawn(env, sp, drawn[k], others[k].as_vec2(), vis);
-                    a.value + b.value
-                }
                 (Method::Ris, _) => {
                     let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
                     sobol02(hash_combine(seed, 3 + first as u64 + (done + k) as u64), 0, &mut candidates);

@@ -230,7 +230,17 @@ fn mis_drawn_half<B: Brdf + ?Sized>(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let Some((dir, uv, p)) = drawn else { return Contribution::default() };
-    let (b, p_brdf) = sp.eval_pdf(dir);
+    drawn_half(env_h, (dir, uv, p), sp.eval_pdf(dir), vis)
+}
+
+/// [`mis_drawn_half`] with the BRDF × cos and the BRDF's density at the direction evaluated.
+#[inline]
+fn drawn_half(
+    env_h: &EnvHierarchy<'_>,
+    (dir, uv, p): (Vec3, Vec2, f32),
+    (b, p_brdf): (Vec3, f32),
+    vis: &mut impl Visibility,
+) -> Contribution {
     let f = times(env_h.radiance_at(uv), b);
     Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf }
 }
@@ -261,23 +271,82 @@ pub fn product_mis_many<B: Brdf + ?Sized>(
     out: &mut [[Contribution; 2]],
 ) {
     let n = u_product.len().min(u_brdf.len()).min(out.len()).min(64);
-    let env_h = sampler.env();
     let mut drawn = [None; 64];
     sampler.sample_many(&u_product[..n], &mut drawn[..n]);
+    let mut directions = [None; 64];
+    for (d, s) in directions.iter_mut().zip(&drawn[..n]) {
+        *d = s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf));
+    }
+    mis_with_brdf_many(
+        sampler.env(),
+        sp,
+        &directions[..n],
+        &u_brdf[..n],
+        |uv, p| sampler.pdf_square_many(uv, p),
+        vis,
+        out,
+    );
+}
+
+/// [`mis_drawn`] for up to 64 pairs at once (`out[k]` from `drawn[k]` and `u_brdf[k]`), e.g.
+/// with the env samples of [`EnvHierarchy::sample_many`]: the same values as one pair at a time.
+pub fn mis_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<EnvSample>],
+    u_brdf: &[Vec2],
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = drawn.len().min(u_brdf.len()).min(out.len()).min(64);
+    let mut directions = [None; 64];
+    for (d, s) in directions.iter_mut().zip(&drawn[..n]) {
+        *d = s.map(|s| (s.dir, s.uv, s.pdf));
+    }
+    let pdf_square_many =
+        |uv: &[Vec2], p: &mut [f32]| p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
+    mis_with_brdf_many(env_h, sp, &directions[..n], &u_brdf[..n], pdf_square_many, vis, out);
+}
+
+/// Balance-heuristic MIS of up to 64 directions drawn by one technique (direction, point of the
+/// square, density) and as many BRDF samples, the BRDF's draws and evaluations batched
+/// ([`Brdf::sample_many`], [`Brdf::eval_pdf_many`]: four lanes for GGX) and the other
+/// technique's densities at the BRDF samples' points by `pdf_square_many` — bit for bit the
+/// values of [`mis_with_brdf`] pair by pair.
+fn mis_with_brdf_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<(Vec3, Vec2, f32)>],
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = drawn.len().min(u_brdf.len()).min(out.len()).min(64);
     let wo = sp.frame.to_local(sp.wo);
+    // The BRDF at the drawn directions.
+    let mut local = [Vec3::Z; 64];
+    for (l, d) in local.iter_mut().zip(&drawn[..n]) {
+        *l = d.map_or(Vec3::Z, |(dir, _, _)| sp.frame.to_local(dir));
+    }
+    let mut evaluated = [(Vec3::ZERO, 0.0); 64];
+    sp.brdf.eval_pdf_many(wo, &local[..n], &mut evaluated[..n]);
+    // The BRDF samples, their points of the square and the other technique's density there.
+    let mut samples = [None; 64];
+    sp.brdf.sample_many(wo, &u_brdf[..n], &mut samples[..n]);
     let mut brdf = [None; 64];
     let mut uvs = [Vec2::ZERO; 64];
     for k in 0..n {
-        if let Some(s) = sp.brdf.sample(wo, u_brdf[k]) {
+        if let Some(s) = samples[k] {
             let dir = sp.frame.to_world(s.wi);
             uvs[k] = env_h.square_of(dir);
             brdf[k] = Some((dir, uvs[k], s));
         }
     }
     let mut p_other = [0.0f32; 64];
-    sampler.pdf_square_many(&uvs[..n], &mut p_other[..n]);
+    pdf_square_many(&uvs[..n], &mut p_other[..n]);
     for k in 0..n {
-        let first = mis_drawn_half(env_h, sp, drawn[k].map(|s| (s.dir, s.uv, s.pdf)), vis);
+        let first = drawn[k].map_or(Contribution::default(), |d| drawn_half(env_h, d, evaluated[k], vis));
         let second =
             brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
         out[k] = [first, second];

@@ -76,8 +76,9 @@ fn sin_cos_quarter4(w: Vec4) -> (Vec4, Vec4) {
     (s, c)
 }
 
+/// Lane-wise square root (correctly rounded, as `libm::sqrtf`).
 #[inline(always)]
-fn sqrt4(v: Vec4) -> Vec4 {
+pub(crate) fn sqrt4(v: Vec4) -> Vec4 {
     #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     {
         use core::arch::x86_64::{__m128, _mm_sqrt_ps};

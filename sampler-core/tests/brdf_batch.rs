@@ -74,3 +74,52 @@ fn eval_pdf_is_eval_and_pdf() {
     }
     assert!(checked > 2000, "only {checked} directions where both are positive");
 }
+
+/// `sample_many` and `eval_pdf_many` (four lanes for the GGX conductor) are `sample` and
+/// `eval_pdf` bit for bit, whatever the batch length (tails of 1–3, outputs longer than inputs).
+#[test]
+fn many_at_once_is_one_at_a_time() {
+    use sampler_core::brdf::BrdfSample;
+    let bits = |s: &Option<BrdfSample>| {
+        s.map(|s| (s.wi.to_array().map(f32::to_bits), s.value.to_array().map(f32::to_bits), s.pdf.to_bits()))
+    };
+    let mut brdfs: Vec<Box<dyn Brdf>> = [1e-4, 1e-3, 0.02, 0.1, 0.3, 1.0]
+        .map(|a| Box::new(RoughConductor::new(a, Vec3::new(1.0, 0.8, 0.6))) as Box<dyn Brdf>)
+        .into();
+    brdfs.push(Box::new(CarPaint::default()));
+    brdfs.push(Box::new(Lambert::new(Vec3::splat(0.5))));
+    let mut rng = Pcg32::new(11, 13);
+    let mut u: Vec<Vec2> = (0..61).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
+    u.extend([Vec2::ZERO, Vec2::new(0.25, 0.5), Vec2::new(0.125, 1.0), Vec2::splat(1.0 - f32::EPSILON / 2.0)]);
+    let views = [
+        Vec3::Z,
+        Vec3::new(0.3, -0.2, 0.9),
+        Vec3::new(0.999, 0.0, 0.04),
+        Vec3::new(-0.5, 0.5, 1e-3),
+        Vec3::new(0.2, 0.1, -0.9),
+    ];
+    let mut positive = 0;
+    for brdf in &brdfs {
+        for wo in views.map(Vec3::normalize) {
+            for n in [u.len(), 1, 2, 3, 5] {
+                let mut many = vec![None; n + 3];
+                brdf.sample_many(wo, &u[..n], &mut many);
+                for (k, p) in u[..n].iter().enumerate() {
+                    assert_eq!(bits(&many[k]), bits(&brdf.sample(wo, *p)), "wo {wo}, u {p}");
+                    positive += usize::from(many[k].is_some());
+                }
+                assert!(many[n..].iter().all(Option::is_none), "wrote past the inputs");
+            }
+            let wis: Vec<Vec3> =
+                u.iter().map(|p| Vec3::new(2.0 * p.x - 1.0, 2.0 * p.y - 1.0, p.x - p.y).normalize()).collect();
+            let mut many = vec![(Vec3::NAN, f32::NAN); wis.len()];
+            brdf.eval_pdf_many(wo, &wis, &mut many);
+            for (wi, (value, pdf)) in wis.iter().zip(&many) {
+                let (e, p) = brdf.eval_pdf(wo, *wi);
+                assert_eq!(value.to_array().map(f32::to_bits), e.to_array().map(f32::to_bits), "wo {wo}, wi {wi}");
+                assert_eq!(pdf.to_bits(), p.to_bits(), "wo {wo}, wi {wi}");
+            }
+        }
+    }
+    assert!(positive > 1000, "only {positive} draws");
+}

@@ -9,7 +9,7 @@
 mod common;
 
 use common::*;
-use glam::{DVec2, Vec3};
+use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, luminance};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};
@@ -232,6 +232,19 @@ fn run(estimator: &str) {
                     lum(a.value + b.value)
                 })
                 .collect(),
+            "mis batched" => (0..20_000)
+                .map(|_| {
+                    // The renderer's batched path: env draws four side by side, BRDF draws and
+                    // evaluations four lanes at a time.
+                    let pts: Vec<DVec2> = (0..16).map(|_| u()).collect();
+                    let brdf_pts: Vec<Vec2> = (0..16).map(|_| u().as_vec2()).collect();
+                    let mut drawn = [None; 16];
+                    e.sample_many(&pts, &mut drawn);
+                    let mut pairs = [[estimator::Contribution::default(); 2]; 16];
+                    estimator::mis_many(&e, &sp, &drawn, &brdf_pts, &mut vis, &mut pairs);
+                    pairs.iter().map(|[a, b]| lum(a.value + b.value)).sum::<f64>() / 16.0
+                })
+                .collect(),
             _ => unreachable!(),
         };
         check(&format!("{estimator} / {}", case.name), reference, &values, &mut failures);
@@ -278,6 +291,11 @@ fn env_estimator_is_unbiased() {
 #[test]
 fn brdf_estimator_is_unbiased() {
     run("brdf");
+}
+
+#[test]
+fn batched_mis_estimator_is_unbiased() {
+    run("mis batched");
 }
 
 #[test]

@@ -103,6 +103,10 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let brdf_points = points.map(|p| p.as_vec2());
         estimator::product_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+        let mut drawn = [None; 4];
+        env.sample_many(&points, &mut drawn);
+        estimator::mis_many(&env, &sp, &drawn, &brdf_points, &mut vis, &mut pairs);
+        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
         let mut many = [None; 4];
         sampler.sample_many(&points, &mut many);
         sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();

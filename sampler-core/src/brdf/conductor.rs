@@ -61,6 +61,14 @@ impl Brdf for RoughConductor {
         (value, pdf)
     }
 
+    fn sample_many(&self, wo: Vec3, u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        self.sample_x4(wo, u, out);
+    }
+
+    fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
+        self.eval_pdf_many_x4(wo, wi, out);
+    }
+
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         if wo.z <= 0.0 {
             return 0;

@@ -7,6 +7,7 @@
 
 mod carpaint;
 mod conductor;
+mod ggx_x4;
 mod lambert;
 pub mod microfacet;
 mod phong;
@@ -59,6 +60,21 @@ pub trait Brdf {
         (self.eval(wo, wi), self.pdf(wo, wi))
     }
 
+    /// [`Brdf::sample`] for every point of `u` (`out[k]` from `u[k]`, as many as both hold),
+    /// bit for bit; implementations may draw several at once (the GGX conductor: four lanes).
+    fn sample_many(&self, wo: Vec3, u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        for (o, p) in out.iter_mut().zip(u) {
+            *o = self.sample(wo, *p);
+        }
+    }
+
+    /// [`Brdf::eval_pdf`] for every direction of `wi` (as many as both hold), bit for bit.
+    fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
+        for (o, w) in out.iter_mut().zip(wi) {
+            *o = self.eval_pdf(wo, *w);
+        }
+    }
+
     /// Draws one direction per point of `u` like [`Brdf::sample`], for building B̃: writes
     /// each successful draw's direction and the luminance of BRDF × cos into `out`, and returns how many were written (≤ `u.len()` ≤
     /// `out.len()`). One call per shading point, so implementations can hoist what depends only
@@ -93,6 +109,12 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     }
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         (**self).eval_pdf(wo, wi)
+    }
+    fn sample_many(&self, wo: Vec3, u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        (**self).sample_many(wo, u, out)
+    }
+    fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
+        (**self).eval_pdf_many(wo, wi, out)
     }
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         (**self).sample_batch(wo, u, out)
