@@ -74,7 +74,8 @@ impl Method {
     ///   wide enough to span bright detail of the map and narrow enough that one B̃ per pixel fits
     ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time (`ppis
     ///   report --base product-mis --bracket`): s1 α = 0.05 2.2–2.6× (MIS), studio α = 0.05
-    ///   2.6–2.7× (MIS), s2 α = 0.1 1.76× (MIS) (two runs; timing noise).
+    ///   2.4–2.7× (MIS), s2 α = 0.1 1.0–1.8× (MIS) (three runs; timing noise, and MIS 26–31%
+    ///   faster since session 7's BRDF lanes — s2's α = 0.1 is now a tie).
     /// * Under extended bright regions rather than a sun (`env_peak` below [`SUN_PEAK`]: the
     ///   shared maps and studio, 21–67; the built-in sky 713), wider conductors too, α in
     ///   [`PRODUCT_ALPHA_EXTENDED`]: product-MIS beats MIS there (studio α = 0.15 2.1–2.3×, α = 0.3

@@ -11,7 +11,9 @@
 //! RGB radiance for shading is kept at the finest level only, row-major. Lookups are nearest-texel, the same piecewise-constant function the
 //! sampling densities are built from, so radiance cancels exactly in the product estimator.
 
-use crate::mapping::{SPHERE_AREA, sphere_to_square, square_to_sphere, texel_of};
+use crate::mapping::{
+    SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
+};
 use crate::warp::{child_offset, choose_child, choose_grandchild, point_in_cell};
 use glam::{DVec2, Mat3, Vec2, Vec3};
 
@@ -331,6 +333,29 @@ impl<'a> EnvHierarchy<'a> {
         self.to_world(square_to_sphere(uv))
     }
 
+    /// [`dir_of`](Self::dir_of) for every point of `uv` (as many as both hold), four lanes at a
+    /// time, bit for bit.
+    pub fn dirs_of(&self, uv: &[Vec2], out: &mut [Vec3]) {
+        let n = uv.len().min(out.len());
+        square_to_sphere_batch(&uv[..n], &mut out[..n]);
+        for d in &mut out[..n] {
+            *d = self.to_world(*d);
+        }
+    }
+
+    /// [`square_of`](Self::square_of) for every direction of `dirs` (as many as both hold), four
+    /// lanes at a time, bit for bit.
+    pub fn squares_of(&self, dirs: &[Vec3], out: &mut [Vec2]) {
+        for (ds, os) in dirs.chunks(64).zip(out.chunks_mut(64)) {
+            let n = ds.len().min(os.len());
+            let mut local = [Vec3::ZERO; 64];
+            for (l, d) in local.iter_mut().zip(ds) {
+                *l = self.to_map(*d);
+            }
+            sphere_to_square_batch(&local[..n], &mut os[..n]);
+        }
+    }
+
     /// Finest-level texel containing a point of the square.
     #[inline]
     #[must_use]
@@ -414,15 +439,42 @@ impl<'a> EnvHierarchy<'a> {
     /// The sample at point `xi` of finest-level texel (x, y), with its density.
     #[inline]
     pub(crate) fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> EnvSample {
-        let uv = point_in_cell(x, y, self.finest, xi);
-        let pdf = self.node_relative(self.finest, x, y) / SPHERE_AREA;
+        let (uv, pdf) = self.point_in_texel(x, y, xi);
         EnvSample { dir: self.dir_of(uv), uv, pdf }
+    }
+
+    /// The point of texel (x, y) at `xi` and the density there (solid angle).
+    #[inline]
+    pub(crate) fn point_in_texel(&self, x: u32, y: u32, xi: DVec2) -> (Vec2, f32) {
+        (point_in_cell(x, y, self.finest, xi), self.node_relative(self.finest, x, y) / SPHERE_AREA)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batched_directions_and_points_are_bit_identical() {
+        let rgb = [[1.0f32; 3]; 16];
+        let mut p = [0.0f32; 21];
+        build_pyramid(2, &rgb, &mut p).unwrap();
+        let e = EnvHierarchy::new(2, &p, &rgb)
+            .unwrap()
+            .with_rotation(Mat3::from_rotation_y(0.7) * Mat3::from_rotation_x(-0.3));
+        let mut uv = [Vec2::ZERO; 67];
+        for (k, u) in uv.iter_mut().enumerate() {
+            *u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.754_877_7).fract());
+        }
+        let mut dirs = [Vec3::ZERO; 67];
+        e.dirs_of(&uv, &mut dirs);
+        let mut back = [Vec2::ZERO; 67];
+        e.squares_of(&dirs, &mut back);
+        for k in 0..uv.len() {
+            assert_eq!(dirs[k].to_array().map(f32::to_bits), e.dir_of(uv[k]).to_array().map(f32::to_bits));
+            assert_eq!(back[k].to_array().map(f32::to_bits), e.square_of(dirs[k]).to_array().map(f32::to_bits));
+        }
+    }
 
     #[test]
     fn pyramid_layout() {

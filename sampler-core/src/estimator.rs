@@ -334,14 +334,17 @@ fn mis_with_brdf_many<B: Brdf + ?Sized>(
     // The BRDF samples, their points of the square and the other technique's density there.
     let mut samples = [None; 64];
     sp.brdf.sample_many(wo, &u_brdf[..n], &mut samples[..n]);
-    let mut brdf = [None; 64];
-    let mut uvs = [Vec2::ZERO; 64];
-    for k in 0..n {
-        if let Some(s) = samples[k] {
-            let dir = sp.frame.to_world(s.wi);
-            uvs[k] = env_h.square_of(dir);
-            brdf[k] = Some((dir, uvs[k], s));
+    let mut dirs = [Vec3::Z; 64];
+    for (d, s) in dirs.iter_mut().zip(&samples[..n]) {
+        if let Some(s) = s {
+            *d = sp.frame.to_world(s.wi);
         }
+    }
+    let mut uvs = [Vec2::ZERO; 64];
+    env_h.squares_of(&dirs[..n], &mut uvs[..n]);
+    let mut brdf = [None; 64];
+    for k in 0..n {
+        brdf[k] = samples[k].map(|s| (dirs[k], uvs[k], s));
     }
     let mut p_other = [0.0f32; 64];
     pdf_square_many(&uvs[..n], &mut p_other[..n]);

@@ -15,7 +15,7 @@ use crate::sampler::{DirectionSample, ProductSampler, branch_probability};
 use crate::warp::{
     ONE_MINUS_EPSILON, child_offset, choose_child, choose_child_branchless, choose_grandchild_branchless, point_in_cell,
 };
-use glam::{DVec2, Vec2};
+use glam::{DVec2, Vec2, Vec3};
 
 /// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
 #[derive(Clone, Copy, Debug, Default)]
@@ -59,8 +59,16 @@ impl EnvHierarchy<'_> {
                 *lane = WarpLane::new(0, 0, 0, *u);
             }
             self.warp_down_lanes(&mut lanes[..n]);
-            for (o, lane) in os.iter_mut().zip(&lanes[..n]) {
-                *o = lane.alive.then(|| self.sample_in_texel(lane.x, lane.y, lane.xi));
+            // The points and densities, then the four directions at once.
+            let mut points = [(Vec2::ZERO, 0.0); 4];
+            for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
+                *p = self.point_in_texel(lane.x, lane.y, lane.xi);
+            }
+            let mut dirs = [Vec3::ZERO; 4];
+            self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
+            for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
+                let (uv, pdf) = points[k];
+                *o = lane.alive.then_some(EnvSample { dir: dirs[k], uv, pdf });
             }
         }
     }
@@ -157,8 +165,15 @@ impl ProductSampler<'_, '_> {
                 e.alive = t.alive;
             }
             self.env.warp_down_lanes(&mut below[..n]);
-            for ((o, t), e) in os.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
-                *o = self.finish(t, e);
+            let mut landed = [None; 4];
+            for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
+                *l = self.finish(t, e);
+            }
+            // The four directions at once.
+            let mut dirs = [Vec3::ZERO; 4];
+            self.env.dirs_of(&landed.map(|l| l.map_or(Vec2::ZERO, |(uv, _)| uv))[..n], &mut dirs[..n]);
+            for (k, o) in os.iter_mut().enumerate().take(n) {
+                *o = landed[k].map(|(uv, pdf)| DirectionSample { dir: dirs[k], uv, pdf });
             }
         }
     }
@@ -191,9 +206,9 @@ impl ProductSampler<'_, '_> {
         }
     }
 
-    /// The sample at the end of a tree descent `t` and the environment descent `e` below it,
-    /// with its density as [`sample`](Self::sample) computes it.
-    fn finish(&self, t: &TreeLane, e: &WarpLane) -> Option<DirectionSample> {
+    /// The sample's point at the end of a tree descent `t` and the environment descent `e` below
+    /// it, with its density (solid angle) as [`sample`](Self::sample) computes it.
+    fn finish(&self, t: &TreeLane, e: &WarpLane) -> Option<(Vec2, f32)> {
         if !t.alive || !e.alive {
             return None;
         }
@@ -206,7 +221,7 @@ impl ProductSampler<'_, '_> {
             let (uv, product, texel) = self.land(t.path, t.depth, t.x, t.y, (e.x, e.y), e.xi);
             (uv, self.mixture(product, texel))
         };
-        Some(DirectionSample { dir: self.env.dir_of(uv), uv, pdf: pdf_square / SPHERE_AREA })
+        Some((uv, pdf_square / SPHERE_AREA))
     }
 }
 
