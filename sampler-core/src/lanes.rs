@@ -11,7 +11,7 @@
 use crate::env::{EnvHierarchy, EnvSample, level_offset, morton2};
 use crate::mapping::SPHERE_AREA;
 use crate::quadtree::{COORD_BITS, Node, quantize};
-use crate::sampler::{DirectionSample, ProductSampler, branch_probability};
+use crate::sampler::{DirectionSample, ProductSampler};
 use crate::warp::{
     ONE_MINUS_EPSILON, child_offset, choose_child, choose_child_branchless, choose_grandchild_branchless, point_in_cell,
 };
@@ -113,12 +113,13 @@ impl EnvHierarchy<'_> {
 /// One descent through the product tree.
 #[derive(Clone, Copy, Default)]
 struct TreeLane {
-    /// The node the descent is at (a copy: its leaf test needs no load).
+    /// The node the descent is at (a copy: its leaf test needs no load) and its index.
     node: Node,
+    index: usize,
     depth: u32,
     x: u32,
     y: u32,
-    /// Probability of the path so far (the product of the branch probabilities).
+    /// Probability of the path (the leaf's, once there).
     path: f64,
     xi: DVec2,
     /// Drawn by the defensive environment part of the mixture: no tree descent.
@@ -184,7 +185,7 @@ impl ProductSampler<'_, '_> {
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.in_tree) {
                 if lane.node.is_leaf() {
-                    lane.in_tree = false;
+                    (lane.in_tree, lane.path) = (false, self.paths[lane.index]);
                     continue;
                 }
                 busy = true;
@@ -195,9 +196,8 @@ impl ProductSampler<'_, '_> {
                     (lane.in_tree, lane.alive) = (false, false);
                     continue;
                 };
-                lane.path *= branch_probability(mass, k);
                 let (dx, dy) = child_offset(k);
-                lane.node = c[k];
+                (lane.node, lane.index) = (c[k], first + k);
                 (lane.depth, lane.x, lane.y) = (lane.depth + 1, 2 * lane.x + dx, 2 * lane.y + dy);
             }
             if !busy {
@@ -229,19 +229,19 @@ impl ProductSampler<'_, '_> {
 #[derive(Clone, Copy, Default)]
 struct PdfLane {
     node: Node,
+    index: usize,
     depth: u32,
     x: u32,
     y: u32,
     /// The point's 24-bit coordinates.
     qx: u32,
     qy: u32,
-    path: f64,
 }
 
 impl ProductSampler<'_, '_> {
     /// [`pdf_square`](Self::pdf_square) at every point of `uv` (into `out`, as many as both
-    /// hold), bit for bit: the same branch probabilities multiplied in the same order, four
-    /// descents side by side.
+    /// hold), bit for bit: the same leaves and their path probabilities, four descents side by
+    /// side.
     pub fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
         let Some(&root) = self.nodes.first() else {
             out.iter_mut().zip(uv).for_each(|(o, uv)| *o = self.pdf_square(*uv));
@@ -255,7 +255,7 @@ impl ProductSampler<'_, '_> {
             let n = us.len().min(os.len());
             let mut lanes = [PdfLane::default(); 4];
             for (lane, uv) in lanes.iter_mut().zip(&us[..n]) {
-                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), path: 1.0, ..*lane };
+                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), ..*lane };
             }
             loop {
                 let mut busy = false;
@@ -264,10 +264,8 @@ impl ProductSampler<'_, '_> {
                     let shift = COORD_BITS - 1 - lane.depth;
                     let (dx, dy) = ((lane.qx >> shift) & 1, (lane.qy >> shift) & 1);
                     let k = (dx + 2 * dy) as usize;
-                    let first = lane.node.child as usize;
-                    let c = &self.nodes[first..first + 4];
-                    lane.path *= branch_probability([c[0].product, c[1].product, c[2].product, c[3].product], k);
-                    lane.node = c[k];
+                    lane.index = lane.node.child as usize + k;
+                    lane.node = self.nodes[lane.index];
                     (lane.depth, lane.x, lane.y) = (lane.depth + 1, 2 * lane.x + dx, 2 * lane.y + dy);
                 }
                 if !busy {
@@ -276,7 +274,7 @@ impl ProductSampler<'_, '_> {
             }
             for ((o, l), uv) in os.iter_mut().zip(&lanes[..n]).zip(us) {
                 let texel = self.env.pdf_square(*uv);
-                *o = self.mixture(self.leaf_density(l.path, l.depth, l.x, l.y, texel), texel);
+                *o = self.mixture(self.leaf_density(self.paths[l.index], l.depth, l.x, l.y, texel), texel);
             }
         }
     }

@@ -108,11 +108,12 @@ impl ProductParams {
 
 /// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
 /// Reused from point to point; never allocates. `size_of::<ProductArena<K, NODES>>()` is about
-/// 48·K + 8·NODES bytes (28 696 bytes for the default 256 / 2048). 256 samples make ~650–760 nodes
+/// 48·K + 16·NODES bytes (45 112 bytes for the default 256 / 2048: each node's 8 bytes and its
+/// path probability's 8). 256 samples make ~650–760 nodes
 /// on average and at most 1497 in 30 000 measured shading points (GGX α = 1e-3); when NODES is
 /// exhausted, splitting stops and leaves keep the mean of their samples (still exact sampling).
 /// A bilinear B̃ (`ProductParams::bilinear`) also stores four corner values per node and needs
-/// CORNERS ≥ NODES (`ProductArena<256, 2048, 2048>`: +16·NODES bytes, 61 464 in all); with the
+/// CORNERS ≥ NODES (`ProductArena<256, 2048, 2048>`: +16·NODES bytes, 77 880 in all); with the
 /// default CORNERS = 0 nobody pays for it and B̃ stays piecewise constant
 /// ([`ProductSampler::is_bilinear`] says which was built).
 pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const CORNERS: usize = 0> {
@@ -126,6 +127,8 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     values: [f32; K],
     keys: Vec<u64, K>,
     nodes: Vec<Node, NODES>,
+    /// Per node, the probability that the warp reaches it (see `path_probabilities`).
+    paths: Vec<f64, NODES>,
     /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
     corners: Vec<Corners, CORNERS>,
     /// The last build's defensive fraction and usable BRDF samples (`None` before the first).
@@ -152,6 +155,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             values: [0.0; K],
             keys: Vec::new(),
             nodes: Vec::new(),
+            paths: Vec::new(),
             corners: Vec::new(),
             built: None,
         }
@@ -210,11 +214,19 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             corners: &mut self.corners,
         };
         builder.build();
+        path_probabilities(&self.nodes, &mut self.paths);
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
         self.built = Some((defensive, count));
-        ProductSampler { env, nodes: &self.nodes, corners: &self.corners, defensive, brdf_samples: count }
+        ProductSampler {
+            env,
+            nodes: &self.nodes,
+            paths: &self.paths,
+            corners: &self.corners,
+            defensive,
+            brdf_samples: count,
+        }
     }
 
     /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena
@@ -223,7 +235,37 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
     #[must_use]
     pub fn last_built<'a, 'e>(&'a self, env: &'a EnvHierarchy<'e>) -> Option<ProductSampler<'a, 'e>> {
         let (defensive, brdf_samples) = self.built?;
-        Some(ProductSampler { env, nodes: &self.nodes, corners: &self.corners, defensive, brdf_samples })
+        Some(ProductSampler {
+            env,
+            nodes: &self.nodes,
+            paths: &self.paths,
+            corners: &self.corners,
+            defensive,
+            brdf_samples,
+        })
+    }
+}
+
+/// Each node's path probability: the product of the branch probabilities from the root down to
+/// it, multiplied in the warp's order (so bit for bit what a descent would multiply). Computed
+/// once per build, top-down (children always follow their parent in `nodes`), so that the warp
+/// and the density read it at the leaf instead of dividing at every level.
+fn path_probabilities<const N: usize>(nodes: &[Node], paths: &mut Vec<f64, N>) {
+    paths.clear();
+    let _ = paths.resize(nodes.len(), 0.0);
+    if let Some(root) = paths.first_mut() {
+        *root = 1.0;
+    }
+    for (i, n) in nodes.iter().enumerate() {
+        if n.is_leaf() {
+            continue;
+        }
+        let first = n.child as usize;
+        let c = &nodes[first..first + 4];
+        let mass = [c[0].product, c[1].product, c[2].product, c[3].product];
+        for k in 0..4 {
+            paths[first + k] = paths[i] * branch_probability(mass, k);
+        }
     }
 }
 
@@ -257,6 +299,8 @@ pub struct DirectionSample {
 pub struct ProductSampler<'a, 'e> {
     pub(crate) env: &'a EnvHierarchy<'e>,
     pub(crate) nodes: &'a [Node],
+    /// Per node, the probability that the warp reaches it.
+    pub(crate) paths: &'a [f64],
     /// Per node, B̃ at its corners; empty unless B̃ is bilinear.
     pub(crate) corners: &'a [Corners],
     pub(crate) defensive: f32,
@@ -324,16 +368,14 @@ impl<'e> ProductSampler<'_, 'e> {
     /// importance of its texel (the env's density per unit square area).
     fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f64, f32)> {
         let (mut i, mut depth, mut x, mut y) = (0usize, 0u32, 0u32, 0u32);
-        let mut path = 1.0f64;
         while !self.nodes[i].is_leaf() {
             let first = self.nodes[i].child as usize;
             let c = &self.nodes[first..first + 4];
-            let mass = [c[0].product, c[1].product, c[2].product, c[3].product];
-            let child = choose_child(mass, xi)?;
-            path *= branch_probability(mass, child);
+            let child = choose_child([c[0].product, c[1].product, c[2].product, c[3].product], xi)?;
             let (dx, dy) = child_offset(child);
             (i, depth, x, y) = (first + child, depth + 1, 2 * x + dx, 2 * y + dy);
         }
+        let path = self.paths[i];
         let finest = self.env.finest_level();
         if !self.corners.is_empty() {
             return self.warp_bilinear(i, path, depth, x, y, xi);
@@ -489,25 +531,24 @@ impl<'e> ProductSampler<'_, 'e> {
         }
     }
 
-    /// The product's density per unit square area at `uv`, as the product of the branch
-    /// probabilities the warp takes to reach it: exactly the density the warp realises, however
+    /// The product's density per unit square area at `uv`, from the product of the branch
+    /// probabilities the warp takes to reach its leaf (kept per node by the build): exactly the density the warp realises, however
     /// the node values were computed (the Haar product's cancellation makes its node values
     /// differ from the means of their children at extreme dynamic range). `texel`: the env's
     /// relative importance at `uv` (`EnvHierarchy::pdf_square`), which the caller has already.
     fn product_density(&self, uv: Vec2, texel: f32) -> f64 {
         let Some(root) = self.nodes.first() else { return 0.0 };
         let (qx, qy) = (quantize(uv.x), quantize(uv.y));
-        let (mut node, mut index, mut depth, mut x, mut y, mut path) = (*root, 0usize, 0u32, 0u32, 0u32, 1.0f64);
+        let (mut node, mut index, mut depth, mut x, mut y) = (*root, 0usize, 0u32, 0u32, 0u32);
         while !node.is_leaf() {
             let shift = COORD_BITS - 1 - depth;
             let (dx, dy) = ((qx >> shift) & 1, (qy >> shift) & 1);
             let k = (dx + 2 * dy) as usize;
-            let c = &self.nodes[node.child as usize..node.child as usize + 4];
-            path *= branch_probability([c[0].product, c[1].product, c[2].product, c[3].product], k);
             index = node.child as usize + k;
-            node = c[k];
+            node = self.nodes[index];
             (depth, x, y) = (depth + 1, 2 * x + dx, 2 * y + dy);
         }
+        let path = self.paths[index];
         if !self.corners.is_empty() {
             return self.bilinear_density(index, path, depth, x, y, uv);
         }
