@@ -126,7 +126,10 @@ pub fn shading_points_for(spp: usize, requested: usize) -> usize {
 /// (the base method of the equal-time tables), every faster method is then rendered on at
 /// doubling spp — at most [`BRACKET_DOUBLINGS`] times — until its time reaches the base's at
 /// its largest spp, so that the tables interpolate its error there instead of extrapolating.
-/// `progress` is told about each finished render.
+/// With `repeat` > 1 every render is timed that many times in all, in rounds over all the
+/// (method, spp) pairs — so that a slow spell of the machine falls on all methods alike — and
+/// keeps its fastest time (the image, and so its error, is the same each time: renders are
+/// deterministic). `progress` is told about each first render.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep(
     scene: &Scene,
@@ -138,17 +141,18 @@ pub fn sweep(
     per_point: Option<usize>,
     reference: &[[f32; 3]],
     bracket: Option<Method>,
+    repeat: usize,
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
+    let settings = |method: Method, spp: usize| Settings {
+        method,
+        spp,
+        shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
+        ..*base
+    };
     let mut measure = |method: Method, spp: usize| {
-        let settings = Settings {
-            method,
-            spp,
-            shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
-            ..*base
-        };
-        let image = render::render(scene, bvh, env, &settings);
+        let image = render::render(scene, bvh, env, &settings(method, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
         let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions };
@@ -161,14 +165,33 @@ pub fn sweep(
             out.push(measure(method, spp));
         }
     }
-    let Some(target) = bracket else { return out };
+    if let Some(target) = bracket {
+        bracket_base(&mut out, methods, target, &mut measure);
+    }
+    for _ in 1..repeat {
+        for m in &mut out {
+            let again = render::render(scene, bvh, env, &Settings { progress: false, ..settings(m.method, m.spp) });
+            m.seconds = m.seconds.min(again.render_seconds);
+        }
+    }
+    out
+}
+
+/// Renders every method but `target` on at doubling spp until it reaches `target`'s time at its
+/// largest spp (see [`sweep`]).
+fn bracket_base(
+    out: &mut Vec<Measurement>,
+    methods: &[Method],
+    target: Method,
+    measure: &mut impl FnMut(Method, usize) -> Measurement,
+) {
     let slowest = |out: &[Measurement], m: Method| {
         out.iter().filter(|x| x.method == m).max_by_key(|x| x.spp).map(|x| (x.spp, x.seconds))
     };
-    let Some((_, goal)) = slowest(&out, target) else { return out };
+    let Some((_, goal)) = slowest(out, target) else { return };
     for &method in methods.iter().filter(|&&m| m != target) {
         for _ in 0..BRACKET_DOUBLINGS {
-            match slowest(&out, method) {
+            match slowest(out, method) {
                 Some((spp, seconds)) if seconds < goal && spp <= MAX_BRACKET_SPP / 2 => {
                     out.push(measure(method, 2 * spp));
                 }
@@ -176,7 +199,6 @@ pub fn sweep(
             }
         }
     }
-    out
 }
 
 /// Most extra doublings of a method's spp when bracketing the base's time (8× its largest).

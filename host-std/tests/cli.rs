@@ -132,6 +132,32 @@ fn report_writes_csv_plots_and_table() {
     fails(dir, &["report", "--out", "rep3", "--methods", "product,mis", "--base", "env"], "--base env");
 }
 
+/// `--repeat N` times every render N times and keeps the fastest: the same renders, the same
+/// errors, times no longer than one run's, and the report says so.
+#[test]
+fn report_repeats_timings() {
+    let tmp = scratch("repeat");
+    let dir = tmp.path();
+    let rows = |name: &str| {
+        let csv = std::fs::read_to_string(dir.join(name).join("error_vs_time.csv")).unwrap();
+        csv.lines().skip(1).map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>()).collect::<Vec<_>>()
+    };
+    tiny_report(dir, &["--spp", "2,4", "--methods", "env,mis", "--base", "mis"]);
+    std::fs::rename(dir.join("rep"), dir.join("one")).unwrap();
+    tiny_report(dir, &["--spp", "2,4", "--methods", "env,mis", "--base", "mis", "--repeat", "3"]);
+    std::fs::rename(dir.join("rep"), dir.join("three")).unwrap();
+    let (one, three) = (rows("one"), rows("three"));
+    assert_eq!(one.len(), three.len());
+    for (a, b) in one.iter().zip(&three) {
+        // method, spp, region and both errors agree; only the time may differ.
+        assert_eq!((&a[0], &a[1], &a[3], &a[4], &a[5]), (&b[0], &b[1], &b[3], &b[4], &b[5]));
+        assert!(b[2].parse::<f64>().unwrap() > 0.0);
+    }
+    let md = std::fs::read_to_string(dir.join("three/report.md")).unwrap();
+    assert!(md.contains("fastest of 3 runs"), "{md}");
+    fails(dir, &["report", "--out", "rep4", "--repeat", "0"], "--repeat");
+}
+
 /// `--base` keys the equal-time tables; `--bracket` renders the faster methods on until they
 /// reach the base's time or have doubled their spp three times.
 #[test]

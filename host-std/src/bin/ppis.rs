@@ -69,6 +69,10 @@ struct ReportArgs {
     /// times is interpolated, not extrapolated.
     #[arg(long)]
     bracket: bool,
+    /// Time every render this many times in all (in rounds over all renders) and keep the
+    /// fastest: on a noisy machine single timings move by tens of per cent.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
     #[command(flatten)]
     sampling: SamplingArgs,
     /// Output folder (created if missing).
@@ -472,21 +476,34 @@ fn report_command(args: ReportArgs) -> Result<()> {
     let measurements = pool.install(|| {
         let per_point = args.samples_per_point.map(|v| v as usize);
         let methods = &args.methods;
-        report::sweep(&scene, &bvh, hierarchy.as_ref(), methods, &spps, &base, per_point, &reference, bracket, |m| {
-            eprintln!(
-                "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
-                m.method.name(),
-                m.spp,
-                m.seconds,
-                m.rmse,
-                m.relmse
-            );
-        })
+        let repeat = args.repeat as usize;
+        report::sweep(
+            &scene,
+            &bvh,
+            hierarchy.as_ref(),
+            methods,
+            &spps,
+            &base,
+            per_point,
+            &reference,
+            bracket,
+            repeat,
+            |m| {
+                eprintln!(
+                    "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                    m.method.name(),
+                    m.spp,
+                    m.seconds,
+                    m.rmse,
+                    m.relmse
+                );
+            },
+        )
     });
     output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(&measurements))?;
     output::write_text(
         &args.out.join("report.md"),
-        &report::markdown(&scene.name, &measurements, args.base, threads, &note),
+        &report::markdown(&scene.name, &measurements, args.base, threads, &timing_note(&note, args.repeat)),
     )?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
@@ -574,4 +591,9 @@ fn conformance(dir: &Path) -> Result<()> {
 #[cfg(not(feature = "usd"))]
 fn conformance(_dir: &Path) -> Result<()> {
     bail!("--expected: this ppis was built without USD support (cargo feature `usd`)")
+}
+
+/// The report's reference note, and how renders were timed when more than once.
+fn timing_note(reference: &str, repeat: u32) -> String {
+    if repeat > 1 { format!("{reference}; times: the fastest of {repeat} runs") } else { reference.to_string() }
 }
