@@ -1,0 +1,64 @@
+//! The batched MIS estimators the renderer uses give, pair by pair, bit for bit what the
+//! one-pair estimators give for the same drawn directions and BRDF points.
+
+mod common;
+
+use common::TestEnv;
+use glam::{DVec2, Vec2, Vec3};
+use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
+use sampler_core::estimator::{self, Contribution, ShadingPoint};
+use sampler_core::frame::Frame;
+use sampler_core::points::sobol02;
+use sampler_core::sampler::{ProductArena, ProductParams};
+
+fn bits(c: &Contribution) -> ([u64; 3], [u32; 3], u32, u32) {
+    (c.value.to_array().map(f64::to_bits), c.dir.to_array().map(f32::to_bits), c.pdf.to_bits(), c.other_pdf.to_bits())
+}
+
+#[test]
+fn batched_mis_is_pair_by_pair_mis() {
+    let env = TestEnv::random_smooth(5, 9);
+    let e = env.view();
+    let brdfs: Vec<Box<dyn Brdf>> = vec![
+        Box::new(RoughConductor::new(0.05, Vec3::new(0.9, 0.7, 0.5))),
+        Box::new(RoughConductor::new(1e-3, Vec3::ONE)),
+        Box::new(Lambert::new(Vec3::splat(0.6))),
+        Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.7), 200.0)),
+        Box::new(CarPaint::default()),
+    ];
+    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    let mut compared = 0;
+    for (i, brdf) in brdfs.iter().enumerate() {
+        for (j, n) in [Vec3::Z, Vec3::new(0.3, -0.5, 0.8), Vec3::new(-0.9, 0.1, 0.2)].into_iter().enumerate() {
+            let frame = Frame::from_normal(n.normalize());
+            let wo = frame.to_world(Vec3::new(0.4, 0.1, 0.6).normalize());
+            let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
+            // Visibility that blocks part of the sphere, the same for both paths.
+            let mut vis = |d: Vec3| d.x + 0.3 * d.y < 0.5;
+            let (mut u, mut v) = ([DVec2::ZERO; 61], [DVec2::ZERO; 61]);
+            sobol02((i * 7 + j) as u64, 0, &mut u);
+            sobol02((i * 7 + j) as u64 + 99, 0, &mut v);
+            let brdf_points: Vec<Vec2> = v.iter().map(|p| p.as_vec2()).collect();
+            let mut out = [[Contribution::default(); 2]; 61];
+            // Env and BRDF.
+            let mut drawn = [None; 61];
+            e.sample_many(&u, &mut drawn);
+            estimator::mis_many(&e, &sp, &drawn, &brdf_points, &mut vis, &mut out);
+            for k in 0..u.len() {
+                let one = estimator::mis_drawn(&e, &sp, drawn[k], brdf_points[k], &mut vis);
+                assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "mis, brdf {i}, pair {k}");
+                compared += usize::from(out[k][0].value.max_element() > 0.0 && out[k][1].value.max_element() > 0.0);
+            }
+            // Product and BRDF.
+            let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
+            let mut drawn = [None; 61];
+            s.sample_many(&u, &mut drawn);
+            estimator::product_mis_many(&s, &sp, &u, &brdf_points, &mut vis, &mut out);
+            for k in 0..u.len() {
+                let one = estimator::product_mis_drawn(&s, &sp, drawn[k], brdf_points[k], &mut vis);
+                assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "product-mis, brdf {i}, pair {k}");
+            }
+        }
+    }
+    assert!(compared > 100, "only {compared} pairs with both halves lit");
+}
