@@ -170,6 +170,18 @@ impl ProductSampler<'_, '_> {
             for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
                 *l = self.finish(t, e);
             }
+            // The defensive samples' densities: the product's four descents at once.
+            let (mut points, mut which, mut count) = ([Vec2::ZERO; 4], [0; 4], 0);
+            for (k, t) in tree[..n].iter().enumerate() {
+                if let (true, Some((uv, _))) = (t.defensive, landed[k]) {
+                    (points[count], which[count], count) = (uv, k, count + 1);
+                }
+            }
+            let mut densities = [0.0f32; 4];
+            self.pdf_square_many(&points[..count], &mut densities[..count]);
+            for (&k, &d) in which[..count].iter().zip(&densities) {
+                landed[k] = landed[k].map(|(uv, _)| (uv, d / SPHERE_AREA));
+            }
             // The four directions at once.
             let mut dirs = [Vec3::ZERO; 4];
             self.env.dirs_of(&landed.map(|l| l.map_or(Vec2::ZERO, |(uv, _)| uv))[..n], &mut dirs[..n]);
@@ -207,14 +219,14 @@ impl ProductSampler<'_, '_> {
     }
 
     /// The sample's point at the end of a tree descent `t` and the environment descent `e` below
-    /// it, with its density (solid angle) as [`sample`](Self::sample) computes it.
+    /// it, with its density (solid angle) as [`sample`](Self::sample) computes it — except for
+    /// defensive samples, whose density (0 here) the caller looks up for four at once.
     fn finish(&self, t: &TreeLane, e: &WarpLane) -> Option<(Vec2, f32)> {
         if !t.alive || !e.alive {
             return None;
         }
         let (uv, pdf_square) = if t.defensive {
-            let uv = point_in_cell(e.x, e.y, self.env.finest_level(), e.xi);
-            (uv, self.pdf_square(uv))
+            (point_in_cell(e.x, e.y, self.env.finest_level(), e.xi), 0.0)
         } else {
             // Below a leaf finer than the map the env lane did not move: (e.x, e.y, e.xi) are
             // the leaf's.

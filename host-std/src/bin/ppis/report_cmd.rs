@@ -1,0 +1,167 @@
+//! `ppis report`: every method at every sample count against a reference — error against
+//! render time as CSV, plot and equal-time tables.
+
+use super::{MAX_SPP, SamplingArgs, SceneArgs, load_scene, parse_method, warn_notes};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use host_std::bvh::Bvh;
+use host_std::environment::Environment;
+use host_std::integrator::Method;
+use host_std::output;
+use host_std::render::{self, Settings};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub(crate) struct ReportArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Comma-separated methods.
+    #[arg(long, default_value = "product,env,brdf,mis,product-mis,ris,two-stage,auto", value_delimiter = ',', value_parser = parse_method)]
+    methods: Vec<Method>,
+    /// Comma-separated visibility samples per pixel.
+    #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
+    spp: Vec<u32>,
+    /// Reference image (linear EXR of the same size); otherwise one is rendered.
+    #[arg(long, conflicts_with = "reference_spp")]
+    reference: Option<PathBuf>,
+    /// Visibility samples per pixel of the rendered reference.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
+    reference_spp: u32,
+    /// Visibility samples per shading point: primary rays per pixel then grow as spp / V
+    /// (instead of the fixed --shading-points), so the pixel-footprint integration converges too.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    samples_per_point: Option<u32>,
+    /// Method of the rendered reference (an independent code path from the product by default).
+    #[arg(long, default_value = "mis", value_parser = parse_method)]
+    reference_method: Method,
+    /// The method the equal-time tables compare every other one against (one of --methods).
+    #[arg(long, default_value = "product", value_parser = parse_method)]
+    base: Method,
+    /// Render every method faster than the base on at doubling spp (at most 8× its largest)
+    /// until its time reaches the base's at its largest spp, so that its error at the base's
+    /// times is interpolated, not extrapolated.
+    #[arg(long)]
+    bracket: bool,
+    /// Time every render this many times in all (in rounds over all renders) and keep the
+    /// fastest: on a noisy machine single timings move by tens of per cent.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Output folder (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
+    if !args.methods.contains(&args.base) {
+        bail!("--base {} is not among --methods", args.base);
+    }
+    use host_std::report;
+    let loaded = load_scene(&args.scene)?;
+    warn_notes(&loaded.scene, &loaded.notes);
+    let mut scene = loaded.scene;
+    args.sampling.resize(&mut scene);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
+    let environment = match &scene.env {
+        Some((source, placement)) => Some(Environment::build(source, *placement)?),
+        None => None,
+    };
+    let bvh = Bvh::build(&scene);
+    let hierarchy = environment.as_ref().map(Environment::hierarchy);
+    let threads = args.sampling.threads();
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
+    let base = Settings {
+        method: Method::Product,
+        spp: 1,
+        shading_points: args.sampling.shading_points as usize,
+        brdf_samples: args.sampling.brdf_samples as usize,
+        seed: args.sampling.seed,
+        progress: false,
+        shadows: !args.sampling.unshadowed,
+    };
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let (reference, note) = match &args.reference {
+        Some(path) => {
+            let image = host_std::env_io::load(path)?;
+            if (image.width, image.height) != (w, h) {
+                bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
+            }
+            (image.texels, format!("{}", path.display()))
+        }
+        None => {
+            let spp = args.reference_spp as usize;
+            let settings = Settings {
+                method: args.reference_method,
+                spp,
+                shading_points: report::shading_points_per_pixel(spp, 16, args.samples_per_point.map(|v| v as usize)),
+                seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
+                progress: true,
+                ..base
+            };
+            eprintln!("ppis: rendering the reference ({}, {spp} spp)", args.reference_method);
+            let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+            output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
+            (
+                image.pixels,
+                format!(
+                    "{} at {spp} spp (reference.exr, {:.1} s), independent seed",
+                    args.reference_method, image.render_seconds
+                ),
+            )
+        }
+    };
+    let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
+    let bracket = args.bracket.then_some(args.base);
+    let measurements = pool.install(|| {
+        let per_point = args.samples_per_point.map(|v| v as usize);
+        let methods = &args.methods;
+        let repeat = args.repeat as usize;
+        report::sweep(
+            &scene,
+            &bvh,
+            hierarchy.as_ref(),
+            methods,
+            &spps,
+            &base,
+            per_point,
+            &reference,
+            bracket,
+            repeat,
+            |m| {
+                eprintln!(
+                    "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                    m.method.name(),
+                    m.spp,
+                    m.seconds,
+                    m.rmse,
+                    m.relmse
+                );
+            },
+        )
+    });
+    output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(&measurements))?;
+    output::write_text(
+        &args.out.join("report.md"),
+        &report::markdown(&scene.name, &measurements, args.base, threads, &timing_note(&note, args.repeat)),
+    )?;
+    report::plot(
+        &args.out.join("error_vs_time.svg"),
+        &args.out.join("error_vs_time.png"),
+        &format!("{}: relMSE against render time ({threads} threads)", scene.name),
+        &measurements,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: cannot draw the plot: {e}", args.out.display()))?;
+    eprintln!(
+        "ppis: wrote error_vs_time.csv, error_vs_time.svg, error_vs_time.png and report.md in {}",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The report's reference note, and how renders were timed when more than once.
+fn timing_note(reference: &str, repeat: u32) -> String {
+    if repeat > 1 { format!("{reference}; times: the fastest of {repeat} runs") } else { reference.to_string() }
+}
