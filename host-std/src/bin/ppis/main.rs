@@ -65,8 +65,10 @@ struct SceneArgs {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto.
-    #[arg(long, default_value = "product", value_parser = parse_method)]
+    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto. The default,
+    /// product-MIS, is product sampling beside BRDF sampling: on the default scene 5× faster
+    /// than `product` alone and far less noisy (docs/perf.md).
+    #[arg(long, default_value = "product-mis", value_parser = parse_method)]
     method: Method,
     /// Visibility samples (shadow rays) per pixel.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
