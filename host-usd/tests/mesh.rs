@@ -108,6 +108,19 @@ fn bad_topology_is_an_error_naming_the_prim() {
     assert!(e.contains("bad.usda") && e.contains("/Broken") && e.contains("40"), "{e}");
 }
 
+/// A prim name that is not an identifier is a clean error. (Found by the mutation test: a
+/// flipped byte made `"Own"` into `"}wn"`, whose path was its own parent, and openusd's
+/// instancing walk recursed until the stack overflowed.)
+#[test]
+fn prim_names_that_are_not_identifiers_are_errors() {
+    let dir = tempfile::Builder::new().prefix("ppis-usd-name-").tempdir().unwrap();
+    let file = dir.path().join("name.usda");
+    let body = "def Xform \"Root\"\n{\n    def Cube \"}wn\"\n    {\n        double size = 1\n    }\n}\n";
+    std::fs::write(&file, format!("#usda 1.0\n{body}")).unwrap();
+    let e = host_usd::load(&file).unwrap_err().to_string();
+    assert!(e.contains("name.usda") && e.contains("}wn"), "{e}");
+}
+
 #[test]
 fn unbound_gprims_show_their_display_color() {
     let s = import(&format!(

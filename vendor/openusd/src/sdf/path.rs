@@ -395,8 +395,12 @@ impl Path {
         // (a child of another prim) or directly by a `}` (a child of a variant
         // selection, `/A{v=s}B`), whichever is rightmost.
         match self.path.rfind(['/', '}']) {
-            // Child of a variant selection: keep up to and including the `}`.
-            Some(i) if self.path.as_bytes()[i] == b'}' => Some(Path::from_str_unchecked(&self.path[..i + 1])),
+            // Child of a variant selection: keep up to and including the `}`. (ppis patch: a
+            // path ending in a stray `}` has no such parent — it would be the path itself, and
+            // every ancestor walk would loop; see PATCHED.md.)
+            Some(i) if self.path.as_bytes()[i] == b'}' => {
+                (i + 1 < self.path.len()).then(|| Path::from_str_unchecked(&self.path[..i + 1]))
+            }
             Some(0) => Some(Path::abs_root()),
             // Child of another prim: drop the `/` and the name.
             Some(i) => Some(Path::from_str_unchecked(&self.path[..i])),

@@ -347,6 +347,10 @@ impl<'a> Parser<'a> {
         let Token::String(name) = name_token else {
             bail!("Expected prim name string, got {name_token:?}");
         };
+        // ppis patch: a prim name is an identifier. Unchecked, a name such as "}wn" made a
+        // path whose parent is itself, and instancing's ancestor walk recursed until the
+        // stack overflowed (see PATCHED.md).
+        ensure!(sdf::Path::is_valid_identifier(name), "Invalid prim name \"{name}\": not an identifier");
         parent_children.push(name.to_string());
         let prim_path = current_path.append_path(name)?;
 
