@@ -219,14 +219,8 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
         self.built = Some((defensive, count));
-        ProductSampler {
-            env,
-            nodes: &self.nodes,
-            paths: &self.paths,
-            corners: &self.corners,
-            defensive,
-            brdf_samples: count,
-        }
+        let built: &'a Self = self;
+        built.last_built(env).expect("just built")
     }
 
     /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena
