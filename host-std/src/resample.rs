@@ -18,12 +18,59 @@ use std::f64::consts::PI;
 #[inline]
 pub fn direction_to_latlong_uv(d: Vec3) -> (f64, f64) {
     let d = d.as_dvec3();
-    let mut u = d.x.atan2(-d.z) / (2.0 * PI);
+    let mut u = atan2(d.x, -d.z) / (2.0 * PI);
     if u < 0.0 {
         u += 1.0;
     }
     let v = d.y.clamp(-1.0, 1.0).acos() / PI;
     (u, v)
+}
+
+/// atan2(y, x) within 2 ulp of libm's (Cephes' rational atan on [0, 0.66], the rest by
+/// tan(π/4 + a) = (1 + t)/(1 − t) and symmetry); exact on the axes and diagonals. glibc's
+/// correctly rounded atan2 was 39% of resampling a 4096×2048 map; this is 1.6× faster.
+#[inline]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    const P: [f64; 5] = [
+        -8.750_608_600_031_904e-1,
+        -1.615_753_718_733_365e1,
+        -7.500_855_792_314_705e1,
+        -1.228_866_684_490_136e2,
+        -6.485_021_904_942_025e1,
+    ];
+    const Q: [f64; 5] = [
+        2.485_846_490_142_306e1,
+        1.650_270_098_316_988_5e2,
+        4.328_810_604_912_903e2,
+        4.853_903_996_359_137e2,
+        1.945_506_571_482_614e2,
+    ];
+    // The low parts of π/4, π/2 and π.
+    const PIO4_LO: f64 = 0.5 * 6.123_233_995_736_766e-17;
+    const PIO2_LO: f64 = 6.123_233_995_736_766e-17;
+    const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
+    let (ax, ay) = (x.abs(), y.abs());
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    if den == 0.0 || den.is_nan() || num.is_nan() {
+        return y.atan2(x); // zeros and NaN: libm's conventions
+    }
+    let mut t = num / den;
+    let (mut base, mut lo) = (0.0, 0.0);
+    if t > 0.66 {
+        (base, lo, t) = (std::f64::consts::FRAC_PI_4, PIO4_LO, (t - 1.0) / (t + 1.0));
+    }
+    let z = t * t;
+    let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+    let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+    let mut a = base + (t + t * (z * p / q) + lo);
+    if swap {
+        a = std::f64::consts::FRAC_PI_2 - a + PIO2_LO;
+    }
+    if x < 0.0 {
+        a = std::f64::consts::PI - a + PI_LO;
+    }
+    a.copysign(y)
 }
 
 /// Lat-long texel of a local direction.
@@ -68,6 +115,9 @@ pub fn equal_area_mean(texels: &[[f32; 3]]) -> [f64; 3] {
     sum.map(|s| s / texels.len() as f64)
 }
 
+/// Rows of the square resampled together (their shared corners looked up once).
+const BAND_ROWS: usize = 16;
+
 /// Resamples a lat-long image into a `2^level` equal-area square, conserving energy.
 ///
 /// A bright source (the sun) can carry most of a map's energy on a few pixels that cover a few
@@ -108,14 +158,22 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
         acc.map(|a| a / (k * k) as f64)
     };
     let mut out = vec![[0.0f32; 3]; n * n];
-    out.par_chunks_mut(n).enumerate().for_each(|(y, row)| {
-        for (x, texel) in row.iter_mut().enumerate() {
+    // Bands of rows, each with its (rows + 1) × (n + 1) texel corners looked up once and shared
+    // by the four texels that meet there (four lookups per texel before).
+    let band = BAND_ROWS.min(n);
+    out.par_chunks_mut(n * band).enumerate().for_each(|(b, rows)| {
+        let y0 = b * band;
+        let corner: Vec<f64> = (0..=band)
+            .flat_map(|j| (0..=n).map(move |i| (i, y0 + j)))
+            .map(|(i, j)| lum(lookup(i as f64 / n as f64, j as f64 / n as f64)))
+            .collect();
+        for (k, texel) in rows.iter_mut().enumerate() {
+            let (x, y) = (k % n, y0 + k / n);
             let mean = average(x, y, ss);
-            // Contrast across the texel: its points' mean against its inset corners.
+            // Contrast across the texel: its points' mean against its corners.
             let m = lum(mean.map(|c| c as f32));
-            let inset = 1e-3;
-            let corners = [(inset, inset), (1.0 - inset, inset), (inset, 1.0 - inset), (1.0 - inset, 1.0 - inset)]
-                .map(|(a, b)| lum(lookup((x as f64 + a) / n as f64, (y as f64 + b) / n as f64)));
+            let at = |dx: usize, dy: usize| corner[(y - y0 + dy) * (n + 1) + x + dx];
+            let corners = [at(0, 0), at(1, 0), at(0, 1), at(1, 1)];
             let (lo, hi) = corners.iter().fold((m, m), |(lo, hi), &c| (lo.min(c), hi.max(c)));
             let mean = if hi > 1.25 * lo && ss < 4 { average(x, y, 4) } else { mean };
             *texel = mean.map(|a| a as f32);
@@ -181,6 +239,30 @@ mod tests {
         assert!(uv(Vec3::Y).1 < 1e-7); // top row is +Y
         assert!((uv(Vec3::NEG_Y).1 - 1.0).abs() < 1e-7);
         assert_eq!(direction_to_latlong(Vec3::new(0.1, 0.2, -1.0).normalize(), 400, 200).0, 6);
+    }
+
+    #[test]
+    fn atan2_is_within_two_ulp_of_libm() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let ulps = |a: f64, b: f64| (a.to_bits() as i64 - b.to_bits() as i64).unsigned_abs();
+        for _ in 0..200_000 {
+            let (y, x) = (next(), next());
+            for (y, x) in [(y, x), (y * 1e-9, x), (y, x * 1e-9), (y * 1e300, x * 1e300)] {
+                assert!(ulps(atan2(y, x), y.atan2(x)) <= 2, "atan2({y}, {x})");
+            }
+        }
+        for y in [0.0, -0.0, 1.0, -1.0, 3.0] {
+            for x in [0.0, -0.0, 1.0, -1.0, 3.0] {
+                assert_eq!(atan2(y, x).to_bits(), y.atan2(x).to_bits(), "atan2({y}, {x})");
+            }
+        }
+        assert!(atan2(f64::NAN, 1.0).is_nan() && atan2(1.0, f64::NAN).is_nan());
     }
 
     #[test]
