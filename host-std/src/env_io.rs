@@ -16,8 +16,8 @@ pub struct RgbImage {
 
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
-    #[error("{path}: cannot read the file: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: cannot read the file: {error}")]
+    Io { path: PathBuf, error: std::io::Error },
     #[error("{path}: not a readable {format} image: {message}")]
     Decode { path: PathBuf, format: &'static str, message: String },
     #[error("{path}: the image is empty (zero width or height)")]
@@ -37,7 +37,7 @@ const MAX_HEIGHT: usize = 16_384;
 
 /// Loads an image by its extension.
 pub fn load(path: &Path) -> Result<RgbImage, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.to_owned(), source })?;
+    let bytes = std::fs::read(path).map_err(|error| LoadError::Io { path: path.to_owned(), error })?;
     load_bytes(path, &bytes)
 }
 

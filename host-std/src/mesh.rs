@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("{path}: cannot read the mesh: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: cannot read the mesh: {error}")]
+    Io { path: PathBuf, error: std::io::Error },
     #[error("{path}: not a readable {format} mesh: {message}")]
     Decode { path: PathBuf, format: &'static str, message: String },
     #[error("{path}: unsupported mesh format (expected .obj or .ply)")]
@@ -19,7 +19,7 @@ pub enum MeshError {
 /// Positions and triangles of a mesh file.
 pub fn load(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), MeshError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.to_owned(), error })?;
     let (positions, triangles) = match ext.as_str() {
         "obj" => load_obj(path, &bytes)?,
         "ply" => load_ply(path, &bytes)?,

@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{path}: cannot read the scene: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: cannot read the scene: {error}")]
+    Io { path: PathBuf, error: std::io::Error },
     #[error("{path}: invalid scene JSON: {message}")]
     Json { path: PathBuf, message: String },
     #[error("{path}: {message}")]
@@ -147,7 +147,7 @@ fn white() -> [f32; 3] {
 
 /// Reads a scene file; relative paths inside it are relative to the file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_owned(), error })?;
     parse(&text, path)
 }
 

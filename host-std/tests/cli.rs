@@ -21,6 +21,12 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(stderr.contains(needle), "{args:?}: stderr does not mention {needle:?}: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    // Each cause said once (an error's source printed again after its own message read
+    // "…: No such file or directory (os error 2): No such file or directory (os error 2)").
+    for line in stderr.lines() {
+        let parts: Vec<_> = line.split(": ").collect();
+        assert!(parts.windows(2).all(|w| w[0] != w[1]), "{args:?}: repeated cause: {line}");
+    }
     let leftovers: Vec<_> = std::fs::read_dir(dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
     assert!(leftovers.iter().all(|f| !f.to_string_lossy().starts_with("render")), "{args:?} left {leftovers:?}");
 }
