@@ -185,25 +185,47 @@ pub fn product_params(method: Method, brdf_samples: usize) -> ProductParams {
     }
 }
 
+/// Share of a product-MIS budget spent on product samples where a lobe at least
+/// [`WIDE_LOBE`] wide meets extended light (`env_peak` below [`SUN_PEAK`]); elsewhere half.
+/// Measured at 1024 spp against shares ½ and ⅞ (docs/perf.md, session 8): studio α = 0.3 and
+/// α = 0.15, s1's α = 0.3, s2's α = 0.1 and the diffuse surfaces of s1, s2 and studio 1.1–1.6×
+/// lower error at equal samples; under the built-in sky's sun every material, and the α ≤ 0.05
+/// lobes everywhere, lose with it (more BRDF samples lose too).
+pub const WIDE_LOBE_PRODUCT_SHARE: f64 = 0.75;
+
+/// Lobe width (GGX α; see `Bsdf::lobe_width`) from which product-MIS leans on product samples.
+pub const WIDE_LOBE: f32 = 0.1;
+
+/// The share of a material's product-MIS budget spent on product samples (the rest are BRDF
+/// samples; see [`WIDE_LOBE_PRODUCT_SHARE`]).
+pub fn product_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
+    if env_peak < SUN_PEAK && bsdf.lobe_width() >= WIDE_LOBE { WIDE_LOBE_PRODUCT_SHARE } else { 0.5 }
+}
+
 /// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
 /// visibility samples of `method` (not `Auto`: resolve it per material first). `technique`
 /// holds the product sampler or two-stage partition for the methods that need one; it may have
 /// been built for another shading point of the same pixel and material (still unbiased: it is
-/// a valid density that is positive wherever L > 0).
+/// a valid density that is positive wherever L > 0). Product-MIS spends `product_share` of the
+/// budget on product samples and the rest on BRDF samples (at least one of each).
 #[allow(clippy::too_many_arguments)]
 pub fn shade<B: Brdf + ?Sized>(
     method: Method,
     env: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
     budget: usize,
+    product_share: f64,
     seed: u64,
     block: usize,
     technique: &Technique<'_, '_>,
     vis: &mut impl Visibility,
 ) -> DVec3 {
     let budget = budget.max(1);
-    let pairs = (budget / 2).max(1);
-    let n = if matches!(method, Method::Mis | Method::ProductMis) { pairs } else { budget };
+    if let (Method::ProductMis, Technique::Product(p)) = (method, technique) {
+        return shade_product_mis(p, sp, budget, product_share, seed, block, vis);
+    }
+    // MIS spends the budget in pairs, one sample per technique.
+    let n = if method == Method::Mis { (budget / 2).max(1) } else { budget };
     // This shading point's run of the pixel's sequence: the pixel's shading points together
     // draw one (0,2)-net per technique, stratified over the whole pixel, not per point.
     let first = (block * n) as u32;
@@ -218,8 +240,8 @@ pub fn shade<B: Brdf + ?Sized>(
     while done < n {
         let m = (n - done).min(64);
         sobol02(hash_combine(seed, 1), first + done as u32, &mut points[..m]);
-        // The second technique's points, for the MIS methods only.
-        if matches!(method, Method::Mis | Method::ProductMis) {
+        // The second technique's points, for MIS only.
+        if method == Method::Mis {
             sobol02(hash_combine(seed, 2), first + done as u32, &mut others[..m]);
         }
         // The batch's env samples drawn together: their descents overlap.
@@ -231,9 +253,6 @@ pub fn shade<B: Brdf + ?Sized>(
             *b = o.as_vec2();
         }
         match (method, technique) {
-            (Method::ProductMis, Technique::Product(p)) => {
-                estimator::product_mis_many(p, sp, &points[..m], &brdf_points[..m], vis, &mut pairs_out[..m]);
-            }
             (Method::Mis, _) => estimator::mis_many(env, sp, &drawn[..m], &brdf_points[..m], vis, &mut pairs_out[..m]),
             (_, Technique::Product(p)) => p.sample_many(&points[..m], &mut product_drawn[..m]),
             _ => {}
@@ -244,9 +263,7 @@ pub fn shade<B: Brdf + ?Sized>(
                 (Method::Product | Method::Wavelet, Technique::Product(p)) => {
                     estimator::product_drawn(p, sp, product_drawn[k], vis).value
                 }
-                (Method::ProductMis, Technique::Product(_)) | (Method::Mis, _) => {
-                    pairs_out[k][0].value + pairs_out[k][1].value
-                }
+                (Method::Mis, _) => pairs_out[k][0].value + pairs_out[k][1].value,
                 (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
                 (Method::Env, _) => estimator::env_drawn(env, sp, drawn[k], vis).value,
                 (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
@@ -261,6 +278,46 @@ pub fn shade<B: Brdf + ?Sized>(
         done += m;
     }
     sum / n as f64
+}
+
+/// Product-MIS at one shading point: ⌊share·budget⌉ product samples and the rest BRDF samples
+/// (at least one of each; a budget of one still takes one of each), each technique's points
+/// this shading point's run of the pixel's (0,2)-sequence for it.
+fn shade_product_mis<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    budget: usize,
+    share: f64,
+    seed: u64,
+    block: usize,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let (n_p, n_b) = if budget < 2 {
+        (1, 1)
+    } else {
+        let n_p = ((share * budget as f64).round() as usize).clamp(1, budget - 1);
+        (n_p, budget - n_p)
+    };
+    let total = (n_p + n_b) as f64;
+    let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
+    let mut sum = DVec3::ZERO;
+    let (mut done_p, mut done_b) = (0, 0);
+    let mut product_points = [DVec2::ZERO; 64];
+    let mut brdf_points = [DVec2::ZERO; 64];
+    let mut brdf_points_f32 = [Vec2::ZERO; 64];
+    // Batches of up to 64 points of each technique (a power of two keeps each batch a net).
+    while done_p < n_p || done_b < n_b {
+        let (m_p, m_b) = ((n_p - done_p).min(64), (n_b - done_b).min(64));
+        sobol02(hash_combine(seed, 1), (block * n_p + done_p) as u32, &mut product_points[..m_p]);
+        sobol02(hash_combine(seed, 2), (block * n_b + done_b) as u32, &mut brdf_points[..m_b]);
+        for (b, o) in brdf_points_f32.iter_mut().zip(&brdf_points[..m_b]) {
+            *b = o.as_vec2();
+        }
+        let (u_p, u_b) = (&product_points[..m_p], &brdf_points_f32[..m_b]);
+        sum += estimator::product_mis_split(sampler, sp, u_p, u_b, shares, vis);
+        (done_p, done_b) = (done_p + m_p, done_b + m_b);
+    }
+    sum / total
 }
 
 #[cfg(test)]
@@ -294,6 +351,17 @@ mod tests {
         assert_eq!(Method::Auto.for_material(&conductor(0.15), 713.0), Method::Mis);
         assert_eq!(Method::Auto.for_material(&conductor(0.5), 67.0), Method::Mis);
         assert_eq!(Method::Auto.for_material(&conductor(0.05), 1.6), Method::Brdf, "smooth light");
+    }
+
+    #[test]
+    fn product_mis_leans_on_product_samples_for_wide_lobes_under_extended_light() {
+        let diffuse = Bsdf::Diffuse(Lambert::new(Vec3::ONE));
+        assert_eq!(product_share(&conductor(0.3), 67.0), WIDE_LOBE_PRODUCT_SHARE);
+        assert_eq!(product_share(&conductor(0.1), 21.0), WIDE_LOBE_PRODUCT_SHARE);
+        assert_eq!(product_share(&diffuse, 21.0), WIDE_LOBE_PRODUCT_SHARE);
+        assert_eq!(product_share(&conductor(0.05), 21.0), 0.5, "moderate lobe");
+        assert_eq!(product_share(&conductor(0.3), 713.0), 0.5, "sun");
+        assert_eq!(product_share(&Bsdf::CarPaint(sampler_core::brdf::CarPaint::default()), 21.0), 0.5, "sharp coat");
     }
 
     #[test]

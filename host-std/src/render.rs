@@ -69,13 +69,18 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     let sat = sat.as_deref();
     // `auto` resolves per material once, knowing how peaked the lighting is.
     let env_peak = match (env, settings.method) {
-        (Some(e), Method::Auto) => e.peak(5),
+        (Some(e), Method::Auto | Method::ProductMis) => e.peak(5),
         _ => f32::MAX,
     };
-    let methods: Vec<Method> =
-        scene.materials.iter().map(|m| settings.method.for_material(&m.bsdf, env_peak)).collect();
-    // Per material, the cosine of the angle within which a product-MIS sampler is reused.
-    let reuse: Vec<f32> = scene.materials.iter().map(|m| integrator::reuse_cosine(&m.bsdf)).collect();
+    let plans: Vec<MaterialPlan> = scene
+        .materials
+        .iter()
+        .map(|m| MaterialPlan {
+            method: settings.method.for_material(&m.bsdf, env_peak),
+            reuse_cosine: integrator::reuse_cosine(&m.bsdf),
+            product_share: integrator::product_share(&m.bsdf, env_peak),
+        })
+        .collect();
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
     let tiles: Vec<(usize, usize)> =
@@ -99,7 +104,7 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
             let mut out = Vec::with_capacity(TILE * TILE);
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    out.push(pixel(scene, bvh, env, sat, &camera, settings, &methods, &reuse, x, y, &mut scratch));
+                    out.push(pixel(scene, bvh, env, sat, &camera, settings, &plans, x, y, &mut scratch));
                 }
             }
             for (c, l) in counters.iter().zip(scratch.stats) {
@@ -140,6 +145,16 @@ struct Hit {
     index: usize,
 }
 
+/// How a material is shaded, resolved once per render.
+struct MaterialPlan {
+    /// The method (`auto` resolved for the material and lighting).
+    method: Method,
+    /// Cosine of the angle within which a product-MIS sampler is reused.
+    reuse_cosine: f32,
+    /// Share of a product-MIS budget spent on product samples.
+    product_share: f64,
+}
+
 /// A tile's scratch memory, reused from pixel to pixel.
 struct Scratch {
     /// For the product samplers built per shading point.
@@ -162,7 +177,7 @@ struct SharedSampler {
 
 /// One pixel: the mean over its shading points (product-MIS samplers shared per pixel and
 /// material, and reused by the tile's next pixels while their shading points stay within
-/// `reuse[material]`; every other sampler built per shading point).
+/// the material's reuse angle; every other sampler built per shading point).
 #[allow(clippy::too_many_arguments)]
 fn pixel(
     scene: &Scene,
@@ -171,8 +186,7 @@ fn pixel(
     sat: Option<&[f64]>,
     camera: &Camera,
     s: &Settings,
-    methods: &[Method],
-    reuse: &[f32],
+    plans: &[MaterialPlan],
     x: usize,
     y: usize,
     scratch: &mut Scratch,
@@ -229,7 +243,7 @@ fn pixel(
                 },
                 origin: hit.point + n * eps,
                 material: hit.material as usize,
-                method: methods[hit.material as usize],
+                method: plans[hit.material as usize].method,
                 index: done + k,
             });
         }
@@ -255,7 +269,7 @@ fn pixel(
                 let technique = match lead.method {
                     Method::ProductMis => {
                         let (normal, mirror) = (lead.frame.n, reflect(lead.wo, lead.frame.n));
-                        let cos = reuse[group];
+                        let cos = plans[group].reuse_cosine;
                         let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
                         let slot = &mut kept[group];
                         if lead.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
@@ -303,6 +317,7 @@ fn pixel(
                         env,
                         &shading_point(scene, h),
                         budget,
+                        plans[h.material].product_share,
                         light_seed,
                         permutation_element(h.index as u32, p as u32, light_seed as u32) as usize,
                         &technique,

@@ -323,17 +323,43 @@ fn mis_with_brdf_many<B: Brdf + ?Sized>(
     out: &mut [[Contribution; 2]],
 ) {
     let n = drawn.len().min(u_brdf.len()).min(out.len()).min(64);
-    let wo = sp.frame.to_local(sp.wo);
-    // The BRDF at the drawn directions.
+    let evaluated = evaluate_drawn(sp, &drawn[..n]);
+    let (brdf, p_other) = brdf_draws(env_h, sp, &u_brdf[..n], pdf_square_many);
+    for k in 0..n {
+        let first = drawn[k].map_or(Contribution::default(), |d| drawn_half(env_h, d, evaluated[k], vis));
+        let second =
+            brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
+        out[k] = [first, second];
+    }
+}
+
+/// BRDF × cos and the BRDF's density at up to 64 drawn directions, four lanes at a time for GGX.
+fn evaluate_drawn<B: Brdf + ?Sized>(
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<(Vec3, Vec2, f32)>],
+) -> [(Vec3, f32); 64] {
+    let n = drawn.len().min(64);
     let mut local = [Vec3::Z; 64];
     for (l, d) in local.iter_mut().zip(&drawn[..n]) {
         *l = d.map_or(Vec3::Z, |(dir, _, _)| sp.frame.to_local(dir));
     }
     let mut evaluated = [(Vec3::ZERO, 0.0); 64];
-    sp.brdf.eval_pdf_many(wo, &local[..n], &mut evaluated[..n]);
-    // The BRDF samples, their points of the square and the other technique's density there.
+    sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[..n], &mut evaluated[..n]);
+    evaluated
+}
+
+/// Up to 64 BRDF samples (world direction, point of the square, the draw) and the other
+/// technique's density per unit square area at each point, by `pdf_square_many`.
+#[allow(clippy::type_complexity)]
+fn brdf_draws<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+) -> ([Option<(Vec3, Vec2, BrdfSample)>; 64], [f32; 64]) {
+    let n = u_brdf.len().min(64);
     let mut samples = [None; 64];
-    sp.brdf.sample_many(wo, &u_brdf[..n], &mut samples[..n]);
+    sp.brdf.sample_many(sp.frame.to_local(sp.wo), &u_brdf[..n], &mut samples[..n]);
     let mut dirs = [Vec3::Z; 64];
     for (d, s) in dirs.iter_mut().zip(&samples[..n]) {
         if let Some(s) = s {
@@ -348,12 +374,47 @@ fn mis_with_brdf_many<B: Brdf + ?Sized>(
     }
     let mut p_other = [0.0f32; 64];
     pdf_square_many(&uvs[..n], &mut p_other[..n]);
-    for k in 0..n {
-        let first = drawn[k].map_or(Contribution::default(), |d| drawn_half(env_h, d, evaluated[k], vis));
-        let second =
-            brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
-        out[k] = [first, second];
+    (brdf, p_other)
+}
+
+/// Product and BRDF sampling in MIS with the budget split unevenly (Veach's multi-sample
+/// balance heuristic): `shares = (c_p, c_b)` are the fractions of the shading point's samples
+/// that each technique draws (c_p + c_b = 1), and every sample, whichever technique drew it,
+/// weighs f·V / (c_p·p_product + c_b·p_brdf). Returns the sum over this batch — up to 64 points
+/// of each technique; call again for more — and the estimate is the sum over all batches
+/// divided by the total sample count. Unbiased for any split: each technique's density covers
+/// what it samples, and together they cover every direction where L·B > 0 (the product through
+/// its defensive part). Where a wide lobe meets extended light, product samples are worth
+/// more than BRDF samples, and a split towards them lowers the error (docs/perf.md); with
+/// shares (½, ½) and as many points of each it is [`product_mis_many`]'s estimate.
+pub fn product_mis_split<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: &[DVec2],
+    u_brdf: &[Vec2],
+    (c_p, c_b): (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let env_h = sampler.env();
+    let (n_p, n_b) = (u_product.len().min(64), u_brdf.len().min(64));
+    let mut sum = DVec3::ZERO;
+    let mut drawn = [None; 64];
+    sampler.sample_many(&u_product[..n_p], &mut drawn[..n_p]);
+    let drawn = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
+    let evaluated = evaluate_drawn(sp, &drawn[..n_p]);
+    for (d, (b, p_brdf)) in drawn[..n_p].iter().zip(evaluated) {
+        if let Some((dir, uv, p)) = *d {
+            sum += weighted(times(env_h.radiance_at(uv), b), c_p * p + c_b * p_brdf, vis, dir);
+        }
     }
+    let (brdf, p_product) = brdf_draws(env_h, sp, &u_brdf[..n_b], |uv, p| sampler.pdf_square_many(uv, p));
+    for (b, p_square) in brdf[..n_b].iter().zip(p_product) {
+        if let Some((dir, uv, s)) = *b {
+            let p = c_b * s.pdf + c_p * (p_square / SPHERE_AREA);
+            sum += weighted(times(env_h.radiance_at(uv), s.value), p, vis, dir);
+        }
+    }
+    sum
 }
 
 /// Resampled importance sampling (Talbot et al. 2005): `candidates.len()` candidates from the

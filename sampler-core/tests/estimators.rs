@@ -212,6 +212,22 @@ fn run(estimator: &str) {
                     })
                     .collect()
             }
+            "product-mis split 3:1" | "product-mis split 1:3" => {
+                // The renderer's product-MIS: the budget split unevenly between the techniques.
+                let (n_p, n_b) = if estimator.ends_with("3:1") { (24, 8) } else { (8, 24) };
+                let shares = (n_p as f32 / 32.0, n_b as f32 / 32.0);
+                let params = ProductParams::for_mis(256);
+                (0..600u64)
+                    .map(|seed| {
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
+                        sobol02(seed ^ 0xdef, 0, &mut pts[..n_p]);
+                        sobol02(seed ^ 0x123, 0, &mut qts[..n_b]);
+                        let q = qts.map(|q| q.as_vec2());
+                        lum(estimator::product_mis_split(&s, &sp, &pts[..n_p], &q[..n_b], shares, &mut vis)) / 32.0
+                    })
+                    .collect()
+            }
             "ris" => {
                 let mut rng = Pcg32::new(23, 4);
                 // Needle lobes at grazing views: ~1 in 15 000 BRDF candidates is both in the lobe
@@ -276,6 +292,13 @@ fn product_mis_estimator_with_probed_leaves_is_unbiased() {
 #[test]
 fn product_mis_estimator_with_the_mis_preset_is_unbiased() {
     run("product-mis for_mis");
+}
+
+/// Product-MIS with three product samples to each BRDF sample, and the other way round.
+#[test]
+fn product_mis_with_uneven_splits_is_unbiased() {
+    run("product-mis split 3:1");
+    run("product-mis split 1:3");
 }
 
 #[test]
