@@ -185,21 +185,26 @@ pub fn product_params(method: Method, brdf_samples: usize) -> ProductParams {
     }
 }
 
-/// Share of a product-MIS budget spent on product samples where a lobe at least
-/// [`WIDE_LOBE`] wide meets extended light (`env_peak` below [`SUN_PEAK`]); elsewhere half.
-/// Measured at 1024 spp against shares ½ and ⅞ (docs/perf.md, session 8): studio α = 0.3 and
-/// α = 0.15, s1's α = 0.3, s2's α = 0.1 and the diffuse surfaces of s1, s2 and studio 1.1–1.6×
-/// lower error at equal samples; under the built-in sky's sun every material, and the α ≤ 0.05
-/// lobes everywhere, lose with it (more BRDF samples lose too).
+/// Share of a product-MIS budget spent on product samples on GGX conductors at least
+/// [`WIDE_LOBE`] wide under extended light (`env_peak` below [`SUN_PEAK`]); elsewhere half.
+/// Measured at 1024 spp against shares ¼, ½ and ⅞ (docs/perf.md, session 8): studio α = 0.3
+/// and α = 0.15, s1's α = 0.3 and s2's α = 0.1 1.2–1.5× lower error at equal samples; under
+/// the built-in sky's sun every material, and the α ≤ 0.05 lobes everywhere, lose with it (and
+/// with fewer product samples). Diffuse surfaces stay at half: s1's, s2's and studio's gained
+/// 1.4–1.6×, but s3's lost 1.2× (1.5× unshadowed) — its sun sits near the horizon, where the
+/// cosine changes fastest across a B̃ leaf.
 pub const WIDE_LOBE_PRODUCT_SHARE: f64 = 0.75;
 
-/// Lobe width (GGX α; see `Bsdf::lobe_width`) from which product-MIS leans on product samples.
+/// GGX α from which product-MIS leans on product samples (see [`WIDE_LOBE_PRODUCT_SHARE`]).
 pub const WIDE_LOBE: f32 = 0.1;
 
 /// The share of a material's product-MIS budget spent on product samples (the rest are BRDF
 /// samples; see [`WIDE_LOBE_PRODUCT_SHARE`]).
 pub fn product_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
-    if env_peak < SUN_PEAK && bsdf.lobe_width() >= WIDE_LOBE { WIDE_LOBE_PRODUCT_SHARE } else { 0.5 }
+    match bsdf {
+        Bsdf::Conductor(c) if env_peak < SUN_PEAK && c.ggx.alpha() >= WIDE_LOBE => WIDE_LOBE_PRODUCT_SHARE,
+        _ => 0.5,
+    }
 }
 
 /// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
@@ -354,11 +359,11 @@ mod tests {
     }
 
     #[test]
-    fn product_mis_leans_on_product_samples_for_wide_lobes_under_extended_light() {
+    fn product_mis_leans_on_product_samples_for_wide_conductors_under_extended_light() {
         let diffuse = Bsdf::Diffuse(Lambert::new(Vec3::ONE));
         assert_eq!(product_share(&conductor(0.3), 67.0), WIDE_LOBE_PRODUCT_SHARE);
         assert_eq!(product_share(&conductor(0.1), 21.0), WIDE_LOBE_PRODUCT_SHARE);
-        assert_eq!(product_share(&diffuse, 21.0), WIDE_LOBE_PRODUCT_SHARE);
+        assert_eq!(product_share(&diffuse, 21.0), 0.5, "diffuse");
         assert_eq!(product_share(&conductor(0.05), 21.0), 0.5, "moderate lobe");
         assert_eq!(product_share(&conductor(0.3), 713.0), 0.5, "sun");
         assert_eq!(product_share(&Bsdf::CarPaint(sampler_core::brdf::CarPaint::default()), 21.0), 0.5, "sharp coat");
