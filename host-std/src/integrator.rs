@@ -73,13 +73,13 @@ impl Method {
     /// * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is
     ///   wide enough to span bright detail of the map and narrow enough that one B̃ per pixel fits
     ///   its shading points. Best other / product-MIS at product-MIS's 1024-spp time (`ppis
-    ///   report --base product-mis --bracket --repeat 2`, session 7): s1 α = 0.05 2.6× (MIS),
-    ///   studio α = 0.05 2.4× (MIS), s2 α = 0.1 1.3× (MIS; 1.8× in session 6, before MIS's BRDF
-    ///   lanes made it 26–31% faster).
+    ///   report --base product-mis --bracket --repeat 2`, session 8): s1 α = 0.05 2.5× (MIS),
+    ///   studio α = 0.05 2.3× (MIS), s2 α = 0.1 1.6× (MIS; product-MIS split 3:1 there, see
+    ///   [`product_share`]).
     /// * Under extended bright regions rather than a sun (`env_peak` below [`SUN_PEAK`]: the
     ///   shared maps and studio, 21–67; the built-in sky 713), wider conductors too, α in
-    ///   [`PRODUCT_ALPHA_EXTENDED`]: product-MIS beats MIS there (studio α = 0.15 2.0–2.3×, α = 0.3
-    ///   1.5–1.8×, s1 α = 0.3 1.2–1.4× at equal time) — B varies across the bright region, which the
+    ///   [`PRODUCT_ALPHA_EXTENDED`]: product-MIS beats MIS there (session 8, split 3:1: studio
+    ///   α = 0.15 2.3×, α = 0.3 1.8×, s1 α = 0.3 1.8× at equal time) — B varies across the bright region, which the
     ///   product follows — while under the default sky's sun, which env sampling finds exactly,
     ///   MIS stays level or ahead at α = 0.15 (product-MIS 0.84–0.99×).
     /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: product-MIS
