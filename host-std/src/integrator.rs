@@ -187,8 +187,8 @@ pub fn product_params(method: Method, brdf_samples: usize) -> ProductParams {
 
 /// Share of a product-MIS budget spent on product samples on GGX conductors at least
 /// [`WIDE_LOBE`] wide under extended light (`env_peak` below [`SUN_PEAK`]); elsewhere half.
-/// Measured at 1024 spp against shares ¼, ½ and ⅞ (docs/perf.md, session 8): studio α = 0.3
-/// and α = 0.15, s1's α = 0.3 and s2's α = 0.1 1.2–1.5× lower error at equal samples; under
+/// Chosen at 1024 spp from shares ¼, ½, ¾ and ⅞ (docs/perf.md, session 8): studio α = 0.3
+/// and α = 0.15, s1's α = 0.3 and s2's α = 0.1 1.2–1.3× lower error at equal samples; under
 /// the built-in sky's sun every material, and the α ≤ 0.05 lobes everywhere, lose with it (and
 /// with fewer product samples). Diffuse surfaces stay at half: s1's, s2's and studio's gained
 /// 1.4–1.6×, but s3's lost 1.2× (1.5× unshadowed) — its sun sits near the horizon, where the
