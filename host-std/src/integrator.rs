@@ -85,7 +85,8 @@ impl Method {
     /// * Everything else: MIS of env and BRDF sampling — sharper lobes (α ≤ 0.02: product-MIS
     ///   0.72–1.12× MIS), car paint (0.69–0.81×), diffuse. Env-only sampling wins on studio's and s2's
     ///   diffuse and on α = 0.3 (studio, s1's forest) but is 3–6× behind MIS under the default
-    ///   sky's sun, so it is not picked.
+    ///   sky's sun, so it is not picked; instead MIS on diffuse surfaces under extended light
+    ///   draws 3 env samples to 1 BRDF sample ([`auto_env_share`]).
     ///
     /// Smooth lighting (`env_peak`, the brightest 6.4° block of the map over the mean, below
     /// [`SMOOTH_LIGHTING_PEAK`]): BRDF sampling for every material — the product is the lobe
@@ -207,27 +208,49 @@ pub fn product_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
     }
 }
 
+/// Share of an MIS budget that `auto` spends on env samples on diffuse surfaces under extended
+/// light (`env_peak` below [`SUN_PEAK`]); elsewhere, and for `--method mis` (Mitsuba's
+/// `direct`, the baseline), half. Measured at 1024 spp against ½ (docs/perf.md, session 8):
+/// diffuse 1.4–1.8× lower error at equal samples on studio, s1 and s2, 1.15× higher on s3
+/// (its sun near the horizon) and under the built-in sun (1.08×, which stays at half); a
+/// cosine-weighted BRDF sample finds the bright regions of such a map less often than an env
+/// sample.
+pub const AUTO_DIFFUSE_ENV_SHARE: f64 = 0.75;
+
+/// The share of an MIS budget `auto` spends on env samples (see [`AUTO_DIFFUSE_ENV_SHARE`]).
+pub fn auto_env_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
+    match bsdf {
+        Bsdf::Diffuse(_) if env_peak < SUN_PEAK => AUTO_DIFFUSE_ENV_SHARE,
+        _ => 0.5,
+    }
+}
+
 /// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
 /// visibility samples of `method` (not `Auto`: resolve it per material first). `technique`
 /// holds the product sampler or two-stage partition for the methods that need one; it may have
 /// been built for another shading point of the same pixel and material (still unbiased: it is
-/// a valid density that is positive wherever L > 0). Product-MIS spends `product_share` of the
-/// budget on product samples and the rest on BRDF samples (at least one of each).
+/// a valid density that is positive wherever L > 0). The MIS methods spend `split` of the
+/// budget on their first technique (product or env samples) and the rest on BRDF samples (at
+/// least one of each); MIS at ½ is Mitsuba's pairs.
 #[allow(clippy::too_many_arguments)]
 pub fn shade<B: Brdf + ?Sized>(
     method: Method,
     env: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
     budget: usize,
-    product_share: f64,
+    split: f64,
     seed: u64,
     block: usize,
     technique: &Technique<'_, '_>,
     vis: &mut impl Visibility,
 ) -> DVec3 {
     let budget = budget.max(1);
-    if let (Method::ProductMis, Technique::Product(p)) = (method, technique) {
-        return shade_product_mis(p, sp, budget, product_share, seed, block, vis);
+    match (method, technique) {
+        (Method::ProductMis, Technique::Product(p)) => {
+            return shade_split(First::Product(p), sp, budget, split, seed, block, vis);
+        }
+        (Method::Mis, _) if split != 0.5 => return shade_split(First::Env(env), sp, budget, split, seed, block, vis),
+        _ => {}
     }
     // MIS spends the budget in pairs, one sample per technique.
     let n = if method == Method::Mis { (budget / 2).max(1) } else { budget };
@@ -285,11 +308,17 @@ pub fn shade<B: Brdf + ?Sized>(
     sum / n as f64
 }
 
-/// Product-MIS at one shading point: ⌊share·budget⌉ product samples and the rest BRDF samples
-/// (at least one of each; a budget of one still takes one of each), each technique's points
-/// this shading point's run of the pixel's (0,2)-sequence for it.
-fn shade_product_mis<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// The technique an MIS split draws beside BRDF sampling.
+enum First<'s, 'e> {
+    Product(&'s ProductSampler<'s, 'e>),
+    Env(&'s EnvHierarchy<'e>),
+}
+
+/// MIS at one shading point with the budget split: ⌊share·budget⌉ samples of `first` and the
+/// rest BRDF samples (at least one of each; a budget of one still takes one of each), each
+/// technique's points this shading point's run of the pixel's (0,2)-sequence for it.
+fn shade_split<B: Brdf + ?Sized>(
+    first: First<'_, '_>,
     sp: &ShadingPoint<'_, B>,
     budget: usize,
     share: f64,
@@ -307,19 +336,22 @@ fn shade_product_mis<B: Brdf + ?Sized>(
     let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
     let mut sum = DVec3::ZERO;
     let (mut done_p, mut done_b) = (0, 0);
-    let mut product_points = [DVec2::ZERO; 64];
+    let mut first_points = [DVec2::ZERO; 64];
     let mut brdf_points = [DVec2::ZERO; 64];
     let mut brdf_points_f32 = [Vec2::ZERO; 64];
     // Batches of up to 64 points of each technique (a power of two keeps each batch a net).
     while done_p < n_p || done_b < n_b {
         let (m_p, m_b) = ((n_p - done_p).min(64), (n_b - done_b).min(64));
-        sobol02(hash_combine(seed, 1), (block * n_p + done_p) as u32, &mut product_points[..m_p]);
+        sobol02(hash_combine(seed, 1), (block * n_p + done_p) as u32, &mut first_points[..m_p]);
         sobol02(hash_combine(seed, 2), (block * n_b + done_b) as u32, &mut brdf_points[..m_b]);
         for (b, o) in brdf_points_f32.iter_mut().zip(&brdf_points[..m_b]) {
             *b = o.as_vec2();
         }
-        let (u_p, u_b) = (&product_points[..m_p], &brdf_points_f32[..m_b]);
-        sum += estimator::product_mis_split(sampler, sp, u_p, u_b, shares, vis);
+        let (u_p, u_b) = (&first_points[..m_p], &brdf_points_f32[..m_b]);
+        sum += match first {
+            First::Product(sampler) => estimator::product_mis_split(sampler, sp, u_p, u_b, shares, vis),
+            First::Env(env) => estimator::mis_split(env, sp, u_p, u_b, shares, vis),
+        };
         (done_p, done_b) = (done_p + m_p, done_b + m_b);
     }
     sum / total
@@ -367,6 +399,14 @@ mod tests {
         assert_eq!(product_share(&conductor(0.05), 21.0), 0.5, "moderate lobe");
         assert_eq!(product_share(&conductor(0.3), 713.0), 0.5, "sun");
         assert_eq!(product_share(&Bsdf::CarPaint(sampler_core::brdf::CarPaint::default()), 21.0), 0.5, "sharp coat");
+    }
+
+    #[test]
+    fn auto_leans_on_env_samples_on_diffuse_surfaces_under_extended_light() {
+        let diffuse = Bsdf::Diffuse(Lambert::new(Vec3::ONE));
+        assert_eq!(auto_env_share(&diffuse, 21.0), AUTO_DIFFUSE_ENV_SHARE);
+        assert_eq!(auto_env_share(&diffuse, 713.0), 0.5, "sun");
+        assert_eq!(auto_env_share(&conductor(0.01), 21.0), 0.5, "sharp lobe");
     }
 
     #[test]

@@ -75,10 +75,14 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     let plans: Vec<MaterialPlan> = scene
         .materials
         .iter()
-        .map(|m| MaterialPlan {
-            method: settings.method.for_material(&m.bsdf, env_peak),
-            reuse_cosine: integrator::reuse_cosine(&m.bsdf),
-            product_share: integrator::product_share(&m.bsdf, env_peak),
+        .map(|m| {
+            let method = settings.method.for_material(&m.bsdf, env_peak);
+            let split = match (settings.method, method) {
+                (_, Method::ProductMis) => integrator::product_share(&m.bsdf, env_peak),
+                (Method::Auto, Method::Mis) => integrator::auto_env_share(&m.bsdf, env_peak),
+                _ => 0.5,
+            };
+            MaterialPlan { method, reuse_cosine: integrator::reuse_cosine(&m.bsdf), split }
         })
         .collect();
     let camera = Camera::new(&scene.camera);
@@ -151,8 +155,8 @@ struct MaterialPlan {
     method: Method,
     /// Cosine of the angle within which a product-MIS sampler is reused.
     reuse_cosine: f32,
-    /// Share of a product-MIS budget spent on product samples.
-    product_share: f64,
+    /// Share of an MIS budget spent on the first technique (product or env samples).
+    split: f64,
 }
 
 /// A tile's scratch memory, reused from pixel to pixel.
@@ -317,7 +321,7 @@ fn pixel(
                         env,
                         &shading_point(scene, h),
                         budget,
-                        plans[h.material].product_share,
+                        plans[h.material].split,
                         light_seed,
                         permutation_element(h.index as u32, p as u32, light_seed as u32) as usize,
                         &technique,

@@ -392,25 +392,63 @@ pub fn product_mis_split<B: Brdf + ?Sized>(
     sp: &ShadingPoint<'_, B>,
     u_product: &[DVec2],
     u_brdf: &[Vec2],
-    (c_p, c_b): (f32, f32),
+    shares: (f32, f32),
     vis: &mut impl Visibility,
 ) -> DVec3 {
-    let env_h = sampler.env();
-    let (n_p, n_b) = (u_product.len().min(64), u_brdf.len().min(64));
-    let mut sum = DVec3::ZERO;
+    let n = u_product.len().min(64);
     let mut drawn = [None; 64];
-    sampler.sample_many(&u_product[..n_p], &mut drawn[..n_p]);
+    sampler.sample_many(&u_product[..n], &mut drawn[..n]);
     let drawn = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
-    let evaluated = evaluate_drawn(sp, &drawn[..n_p]);
-    for (d, (b, p_brdf)) in drawn[..n_p].iter().zip(evaluated) {
+    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
+    split_with_brdf(sampler.env(), sp, &drawn[..n], u_brdf, pdf_square_many, shares, vis)
+}
+
+/// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
+/// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
+/// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
+/// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
+/// than an env sample (docs/perf.md).
+pub fn mis_split<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_env: &[DVec2],
+    u_brdf: &[Vec2],
+    shares: (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let n = u_env.len().min(64);
+    let mut drawn = [None; 64];
+    env_h.sample_many(&u_env[..n], &mut drawn[..n]);
+    let drawn = drawn.map(|s| s.map(|s: EnvSample| (s.dir, s.uv, s.pdf)));
+    let pdf_square_many =
+        |uv: &[Vec2], p: &mut [f32]| p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
+    split_with_brdf(env_h, sp, &drawn[..n], u_brdf, pdf_square_many, shares, vis)
+}
+
+/// The sum over up to 64 directions drawn by one technique (direction, point of the square,
+/// density) and up to 64 BRDF samples of f·V / (c_d·p_drawn + c_b·p_brdf), the other
+/// technique's densities at the BRDF samples' points by `pdf_square_many`.
+fn split_with_brdf<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<(Vec3, Vec2, f32)>],
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+    (c_d, c_b): (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let (n_d, n_b) = (drawn.len().min(64), u_brdf.len().min(64));
+    let mut sum = DVec3::ZERO;
+    let evaluated = evaluate_drawn(sp, &drawn[..n_d]);
+    for (d, (b, p_brdf)) in drawn[..n_d].iter().zip(evaluated) {
         if let Some((dir, uv, p)) = *d {
-            sum += weighted(times(env_h.radiance_at(uv), b), c_p * p + c_b * p_brdf, vis, dir);
+            sum += weighted(times(env_h.radiance_at(uv), b), c_d * p + c_b * p_brdf, vis, dir);
         }
     }
-    let (brdf, p_product) = brdf_draws(env_h, sp, &u_brdf[..n_b], |uv, p| sampler.pdf_square_many(uv, p));
-    for (b, p_square) in brdf[..n_b].iter().zip(p_product) {
+    let (brdf, p_drawn) = brdf_draws(env_h, sp, &u_brdf[..n_b], pdf_square_many);
+    for (b, p_square) in brdf[..n_b].iter().zip(p_drawn) {
         if let Some((dir, uv, s)) = *b {
-            let p = c_b * s.pdf + c_p * (p_square / SPHERE_AREA);
+            let p = c_b * s.pdf + c_d * (p_square / SPHERE_AREA);
             sum += weighted(times(env_h.radiance_at(uv), s.value), p, vis, dir);
         }
     }

@@ -1,6 +1,6 @@
 //! The batched MIS estimators the renderer uses give, pair by pair, bit for bit what the
-//! one-pair estimators give for the same drawn directions and BRDF points; product-MIS split
-//! half and half sums to the pairs' estimate.
+//! one-pair estimators give for the same drawn directions and BRDF points; both MIS estimators
+//! split half and half sum to the pairs' estimate.
 
 mod common;
 
@@ -50,6 +50,7 @@ fn batched_mis_is_pair_by_pair_mis() {
                 assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "mis, brdf {i}, pair {k}");
                 compared += usize::from(out[k][0].value.max_element() > 0.0 && out[k][1].value.max_element() > 0.0);
             }
+            assert_split_is_pairs(&out, estimator::mis_split(&e, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
             // Product and BRDF.
             let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
             let mut drawn = [None; 61];
@@ -59,13 +60,16 @@ fn batched_mis_is_pair_by_pair_mis() {
                 let one = estimator::product_mis_drawn(&s, &sp, drawn[k], brdf_points[k], &mut vis);
                 assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "product-mis, brdf {i}, pair {k}");
             }
-            // Split half and half, the same estimate as the pairs (×2: the pairs' sum is over
-            // 61 pairs, the split's over 122 samples), up to the order of the sums.
-            let pairs: glam::DVec3 = out.iter().map(|[a, b]| a.value + b.value).sum();
-            let split = estimator::product_mis_split(&s, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis);
-            let tol = 1e-12 * pairs.abs().max_element().max(1e-300);
-            assert!((split - 2.0 * pairs).abs().max_element() <= tol, "split {split} vs pairs {pairs}, brdf {i}");
+            assert_split_is_pairs(&out, estimator::product_mis_split(&s, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
         }
     }
     assert!(compared > 100, "only {compared} pairs with both halves lit");
+}
+
+/// A split half and half is the pairs' estimate (×2: the pairs' sum is over n pairs, the
+/// split's over 2n samples), up to the order of the sums.
+fn assert_split_is_pairs(pairs: &[[Contribution; 2]], split: glam::DVec3) {
+    let pairs: glam::DVec3 = pairs.iter().map(|[a, b]| a.value + b.value).sum();
+    let tol = 1e-12 * pairs.abs().max_element().max(1e-300);
+    assert!((split - 2.0 * pairs).abs().max_element() <= tol, "split {split} vs pairs {pairs}");
 }

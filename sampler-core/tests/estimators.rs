@@ -228,6 +228,14 @@ fn run(estimator: &str) {
                     })
                     .collect()
             }
+            "mis split 3:1" => (0..20_000)
+                .map(|_| {
+                    // Env-heavy MIS, as `auto` runs it on diffuse surfaces under extended light.
+                    let pts: Vec<DVec2> = (0..12).map(|_| u()).collect();
+                    let brdf_pts: Vec<Vec2> = (0..4).map(|_| u().as_vec2()).collect();
+                    lum(estimator::mis_split(&e, &sp, &pts, &brdf_pts, (0.75, 0.25), &mut vis)) / 16.0
+                })
+                .collect(),
             "ris" => {
                 let mut rng = Pcg32::new(23, 4);
                 // Needle lobes at grazing views: ~1 in 15 000 BRDF candidates is both in the lobe
@@ -292,6 +300,12 @@ fn product_mis_estimator_with_probed_leaves_is_unbiased() {
 #[test]
 fn product_mis_estimator_with_the_mis_preset_is_unbiased() {
     run("product-mis for_mis");
+}
+
+/// MIS with three env samples to each BRDF sample.
+#[test]
+fn mis_with_an_uneven_split_is_unbiased() {
+    run("mis split 3:1");
 }
 
 /// Product-MIS with three product samples to each BRDF sample, and the other way round.

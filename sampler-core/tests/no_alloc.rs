@@ -104,6 +104,7 @@ fn ten_thousand_shading_points_allocate_nothing() {
         estimator::product_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
         sink += estimator::product_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
+        sink += estimator::mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
         let mut drawn = [None; 4];
         env.sample_many(&points, &mut drawn);
         estimator::mis_many(&env, &sp, &drawn, &brdf_points, &mut vis, &mut pairs);

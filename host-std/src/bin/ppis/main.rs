@@ -423,7 +423,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
         ),
     }
     println!(
-        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {} of its samples from the product on GGX conductors with α ≥ {} when the map's peak is under {}, half elsewhere); auto = product-mis on GGX conductors with α in {:?} ({:?} when the map's peak is under {}: no sun), mis on the other materials, or BRDF sampling when the lighting is smooth (peak < {})",
+        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {} of its samples from the product on GGX conductors with α ≥ {} when the map's peak is under {}, half elsewhere); auto = product-mis on GGX conductors with α in {:?} ({:?} when the map's peak is under {}: no sun), mis on the other materials ({} of it env samples on diffuse surfaces when the peak is under {}), or BRDF sampling when the lighting is smooth (peak < {})",
         Bvh::build(&scene).primitive_count(),
         if scene.env.is_some() { ", the env hierarchy" } else { "" },
         host_std::integrator::WIDE_LOBE_PRODUCT_SHARE,
@@ -431,6 +431,8 @@ fn info_command(args: InfoArgs) -> Result<()> {
         host_std::integrator::SUN_PEAK,
         host_std::integrator::PRODUCT_ALPHA,
         host_std::integrator::PRODUCT_ALPHA_EXTENDED,
+        host_std::integrator::SUN_PEAK,
+        host_std::integrator::AUTO_DIFFUSE_ENV_SHARE,
         host_std::integrator::SUN_PEAK,
         host_std::integrator::SMOOTH_LIGHTING_PEAK
     );
