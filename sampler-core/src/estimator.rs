@@ -303,8 +303,7 @@ pub fn mis_many<B: Brdf + ?Sized>(
     for (d, s) in directions.iter_mut().zip(&drawn[..n]) {
         *d = s.map(|s| (s.dir, s.uv, s.pdf));
     }
-    let pdf_square_many =
-        |uv: &[Vec2], p: &mut [f32]| p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
+    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
     mis_with_brdf_many(env_h, sp, &directions[..n], &u_brdf[..n], pdf_square_many, vis, out);
 }
 
@@ -420,9 +419,13 @@ pub fn mis_split<B: Brdf + ?Sized>(
     let mut drawn = [None; 64];
     env_h.sample_many(&u_env[..n], &mut drawn[..n]);
     let drawn = drawn.map(|s| s.map(|s: EnvSample| (s.dir, s.uv, s.pdf)));
-    let pdf_square_many =
-        |uv: &[Vec2], p: &mut [f32]| p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
+    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
     split_with_brdf(env_h, sp, &drawn[..n], u_brdf, pdf_square_many, shares, vis)
+}
+
+/// The environment's density per unit square area at each point of `uv` (into `p`).
+fn env_pdf_squares(env_h: &EnvHierarchy<'_>, uv: &[Vec2], p: &mut [f32]) {
+    p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
 }
 
 /// The sum over up to 64 directions drawn by one technique (direction, point of the square,
