@@ -5,7 +5,7 @@
 use crate::scene::Bsdf;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
-use sampler_core::estimator::{self, Contribution, ShadingPoint, Visibility};
+use sampler_core::estimator::{self, BATCH, Contribution, ShadingPoint, Visibility};
 use sampler_core::glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
@@ -257,16 +257,16 @@ pub fn shade<B: Brdf + ?Sized>(
     // This shading point's run of the pixel's sequence: the pixel's shading points together
     // draw one (0,2)-net per technique, stratified over the whole pixel, not per point.
     let first = (block * n) as u32;
-    let mut points = [DVec2::ZERO; 64];
-    let mut others = [DVec2::ZERO; 64];
-    let mut drawn = [None; 64];
-    let mut product_drawn = [None; 64];
-    let mut pairs_out = [[Contribution::default(); 2]; 64];
+    let mut points = [DVec2::ZERO; BATCH];
+    let mut others = [DVec2::ZERO; BATCH];
+    let mut drawn = [None; BATCH];
+    let mut product_drawn = [None; BATCH];
+    let mut pairs_out = [[Contribution::default(); 2]; BATCH];
     let mut sum = DVec3::ZERO;
-    // Points in batches of 64 (a power of two keeps each batch a (0,2)-net).
+    // Points in batches (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
     while done < n {
-        let m = (n - done).min(64);
+        let m = (n - done).min(BATCH);
         sobol02(hash_combine(seed, 1), first + done as u32, &mut points[..m]);
         // The second technique's points, for MIS only.
         if method == Method::Mis {
@@ -276,7 +276,7 @@ pub fn shade<B: Brdf + ?Sized>(
         if matches!(method, Method::Mis | Method::Env) {
             env.sample_many(&points[..m], &mut drawn[..m]);
         }
-        let mut brdf_points = [Vec2::ZERO; 64];
+        let mut brdf_points = [Vec2::ZERO; BATCH];
         for (b, o) in brdf_points.iter_mut().zip(&others[..m]) {
             *b = o.as_vec2();
         }
@@ -336,12 +336,12 @@ fn shade_split<B: Brdf + ?Sized>(
     let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
     let mut sum = DVec3::ZERO;
     let (mut done_p, mut done_b) = (0, 0);
-    let mut first_points = [DVec2::ZERO; 64];
-    let mut brdf_points = [DVec2::ZERO; 64];
-    let mut brdf_points_f32 = [Vec2::ZERO; 64];
-    // Batches of up to 64 points of each technique (a power of two keeps each batch a net).
+    let mut first_points = [DVec2::ZERO; BATCH];
+    let mut brdf_points = [DVec2::ZERO; BATCH];
+    let mut brdf_points_f32 = [Vec2::ZERO; BATCH];
+    // Batches of each technique's points (a power of two keeps each batch a net).
     while done_p < n_p || done_b < n_b {
-        let (m_p, m_b) = ((n_p - done_p).min(64), (n_b - done_b).min(64));
+        let (m_p, m_b) = ((n_p - done_p).min(BATCH), (n_b - done_b).min(BATCH));
         sobol02(hash_combine(seed, 1), (block * n_p + done_p) as u32, &mut first_points[..m_p]);
         sobol02(hash_combine(seed, 2), (block * n_b + done_b) as u32, &mut brdf_points[..m_b]);
         for (b, o) in brdf_points_f32.iter_mut().zip(&brdf_points[..m_b]) {

@@ -1,5 +1,5 @@
 //! Per-sample cost of product-MIS against MIS at one shared sampler, as the renderer uses them
-//! (one sampler per pixel, hundreds of pairs through it, 64 pairs per batched call), without rays.
+//! (one sampler per pixel, hundreds of pairs through it, 16 pairs per batched call), without rays.
 //! `cargo run --release -p sampler-core --example sample_cost -- [alpha] [level]`; `PARAMS=default`
 //! (the paper's build), `noprobe` or `norefine` change the product-MIS preset's build.
 
@@ -82,7 +82,7 @@ fn main() {
                 acc += a.value + b.value;
             }
             t_pm += t.elapsed().as_secs_f64();
-            // The renderer's paths: 64 pairs at a time.
+            // The renderer's paths: a batch at a time.
             let t = Instant::now();
             for (u, b) in us.chunks(64).zip(brdf_points.chunks(64)) {
                 product_mis_many(&s, &sp, u, b, &mut vis, &mut out);

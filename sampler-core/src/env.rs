@@ -346,9 +346,9 @@ impl<'a> EnvHierarchy<'a> {
     /// [`square_of`](Self::square_of) for every direction of `dirs` (as many as both hold), four
     /// lanes at a time, bit for bit.
     pub fn squares_of(&self, dirs: &[Vec3], out: &mut [Vec2]) {
-        for (ds, os) in dirs.chunks(64).zip(out.chunks_mut(64)) {
+        for (ds, os) in dirs.chunks(16).zip(out.chunks_mut(16)) {
             let n = ds.len().min(os.len());
-            let mut local = [Vec3::ZERO; 64];
+            let mut local = [Vec3::ZERO; 16];
             for (l, d) in local.iter_mut().zip(ds) {
                 *l = self.to_map(*d);
             }

@@ -11,6 +11,9 @@ use crate::sampler::{DirectionSample, ProductSampler};
 use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
+mod batched;
+pub use batched::{BATCH, mis_many, mis_split, product_mis_many, product_mis_split};
+
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {
     fn visible(&mut self, dir: Vec3) -> bool;
@@ -71,7 +74,7 @@ pub struct Contribution {
 
 /// L·B in f64.
 #[inline]
-fn times(l: Vec3, b: Vec3) -> DVec3 {
+pub(crate) fn times(l: Vec3, b: Vec3) -> DVec3 {
     l.as_dvec3() * b.as_dvec3()
 }
 
@@ -83,7 +86,7 @@ pub fn luminance64(c: DVec3) -> f64 {
 }
 
 #[inline]
-fn weighted(f: DVec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> DVec3 {
+pub(crate) fn weighted(f: DVec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3) -> DVec3 {
     if pdf > 0.0 && f.cmpgt(DVec3::ZERO).any() && vis.visible(dir) { f / pdf as f64 } else { DVec3::ZERO }
 }
 
@@ -235,7 +238,7 @@ fn mis_drawn_half<B: Brdf + ?Sized>(
 
 /// [`mis_drawn_half`] with the BRDF × cos and the BRDF's density at the direction evaluated.
 #[inline]
-fn drawn_half(
+pub(crate) fn drawn_half(
     env_h: &EnvHierarchy<'_>,
     (dir, uv, p): (Vec3, Vec2, f32),
     (b, p_brdf): (Vec3, f32),
@@ -248,7 +251,7 @@ fn drawn_half(
 /// The balance-heuristic share of a BRDF sample (world direction, its point of the square, the
 /// draw), where the other technique's density is `p_other`.
 #[inline]
-fn mis_brdf_half(
+pub(crate) fn mis_brdf_half(
     env_h: &EnvHierarchy<'_>,
     (dir, uv, s): (Vec3, Vec2, BrdfSample),
     p_other: f32,
@@ -256,206 +259,6 @@ fn mis_brdf_half(
 ) -> Contribution {
     let f = times(env_h.radiance_at(uv), s.value);
     Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other }
-}
-
-/// [`product_mis`] for up to 64 pairs at once (`out[k]` from `u_product[k]` and `u_brdf[k]`):
-/// the product samples drawn by [`ProductSampler::sample_many`] and the product's density at
-/// the BRDF samples by [`ProductSampler::pdf_square_many`], four tree descents side by side
-/// (the same values as one pair at a time, up to the last bits of a product sample's point).
-pub fn product_mis_many<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    u_product: &[DVec2],
-    u_brdf: &[Vec2],
-    vis: &mut impl Visibility,
-    out: &mut [[Contribution; 2]],
-) {
-    let n = u_product.len().min(u_brdf.len()).min(out.len()).min(64);
-    let mut drawn = [None; 64];
-    sampler.sample_many(&u_product[..n], &mut drawn[..n]);
-    let mut directions = [None; 64];
-    for (d, s) in directions.iter_mut().zip(&drawn[..n]) {
-        *d = s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf));
-    }
-    mis_with_brdf_many(
-        sampler.env(),
-        sp,
-        &directions[..n],
-        &u_brdf[..n],
-        |uv, p| sampler.pdf_square_many(uv, p),
-        vis,
-        out,
-    );
-}
-
-/// [`mis_drawn`] for up to 64 pairs at once (`out[k]` from `drawn[k]` and `u_brdf[k]`), e.g.
-/// with the env samples of [`EnvHierarchy::sample_many`]: the same values as one pair at a time.
-pub fn mis_many<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<EnvSample>],
-    u_brdf: &[Vec2],
-    vis: &mut impl Visibility,
-    out: &mut [[Contribution; 2]],
-) {
-    let n = drawn.len().min(u_brdf.len()).min(out.len()).min(64);
-    let mut directions = [None; 64];
-    for (d, s) in directions.iter_mut().zip(&drawn[..n]) {
-        *d = s.map(|s| (s.dir, s.uv, s.pdf));
-    }
-    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
-    mis_with_brdf_many(env_h, sp, &directions[..n], &u_brdf[..n], pdf_square_many, vis, out);
-}
-
-/// Balance-heuristic MIS of up to 64 directions drawn by one technique (direction, point of the
-/// square, density) and as many BRDF samples, the BRDF's draws and evaluations batched
-/// ([`Brdf::sample_many`], [`Brdf::eval_pdf_many`]: four lanes for GGX) and the other
-/// technique's densities at the BRDF samples' points by `pdf_square_many` — bit for bit the
-/// values of [`mis_with_brdf`] pair by pair.
-fn mis_with_brdf_many<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<(Vec3, Vec2, f32)>],
-    u_brdf: &[Vec2],
-    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
-    vis: &mut impl Visibility,
-    out: &mut [[Contribution; 2]],
-) {
-    let n = drawn.len().min(u_brdf.len()).min(out.len()).min(64);
-    let evaluated = evaluate_drawn(sp, &drawn[..n]);
-    let (brdf, p_other) = brdf_draws(env_h, sp, &u_brdf[..n], pdf_square_many);
-    for k in 0..n {
-        let first = drawn[k].map_or(Contribution::default(), |d| drawn_half(env_h, d, evaluated[k], vis));
-        let second =
-            brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
-        out[k] = [first, second];
-    }
-}
-
-/// BRDF × cos and the BRDF's density at up to 64 drawn directions, four lanes at a time for GGX.
-fn evaluate_drawn<B: Brdf + ?Sized>(
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<(Vec3, Vec2, f32)>],
-) -> [(Vec3, f32); 64] {
-    let n = drawn.len().min(64);
-    let mut local = [Vec3::Z; 64];
-    for (l, d) in local.iter_mut().zip(&drawn[..n]) {
-        *l = d.map_or(Vec3::Z, |(dir, _, _)| sp.frame.to_local(dir));
-    }
-    let mut evaluated = [(Vec3::ZERO, 0.0); 64];
-    sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[..n], &mut evaluated[..n]);
-    evaluated
-}
-
-/// Up to 64 BRDF samples (world direction, point of the square, the draw) and the other
-/// technique's density per unit square area at each point, by `pdf_square_many`.
-#[allow(clippy::type_complexity)]
-fn brdf_draws<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    u_brdf: &[Vec2],
-    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
-) -> ([Option<(Vec3, Vec2, BrdfSample)>; 64], [f32; 64]) {
-    let n = u_brdf.len().min(64);
-    let mut samples = [None; 64];
-    sp.brdf.sample_many(sp.frame.to_local(sp.wo), &u_brdf[..n], &mut samples[..n]);
-    let mut dirs = [Vec3::Z; 64];
-    for (d, s) in dirs.iter_mut().zip(&samples[..n]) {
-        if let Some(s) = s {
-            *d = sp.frame.to_world(s.wi);
-        }
-    }
-    let mut uvs = [Vec2::ZERO; 64];
-    env_h.squares_of(&dirs[..n], &mut uvs[..n]);
-    let mut brdf = [None; 64];
-    for k in 0..n {
-        brdf[k] = samples[k].map(|s| (dirs[k], uvs[k], s));
-    }
-    let mut p_other = [0.0f32; 64];
-    pdf_square_many(&uvs[..n], &mut p_other[..n]);
-    (brdf, p_other)
-}
-
-/// Product and BRDF sampling in MIS with the budget split unevenly (Veach's multi-sample
-/// balance heuristic): `shares = (c_p, c_b)` are the fractions of the shading point's samples
-/// that each technique draws (c_p + c_b = 1), and every sample, whichever technique drew it,
-/// weighs f·V / (c_p·p_product + c_b·p_brdf). Returns the sum over this batch — up to 64 points
-/// of each technique; call again for more — and the estimate is the sum over all batches
-/// divided by the total sample count. Unbiased for any split: each technique's density covers
-/// what it samples, and together they cover every direction where L·B > 0 (the product through
-/// its defensive part). Where a wide lobe meets extended light, product samples are worth
-/// more than BRDF samples, and a split towards them lowers the error (docs/perf.md); with
-/// shares (½, ½) and as many points of each it is [`product_mis_many`]'s estimate.
-pub fn product_mis_split<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    u_product: &[DVec2],
-    u_brdf: &[Vec2],
-    shares: (f32, f32),
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    let n = u_product.len().min(64);
-    let mut drawn = [None; 64];
-    sampler.sample_many(&u_product[..n], &mut drawn[..n]);
-    let drawn = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
-    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
-    split_with_brdf(sampler.env(), sp, &drawn[..n], u_brdf, pdf_square_many, shares, vis)
-}
-
-/// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
-/// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
-/// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
-/// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
-/// than an env sample (docs/perf.md).
-pub fn mis_split<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    u_env: &[DVec2],
-    u_brdf: &[Vec2],
-    shares: (f32, f32),
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    let n = u_env.len().min(64);
-    let mut drawn = [None; 64];
-    env_h.sample_many(&u_env[..n], &mut drawn[..n]);
-    let drawn = drawn.map(|s| s.map(|s: EnvSample| (s.dir, s.uv, s.pdf)));
-    let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
-    split_with_brdf(env_h, sp, &drawn[..n], u_brdf, pdf_square_many, shares, vis)
-}
-
-/// The environment's density per unit square area at each point of `uv` (into `p`).
-fn env_pdf_squares(env_h: &EnvHierarchy<'_>, uv: &[Vec2], p: &mut [f32]) {
-    p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
-}
-
-/// The sum over up to 64 directions drawn by one technique (direction, point of the square,
-/// density) and up to 64 BRDF samples of f·V / (c_d·p_drawn + c_b·p_brdf), the other
-/// technique's densities at the BRDF samples' points by `pdf_square_many`.
-fn split_with_brdf<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<(Vec3, Vec2, f32)>],
-    u_brdf: &[Vec2],
-    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
-    (c_d, c_b): (f32, f32),
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    let (n_d, n_b) = (drawn.len().min(64), u_brdf.len().min(64));
-    let mut sum = DVec3::ZERO;
-    let evaluated = evaluate_drawn(sp, &drawn[..n_d]);
-    for (d, (b, p_brdf)) in drawn[..n_d].iter().zip(evaluated) {
-        if let Some((dir, uv, p)) = *d {
-            sum += weighted(times(env_h.radiance_at(uv), b), c_d * p + c_b * p_brdf, vis, dir);
-        }
-    }
-    let (brdf, p_drawn) = brdf_draws(env_h, sp, &u_brdf[..n_b], pdf_square_many);
-    for (b, p_square) in brdf[..n_b].iter().zip(p_drawn) {
-        if let Some((dir, uv, s)) = *b {
-            let p = c_b * s.pdf + c_d * (p_square / SPHERE_AREA);
-            sum += weighted(times(env_h.radiance_at(uv), s.value), p, vis, dir);
-        }
-    }
-    sum
 }
 
 /// Resampled importance sampling (Talbot et al. 2005): `candidates.len()` candidates from the

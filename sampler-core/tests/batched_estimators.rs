@@ -1,6 +1,8 @@
 //! The batched MIS estimators the renderer uses give, pair by pair, bit for bit what the
 //! one-pair estimators give for the same drawn directions and BRDF points; both MIS estimators
-//! split half and half sum to the pairs' estimate.
+//! split half and half sum to the pairs' estimate — for more pairs than one batch holds (101:
+//! six batches of `estimator::BATCH`, the last one partial, and more than the 64 an older
+//! version took at most).
 
 mod common;
 
@@ -36,13 +38,13 @@ fn batched_mis_is_pair_by_pair_mis() {
             let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
             // Visibility that blocks part of the sphere, the same for both paths.
             let mut vis = |d: Vec3| d.x + 0.3 * d.y < 0.5;
-            let (mut u, mut v) = ([DVec2::ZERO; 61], [DVec2::ZERO; 61]);
+            let (mut u, mut v) = ([DVec2::ZERO; 101], [DVec2::ZERO; 101]);
             sobol02((i * 7 + j) as u64, 0, &mut u);
             sobol02((i * 7 + j) as u64 + 99, 0, &mut v);
             let brdf_points: Vec<Vec2> = v.iter().map(|p| p.as_vec2()).collect();
-            let mut out = [[Contribution::default(); 2]; 61];
+            let mut out = [[Contribution::default(); 2]; 101];
             // Env and BRDF.
-            let mut drawn = [None; 61];
+            let mut drawn = [None; 101];
             e.sample_many(&u, &mut drawn);
             estimator::mis_many(&e, &sp, &drawn, &brdf_points, &mut vis, &mut out);
             for k in 0..u.len() {
@@ -53,7 +55,7 @@ fn batched_mis_is_pair_by_pair_mis() {
             assert_split_is_pairs(&out, estimator::mis_split(&e, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
             // Product and BRDF.
             let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
-            let mut drawn = [None; 61];
+            let mut drawn = [None; 101];
             s.sample_many(&u, &mut drawn);
             estimator::product_mis_many(&s, &sp, &u, &brdf_points, &mut vis, &mut out);
             for k in 0..u.len() {

@@ -1,0 +1,239 @@
+//! The MIS estimators for many samples at once: each technique's draws, evaluations and
+//! densities in batches of [`BATCH`] (four lanes at a time where the core has lanes), so that
+//! the descents and BRDF evaluations of a batch overlap. Any number of samples per call; the
+//! scratch of one batch lives on the stack and is a few kilobytes, so a call for a handful of
+//! samples (a shading point with a small budget) costs little more than the samples.
+
+use super::{Contribution, ShadingPoint, Visibility, drawn_half, mis_brdf_half, times, weighted};
+use crate::brdf::{Brdf, BrdfSample};
+use crate::env::{EnvHierarchy, EnvSample};
+use crate::mapping::SPHERE_AREA;
+use crate::sampler::{DirectionSample, ProductSampler};
+use glam::{DVec2, DVec3, Vec2, Vec3};
+
+/// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
+/// samples spends 8 pairs; larger batches only zeroed more scratch per call — measured, 6 kB
+/// of contributions per call were a tenth of a 4-sample shading point's time).
+pub const BATCH: usize = 16;
+
+/// A drawn direction: world direction, its point of the square, density (solid angle).
+type Drawn = Option<(Vec3, Vec2, f32)>;
+
+/// [`product_mis`](super::product_mis) for every pair (`out[k]` from `u_product[k]` and
+/// `u_brdf[k]`, as many as all three hold): the product samples drawn by
+/// [`ProductSampler::sample_many`] and the product's density at the BRDF samples by
+/// [`ProductSampler::pdf_square_many`], four tree descents side by side (the same values as one
+/// pair at a time, up to the last bits of a product sample's point).
+pub fn product_mis_many<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: &[DVec2],
+    u_brdf: &[Vec2],
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = u_product.len().min(u_brdf.len()).min(out.len());
+    for start in (0..n).step_by(BATCH) {
+        let end = (start + BATCH).min(n);
+        let m = end - start;
+        let mut drawn = [None; BATCH];
+        sampler.sample_many(&u_product[start..end], &mut drawn[..m]);
+        let directions = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
+        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
+        let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
+        mis_with_brdf_batch(sampler.env(), sp, &directions[..m], u_b, pdf_square_many, vis, o);
+    }
+}
+
+/// [`mis_drawn`](super::mis_drawn) for every pair (`out[k]` from `drawn[k]` and `u_brdf[k]`),
+/// e.g. with the env samples of [`EnvHierarchy::sample_many`]: the same values as one pair at
+/// a time.
+pub fn mis_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<EnvSample>],
+    u_brdf: &[Vec2],
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = drawn.len().min(u_brdf.len()).min(out.len());
+    for start in (0..n).step_by(BATCH) {
+        let end = (start + BATCH).min(n);
+        let mut directions = [None; BATCH];
+        for (d, s) in directions.iter_mut().zip(&drawn[start..end]) {
+            *d = s.map(|s| (s.dir, s.uv, s.pdf));
+        }
+        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
+        let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
+        mis_with_brdf_batch(env_h, sp, &directions[..end - start], u_b, pdf_square_many, vis, o);
+    }
+}
+
+/// Balance-heuristic MIS of up to [`BATCH`] directions drawn by one technique and as many BRDF
+/// samples, the BRDF's draws and evaluations batched ([`Brdf::sample_many`],
+/// [`Brdf::eval_pdf_many`]: four lanes for GGX) and the other technique's densities at the
+/// BRDF samples' points by `pdf_square_many` — bit for bit the values of
+/// [`mis_with_brdf`](super::mis_with_brdf) pair by pair.
+fn mis_with_brdf_batch<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Drawn],
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+    vis: &mut impl Visibility,
+    out: &mut [[Contribution; 2]],
+) {
+    let n = drawn.len().min(u_brdf.len()).min(out.len()).min(BATCH);
+    let evaluated = evaluate_drawn(sp, &drawn[..n]);
+    let (brdf, p_other) = brdf_draws(env_h, sp, &u_brdf[..n], pdf_square_many);
+    for k in 0..n {
+        let first = drawn[k].map_or(Contribution::default(), |d| drawn_half(env_h, d, evaluated[k], vis));
+        let second =
+            brdf[k].map_or(Contribution::default(), |b| mis_brdf_half(env_h, b, p_other[k] / SPHERE_AREA, vis));
+        out[k] = [first, second];
+    }
+}
+
+/// BRDF × cos and the BRDF's density at up to [`BATCH`] drawn directions, four lanes at a time
+/// for GGX.
+fn evaluate_drawn<B: Brdf + ?Sized>(sp: &ShadingPoint<'_, B>, drawn: &[Drawn]) -> [(Vec3, f32); BATCH] {
+    let n = drawn.len().min(BATCH);
+    let mut local = [Vec3::Z; BATCH];
+    for (l, d) in local.iter_mut().zip(&drawn[..n]) {
+        *l = d.map_or(Vec3::Z, |(dir, _, _)| sp.frame.to_local(dir));
+    }
+    let mut evaluated = [(Vec3::ZERO, 0.0); BATCH];
+    sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[..n], &mut evaluated[..n]);
+    evaluated
+}
+
+/// Up to [`BATCH`] BRDF samples (world direction, point of the square, the draw) and the other
+/// technique's density per unit square area at each point, by `pdf_square_many`.
+#[allow(clippy::type_complexity)]
+fn brdf_draws<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+) -> ([Option<(Vec3, Vec2, BrdfSample)>; BATCH], [f32; BATCH]) {
+    let n = u_brdf.len().min(BATCH);
+    let mut samples = [None; BATCH];
+    sp.brdf.sample_many(sp.frame.to_local(sp.wo), &u_brdf[..n], &mut samples[..n]);
+    let mut dirs = [Vec3::Z; BATCH];
+    for (d, s) in dirs.iter_mut().zip(&samples[..n]) {
+        if let Some(s) = s {
+            *d = sp.frame.to_world(s.wi);
+        }
+    }
+    let mut uvs = [Vec2::ZERO; BATCH];
+    env_h.squares_of(&dirs[..n], &mut uvs[..n]);
+    let mut brdf = [None; BATCH];
+    for k in 0..n {
+        brdf[k] = samples[k].map(|s| (dirs[k], uvs[k], s));
+    }
+    let mut p_other = [0.0f32; BATCH];
+    pdf_square_many(&uvs[..n], &mut p_other[..n]);
+    (brdf, p_other)
+}
+
+/// Product and BRDF sampling in MIS with the budget split unevenly (Veach's multi-sample
+/// balance heuristic): `shares = (c_p, c_b)` are the fractions of the shading point's samples
+/// that each technique draws (c_p + c_b = 1), and every sample, whichever technique drew it,
+/// weighs f·V / (c_p·p_product + c_b·p_brdf). Returns the sum over these points — any number
+/// of each technique; the estimate is the sum over all of a shading point's points divided by
+/// their count. Unbiased for any split: each technique's density covers what it samples, and
+/// together they cover every direction where L·B > 0 (the product through its defensive part).
+/// Where a wide lobe meets extended light, product samples are worth more than BRDF samples,
+/// and a split towards them lowers the error (docs/perf.md); with shares (½, ½) and as many
+/// points of each it is [`product_mis_many`]'s estimate.
+pub fn product_mis_split<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: &[DVec2],
+    u_brdf: &[Vec2],
+    shares: (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    for u in u_product.chunks(BATCH) {
+        let mut drawn = [None; BATCH];
+        sampler.sample_many(u, &mut drawn[..u.len()]);
+        let drawn = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
+        add_drawn(sampler.env(), sp, &drawn[..u.len()], shares, vis, &mut sum);
+    }
+    for u in u_brdf.chunks(BATCH) {
+        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
+        add_brdf(sampler.env(), sp, u, pdf_square_many, shares, vis, &mut sum);
+    }
+    sum
+}
+
+/// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
+/// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
+/// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
+/// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
+/// than an env sample (docs/perf.md).
+pub fn mis_split<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_env: &[DVec2],
+    u_brdf: &[Vec2],
+    shares: (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    for u in u_env.chunks(BATCH) {
+        let mut drawn = [None; BATCH];
+        env_h.sample_many(u, &mut drawn[..u.len()]);
+        let drawn = drawn.map(|s| s.map(|s: EnvSample| (s.dir, s.uv, s.pdf)));
+        add_drawn(env_h, sp, &drawn[..u.len()], shares, vis, &mut sum);
+    }
+    for u in u_brdf.chunks(BATCH) {
+        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
+        add_brdf(env_h, sp, u, pdf_square_many, shares, vis, &mut sum);
+    }
+    sum
+}
+
+/// The environment's density per unit square area at each point of `uv` (into `p`).
+fn env_pdf_squares(env_h: &EnvHierarchy<'_>, uv: &[Vec2], p: &mut [f32]) {
+    p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
+}
+
+/// Adds f·V / (c_d·p_drawn + c_b·p_brdf) of up to [`BATCH`] directions drawn by the first
+/// technique to `sum`, one by one (the same order and rounding however the points are batched).
+fn add_drawn<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Drawn],
+    (c_d, c_b): (f32, f32),
+    vis: &mut impl Visibility,
+    sum: &mut DVec3,
+) {
+    let evaluated = evaluate_drawn(sp, drawn);
+    for (d, (b, p_brdf)) in drawn.iter().zip(evaluated) {
+        if let Some((dir, uv, p)) = *d {
+            *sum += weighted(times(env_h.radiance_at(uv), b), c_d * p + c_b * p_brdf, vis, dir);
+        }
+    }
+}
+
+/// Adds f·V / (c_b·p_brdf + c_d·p_drawn) of up to [`BATCH`] BRDF samples to `sum`, the first
+/// technique's densities at their points by `pdf_square_many`.
+fn add_brdf<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u_brdf: &[Vec2],
+    pdf_square_many: impl FnOnce(&[Vec2], &mut [f32]),
+    (c_d, c_b): (f32, f32),
+    vis: &mut impl Visibility,
+    sum: &mut DVec3,
+) {
+    let (brdf, p_drawn) = brdf_draws(env_h, sp, u_brdf, pdf_square_many);
+    for (b, p_square) in brdf[..u_brdf.len().min(BATCH)].iter().zip(p_drawn) {
+        if let Some((dir, uv, s)) = *b {
+            let p = c_b * s.pdf + c_d * (p_square / SPHERE_AREA);
+            *sum += weighted(times(env_h.radiance_at(uv), s.value), p, vis, dir);
+        }
+    }
+}
