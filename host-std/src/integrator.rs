@@ -262,6 +262,7 @@ pub fn shade<B: Brdf + ?Sized>(
     let mut drawn = [None; BATCH];
     let mut product_drawn = [None; BATCH];
     let mut pairs_out = [[Contribution::default(); 2]; BATCH];
+    let mut singles = [Contribution::default(); BATCH];
     let mut sum = DVec3::ZERO;
     // Points in batches (a power of two keeps each batch a (0,2)-net).
     let mut done = 0;
@@ -276,12 +277,16 @@ pub fn shade<B: Brdf + ?Sized>(
         if matches!(method, Method::Mis | Method::Env) {
             env.sample_many(&points[..m], &mut drawn[..m]);
         }
+        // BRDF points: MIS's second technique, or BRDF sampling's only one.
+        let brdf_source = if method == Method::Brdf { &points } else { &others };
         let mut brdf_points = [Vec2::ZERO; BATCH];
-        for (b, o) in brdf_points.iter_mut().zip(&others[..m]) {
+        for (b, o) in brdf_points.iter_mut().zip(&brdf_source[..m]) {
             *b = o.as_vec2();
         }
         match (method, technique) {
             (Method::Mis, _) => estimator::mis_many(env, sp, &drawn[..m], &brdf_points[..m], vis, &mut pairs_out[..m]),
+            (Method::Env, _) => estimator::env_many(env, sp, &drawn[..m], vis, &mut singles[..m]),
+            (Method::Brdf, _) => estimator::brdf_many(env, sp, &brdf_points[..m], vis, &mut singles[..m]),
             (_, Technique::Product(p)) => p.sample_many(&points[..m], &mut product_drawn[..m]),
             _ => {}
         }
@@ -293,8 +298,7 @@ pub fn shade<B: Brdf + ?Sized>(
                 }
                 (Method::Mis, _) => pairs_out[k][0].value + pairs_out[k][1].value,
                 (Method::TwoStage, Technique::TwoStage(t)) => estimator::two_stage(t, env, sp, u, vis).value,
-                (Method::Env, _) => estimator::env_drawn(env, sp, drawn[k], vis).value,
-                (Method::Brdf, _) => estimator::brdf(env, sp, u, vis).value,
+                (Method::Env | Method::Brdf, _) => singles[k].value,
                 (Method::Ris, _) => {
                     let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
                     sobol02(hash_combine(seed, 3 + first as u64 + (done + k) as u64), 0, &mut candidates);

@@ -12,7 +12,7 @@ use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 mod batched;
-pub use batched::{BATCH, mis_many, mis_split, product_mis_many, product_mis_split};
+pub use batched::{BATCH, brdf_many, env_many, mis_many, mis_split, product_mis_many, product_mis_split};
 
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {

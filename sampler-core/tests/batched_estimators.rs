@@ -1,4 +1,4 @@
-//! The batched MIS estimators the renderer uses give, pair by pair, bit for bit what the
+//! The batched estimators the renderer uses (MIS, env alone, BRDF alone) give, pair by pair, bit for bit what the
 //! one-pair estimators give for the same drawn directions and BRDF points; both MIS estimators
 //! split half and half sum to the pairs' estimate — for more pairs than one batch holds (101:
 //! six batches of `estimator::BATCH`, the last one partial, and more than the 64 an older
@@ -53,6 +53,18 @@ fn batched_mis_is_pair_by_pair_mis() {
                 compared += usize::from(out[k][0].value.max_element() > 0.0 && out[k][1].value.max_element() > 0.0);
             }
             assert_split_is_pairs(&out, estimator::mis_split(&e, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
+            // Env alone and BRDF alone.
+            let mut singles = [Contribution::default(); 101];
+            estimator::env_many(&e, &sp, &drawn, &mut vis, &mut singles);
+            for k in 0..u.len() {
+                let one = estimator::env_drawn(&e, &sp, drawn[k], &mut vis);
+                assert_eq!(bits(&singles[k]), bits(&one), "env, brdf {i}, sample {k}");
+            }
+            estimator::brdf_many(&e, &sp, &brdf_points, &mut vis, &mut singles);
+            for k in 0..u.len() {
+                let one = estimator::brdf(&e, &sp, v[k], &mut vis);
+                assert_eq!(bits(&singles[k]), bits(&one), "brdf, brdf {i}, sample {k}");
+            }
             // Product and BRDF.
             let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
             let mut drawn = [None; 101];

@@ -109,6 +109,11 @@ fn ten_thousand_shading_points_allocate_nothing() {
         env.sample_many(&points, &mut drawn);
         estimator::mis_many(&env, &sp, &drawn, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+        let mut singles = [estimator::Contribution::default(); 4];
+        estimator::env_many(&env, &sp, &drawn, &mut vis, &mut singles);
+        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
+        estimator::brdf_many(&env, &sp, &brdf_points, &mut vis, &mut singles);
+        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
         let mut many = [None; 4];
         sampler.sample_many(&points, &mut many);
         sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();

@@ -69,6 +69,53 @@ pub fn mis_many<B: Brdf + ?Sized>(
     }
 }
 
+/// [`env_drawn`](super::env_drawn) for every drawn env sample (`out[k]` from `drawn[k]`), the
+/// BRDF evaluated a batch at a time ([`Brdf::eval_pdf_many`]): the same values, bit for bit.
+pub fn env_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Option<EnvSample>],
+    vis: &mut impl Visibility,
+    out: &mut [Contribution],
+) {
+    for (ds, os) in drawn.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+        let n = ds.len().min(os.len());
+        let mut directions = [None; BATCH];
+        for (d, s) in directions.iter_mut().zip(&ds[..n]) {
+            *d = s.map(|s| (s.dir, s.uv, s.pdf));
+        }
+        let evaluated = evaluate_drawn(sp, &directions[..n]);
+        for ((o, d), (b, _)) in os.iter_mut().zip(&directions[..n]).zip(evaluated) {
+            *o = d.map_or(Contribution::default(), |(dir, uv, p)| {
+                let f = times(env_h.radiance_at(uv), b);
+                Contribution { dir, value: weighted(f, p, vis, dir), pdf: p, other_pdf: 0.0 }
+            });
+        }
+    }
+}
+
+/// [`brdf()`](super::brdf) for every point of `u` (`out[k]` from `u[k]`), the BRDF samples
+/// drawn and their points of the square found a batch at a time ([`Brdf::sample_many`]: four
+/// lanes for GGX): the same values, bit for bit.
+pub fn brdf_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    u: &[Vec2],
+    vis: &mut impl Visibility,
+    out: &mut [Contribution],
+) {
+    for (us, os) in u.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+        let n = us.len().min(os.len());
+        let (brdf, _) = brdf_draws(env_h, sp, &us[..n], |_, _| {});
+        for (o, b) in os.iter_mut().zip(&brdf[..n]) {
+            *o = b.map_or(Contribution::default(), |(dir, uv, s)| {
+                let f = times(env_h.radiance_at(uv), s.value);
+                Contribution { dir, value: weighted(f, s.pdf, vis, dir), pdf: s.pdf, other_pdf: 0.0 }
+            });
+        }
+    }
+}
+
 /// Balance-heuristic MIS of up to [`BATCH`] directions drawn by one technique and as many BRDF
 /// samples, the BRDF's draws and evaluations batched ([`Brdf::sample_many`],
 /// [`Brdf::eval_pdf_many`]: four lanes for GGX) and the other technique's densities at the
