@@ -35,7 +35,10 @@ pub enum Method {
     /// Two-stage importance sampling (Cline et al. 2006, reconstructed: sampler-core's
     /// two_stage.rs): a BRDF-driven partition weighted through a summed-area table.
     TwoStage,
-    /// Per material, the method expected to be cheapest at equal error (see `Method::for_material`).
+    /// Per material, the plan expected to be cheapest at equal error (`Method::for_material`
+    /// and the splits of [`product_share`] / [`auto_env_share`]), checked by a pilot render of
+    /// the material's pixels that replaces it where another plan measures twice as good
+    /// (`pilot.rs`).
     Auto,
 }
 
@@ -66,7 +69,9 @@ impl Method {
         }
     }
 
-    /// `auto`: per material, the method measured best at equal time (`ppis report
+    /// `auto`'s rules — its plan before the pilot (`pilot.rs`) checks it on the scene, and its
+    /// plan where the image is too small for a pilot: per material, the method measured best
+    /// at equal time (`ppis report
     /// --samples-per-point 16`, default, three shared and studio scenes, per material region;
     /// docs/perf.md, session 6):
     ///

@@ -9,6 +9,7 @@ pub mod environment;
 pub mod integrator;
 pub mod mesh;
 pub mod output;
+pub mod pilot;
 pub mod render;
 pub mod report;
 pub mod resample;

@@ -6,6 +6,7 @@
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::integrator::{self, CountingVisibility, Method, Technique};
+use crate::pilot::PilotResult;
 use crate::scene::{Bsdf, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -51,6 +52,10 @@ pub struct Rendered {
     pub camera_rays: u64,
     /// Pixel values that came out NaN or infinite and were set to 0 (should stay 0).
     pub non_finite: u64,
+    /// `auto`: what its pilot measured per material (empty for the other methods).
+    pub pilot: Vec<PilotResult>,
+    /// `auto`: seconds of the pilot, included in `render_seconds`.
+    pub pilot_seconds: f64,
 }
 
 const TILE: usize = 16;
@@ -87,6 +92,13 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         .collect();
     let camera = Camera::new(&scene.camera);
     let (w, h) = (camera.width as usize, camera.height as usize);
+    // Timed from here: `auto`'s pilot is part of its cost.
+    let start = Instant::now();
+    let (plans, pilot) = match (settings.method, env) {
+        (Method::Auto, Some(e)) => crate::pilot::choose(scene, bvh, e, &camera, settings, &plans, env_peak),
+        _ => (plans, Vec::new()),
+    };
+    let pilot_seconds = start.elapsed().as_secs_f64();
     let tiles: Vec<(usize, usize)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
     let counters = [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)];
@@ -94,17 +106,11 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% ETA {eta}").expect("valid template"),
     );
-    let start = Instant::now();
     let shown = std::sync::atomic::AtomicBool::new(false);
     let results: Vec<Vec<[f32; 3]>> = tiles
         .par_iter()
         .map(|&(tx, ty)| {
-            let mut scratch = Scratch {
-                arena: None,
-                hits: Vec::with_capacity(settings.shading_points.clamp(1, 64)),
-                shared: (0..scene.materials.len()).map(|_| None).collect(),
-                stats: [0; 4],
-            };
+            let mut scratch = Scratch::new(scene.materials.len(), settings.shading_points);
             let mut out = Vec::with_capacity(TILE * TILE);
             for y in ty * TILE..((ty + 1) * TILE).min(h) {
                 for x in tx * TILE..((tx + 1) * TILE).min(w) {
@@ -134,7 +140,18 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         }
     }
     let [shading_points, shadow_rays, camera_rays, non_finite] = counters.map(|c| c.into_inner());
-    Rendered { width: w, height: h, pixels, render_seconds, shading_points, shadow_rays, camera_rays, non_finite }
+    Rendered {
+        width: w,
+        height: h,
+        pixels,
+        render_seconds,
+        shading_points,
+        shadow_rays,
+        camera_rays,
+        non_finite,
+        pilot,
+        pilot_seconds,
+    }
 }
 
 /// A primary ray's hit, ready to shade.
@@ -150,17 +167,18 @@ struct Hit {
 }
 
 /// How a material is shaded, resolved once per render.
-struct MaterialPlan {
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MaterialPlan {
     /// The method (`auto` resolved for the material and lighting).
-    method: Method,
+    pub method: Method,
     /// Cosine of the angle within which a product-MIS sampler is reused.
-    reuse_cosine: f32,
+    pub reuse_cosine: f32,
     /// Share of an MIS budget spent on the first technique (product or env samples).
-    split: f64,
+    pub split: f64,
 }
 
 /// A tile's scratch memory, reused from pixel to pixel.
-struct Scratch {
+pub(crate) struct Scratch {
     /// For the product samplers built per shading point.
     arena: Option<Box<ProductArena>>,
     /// The pixel's primary hits.
@@ -169,6 +187,17 @@ struct Scratch {
     shared: Vec<Option<SharedSampler>>,
     /// Shading points, shadow rays, camera rays and non-finite pixel values.
     stats: [u64; 4],
+}
+
+impl Scratch {
+    pub fn new(materials: usize, shading_points: usize) -> Self {
+        Self {
+            arena: None,
+            hits: Vec::with_capacity(shading_points.clamp(1, 64)),
+            shared: (0..materials).map(|_| None).collect(),
+            stats: [0; 4],
+        }
+    }
 }
 
 /// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
@@ -183,7 +212,7 @@ struct SharedSampler {
 /// material, and reused by the tile's next pixels while their shading points stay within
 /// the material's reuse angle; every other sampler built per shading point).
 #[allow(clippy::too_many_arguments)]
-fn pixel(
+pub(crate) fn pixel(
     scene: &Scene,
     bvh: &Bvh,
     env: Option<&EnvHierarchy<'_>>,

@@ -8,7 +8,7 @@ use host_std::environment::{EnvSource, Environment, Placement};
 use host_std::integrator::Method;
 use host_std::render::{self, Settings};
 use host_std::scene::Scene;
-use host_std::{default_scene, output, scene_json};
+use host_std::{default_scene, output, pilot, scene_json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -341,6 +341,14 @@ fn render_command(args: RenderArgs) -> Result<()> {
             }),
             "primitives": bvh.primitive_count(),
             "env_peak": hierarchy.as_ref().map(|h| h.peak(5)),
+            "pilot_seconds": image.pilot_seconds,
+            "auto_plans": image.pilot.iter().map(|r| serde_json::json!({
+                "material": scene.materials[r.material].bsdf.label(),
+                "plan": pilot::plan_name(r.chosen),
+                "rule_plan": r.rule.map(pilot::plan_name),
+                "pilot_pixels": r.pixels,
+                "scores": (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), serde_json::json!(r.scores[c]))).collect::<serde_json::Map<_, _>>(),
+            })).collect::<Vec<_>>(),
         });
         output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
     }
@@ -359,6 +367,16 @@ fn render_command(args: RenderArgs) -> Result<()> {
         exr_path.display(),
         png_path.display()
     );
+    for r in &image.pilot {
+        eprintln!(
+            "ppis: auto: {} → {}{} (pilot: {} pixels, {:.2} s in all)",
+            scene.materials[r.material].bsdf.label(),
+            pilot::plan_name(r.chosen),
+            if Some(r.chosen) == r.rule { "" } else { ", measured ahead of the rule's plan" },
+            r.pixels,
+            image.pilot_seconds
+        );
+    }
     if image.non_finite > 0 {
         eprintln!("ppis: warning: {} pixels were not finite and were written as 0", image.non_finite);
     }
@@ -423,7 +441,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
         ),
     }
     println!(
-        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {} of its samples from the product on GGX conductors with α ≥ {} when the map's peak is under {}, half elsewhere); auto = product-mis on GGX conductors with α in {:?} ({:?} when the map's peak is under {}: no sun), mis on the other materials ({} of it env samples on diffuse surfaces when the peak is under {}), or BRDF sampling when the lighting is smooth (peak < {})",
+        "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {} of its samples from the product on GGX conductors with α ≥ {} when the map's peak is under {}, half elsewhere); auto = product-mis on GGX conductors with α in {:?} ({:?} when the map's peak is under {}: no sun), mis on the other materials ({} of it env samples on diffuse surfaces when the peak is under {}), or BRDF sampling when the lighting is smooth (peak < {}) — then checked per material by a pilot render of 32–64 of its pixels with {} candidate plans (env, BRDF, MIS and product-MIS, half and half or 3:1), which replaces the rule's plan where another measures {}× better at equal cost (images of at least ~64×64 per material)",
         Bvh::build(&scene).primitive_count(),
         if scene.env.is_some() { ", the env hierarchy" } else { "" },
         host_std::integrator::WIDE_LOBE_PRODUCT_SHARE,
@@ -434,7 +452,9 @@ fn info_command(args: InfoArgs) -> Result<()> {
         host_std::integrator::SUN_PEAK,
         host_std::integrator::AUTO_DIFFUSE_ENV_SHARE,
         host_std::integrator::SUN_PEAK,
-        host_std::integrator::SMOOTH_LIGHTING_PEAK
+        host_std::integrator::SMOOTH_LIGHTING_PEAK,
+        pilot::PLANS.len(),
+        pilot::OVERRIDE_MARGIN
     );
     Ok(())
 }
