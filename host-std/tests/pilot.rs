@@ -12,8 +12,8 @@ use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
 
-/// One sphere filling a 64×64 view (the smallest image whose pilot measures 32 pixels), of
-/// `bsdf`.
+/// One sphere filling a 96×96 view (about the smallest image whose pilot fits its share of a
+/// one-material render), of `bsdf`.
 fn sphere(bsdf: Bsdf) -> Scene {
     Scene {
         name: "pilot".into(),
@@ -22,8 +22,8 @@ fn sphere(bsdf: Bsdf) -> Scene {
             target: Vec3::ZERO,
             up: Vec3::Y,
             fov_y_deg: 10.0,
-            width: 64,
-            height: 64,
+            width: 96,
+            height: 96,
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
@@ -83,15 +83,15 @@ fn a_matte_studio_can_be_env_sampled() {
     // session 8).
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes");
     let mut scene = host_std::scene_json::load(&dir.join("studio.json")).unwrap();
-    scene.camera.width = 64;
-    scene.camera.height = 64;
+    scene.camera.width = 96;
+    scene.camera.height = 96;
     scene.materials.truncate(1);
     scene.materials[0] = Material::new(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), false);
     scene.objects.iter_mut().for_each(|o| o.material = 0);
     let env = Environment::build(&EnvSource::File(dir.join("studio_env.exr")), Placement::default()).unwrap();
-    // Near the margin, and the scores of 32 pixel pairs are noisy: some seeds, not all (4 of 8
-    // when measured); never a third plan.
-    let plans: Vec<String> = (0..8).map(|seed| chosen(&scene, &env, 1024, seed)).collect();
+    // Near the margin, and the scores of a few dozen pixel pairs are noisy: some seeds, not
+    // all; never a third plan.
+    let plans: Vec<String> = (0..6).map(|seed| chosen(&scene, &env, 1024, seed)).collect();
     let env_sampled = plans.iter().filter(|p| *p == "env").count();
     assert!(env_sampled >= 2 && plans.iter().all(|p| p == "env" || p == "mis 3:1"), "{plans:?}");
 }
