@@ -23,6 +23,8 @@ pub struct Measurement {
     pub relmse: f64,
     /// (region, RMSE, relMSE) for each region of `Regions`.
     pub regions: Vec<(String, f64, f64)>,
+    /// `auto`: per material its label and the plan its pilot settled on (empty otherwise).
+    pub plans: Vec<(String, String)>,
 }
 
 impl Measurement {
@@ -155,7 +157,15 @@ pub fn sweep(
         let image = render::render(scene, bvh, env, &settings(method, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
-        let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions };
+        let plans = image
+            .pilot
+            .iter()
+            .map(|r| {
+                let changed = if Some(r.chosen) == r.rule { "" } else { " (pilot)" };
+                (scene.materials[r.material].bsdf.label(), format!("{}{changed}", crate::pilot::plan_name(r.chosen)))
+            })
+            .collect();
+        let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions, plans };
         progress(&m);
         m
     };
@@ -270,6 +280,10 @@ pub fn markdown(
             let _ = write!(s, " {:.4e} |", r.2);
         }
         s.push('\n');
+    }
+    for m in measurements.iter().filter(|m| !m.plans.is_empty()) {
+        let plans: Vec<String> = m.plans.iter().map(|(material, plan)| format!("{material} → {plan}")).collect();
+        let _ = writeln!(s, "\n{} at {} spp: {}.", m.method, m.spp, plans.join(", "));
     }
     let mut others: Vec<Method> = Vec::new();
     for m in measurements {
@@ -396,7 +410,7 @@ mod tests {
 
     fn m(method: Method, spp: usize, seconds: f64, relmse: f64) -> Measurement {
         let regions = vec![("carpaint".into(), 0.0, relmse / 2.0)];
-        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse, regions }
+        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse, regions, plans: Vec::new() }
     }
 
     #[test]
@@ -410,6 +424,11 @@ mod tests {
         assert!(md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"), "{md}");
         assert!(md.contains("### pixels on carpaint"), "{md}");
         assert!(md.contains("| 4 | 2.000 | 2.5000e-2 | 1.0000e-1 | 4.00 |"), "{md}");
+        assert!(!md.contains(" spp: "), "no plans without auto");
+        let mut auto = m(Method::Auto, 16, 3.0, 0.08);
+        auto.plans = vec![("diffuse".into(), "env (pilot)".into()), ("carpaint".into(), "mis".into())];
+        let md = markdown("t", &[auto], Method::Product, 2, "test");
+        assert!(md.contains("auto at 16 spp: diffuse → env (pilot), carpaint → mis."), "{md}");
     }
 
     #[test]
