@@ -201,18 +201,7 @@ pub fn product_mis_split<B: Brdf + ?Sized>(
     shares: (f32, f32),
     vis: &mut impl Visibility,
 ) -> DVec3 {
-    let mut sum = DVec3::ZERO;
-    for u in u_product.chunks(BATCH) {
-        let mut drawn = [None; BATCH];
-        sampler.sample_many(u, &mut drawn[..u.len()]);
-        let drawn = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
-        add_drawn(sampler.env(), sp, &drawn[..u.len()], shares, vis, &mut sum);
-    }
-    for u in u_brdf.chunks(BATCH) {
-        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
-        add_brdf(sampler.env(), sp, u, pdf_square_many, shares, vis, &mut sum);
-    }
-    sum
+    split_with_brdf(sampler, sp, u_product, u_brdf, shares, vis)
 }
 
 /// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
@@ -228,16 +217,72 @@ pub fn mis_split<B: Brdf + ?Sized>(
     shares: (f32, f32),
     vis: &mut impl Visibility,
 ) -> DVec3 {
-    let mut sum = DVec3::ZERO;
-    for u in u_env.chunks(BATCH) {
+    split_with_brdf(env_h, sp, u_env, u_brdf, shares, vis)
+}
+
+/// The technique an MIS split draws beside BRDF sampling: product or env-only sampling.
+trait FirstTechnique {
+    fn env_hierarchy(&self) -> &EnvHierarchy<'_>;
+    /// Directions for the points of `u` (into `out`, as many as both hold).
+    fn draw(&self, u: &[DVec2], out: &mut [Drawn]);
+    /// The technique's density per unit square area at each point of `uv` (into `p`).
+    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]);
+}
+
+impl FirstTechnique for ProductSampler<'_, '_> {
+    fn env_hierarchy(&self) -> &EnvHierarchy<'_> {
+        self.env()
+    }
+    fn draw(&self, u: &[DVec2], out: &mut [Drawn]) {
         let mut drawn = [None; BATCH];
-        env_h.sample_many(u, &mut drawn[..u.len()]);
-        let drawn = drawn.map(|s| s.map(|s: EnvSample| (s.dir, s.uv, s.pdf)));
+        let n = u.len().min(out.len()).min(BATCH);
+        self.sample_many(&u[..n], &mut drawn[..n]);
+        for (o, s) in out.iter_mut().zip(&drawn[..n]) {
+            *o = s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf));
+        }
+    }
+    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]) {
+        self.pdf_square_many(uv, p);
+    }
+}
+
+impl FirstTechnique for EnvHierarchy<'_> {
+    fn env_hierarchy(&self) -> &EnvHierarchy<'_> {
+        self
+    }
+    fn draw(&self, u: &[DVec2], out: &mut [Drawn]) {
+        let mut drawn = [None; BATCH];
+        let n = u.len().min(out.len()).min(BATCH);
+        self.sample_many(&u[..n], &mut drawn[..n]);
+        for (o, s) in out.iter_mut().zip(&drawn[..n]) {
+            *o = s.map(|s: EnvSample| (s.dir, s.uv, s.pdf));
+        }
+    }
+    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]) {
+        env_pdf_squares(self, uv, p);
+    }
+}
+
+/// The sum of f·V / (c_d·p_first + c_b·p_brdf) over the points of both techniques: all of the
+/// first technique's samples, then the BRDF's, one by one (the same order and rounding however
+/// the points are batched).
+fn split_with_brdf<B: Brdf + ?Sized>(
+    first: &impl FirstTechnique,
+    sp: &ShadingPoint<'_, B>,
+    u_first: &[DVec2],
+    u_brdf: &[Vec2],
+    shares: (f32, f32),
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    let env_h = first.env_hierarchy();
+    for u in u_first.chunks(BATCH) {
+        let mut drawn = [None; BATCH];
+        first.draw(u, &mut drawn);
         add_drawn(env_h, sp, &drawn[..u.len()], shares, vis, &mut sum);
     }
     for u in u_brdf.chunks(BATCH) {
-        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
-        add_brdf(env_h, sp, u, pdf_square_many, shares, vis, &mut sum);
+        add_brdf(env_h, sp, u, |uv, p| first.pdf_squares(uv, p), shares, vis, &mut sum);
     }
     sum
 }
