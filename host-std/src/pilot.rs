@@ -152,26 +152,29 @@ pub(crate) fn choose(
         .filter(|&m| found[m].len() >= MIN_PIXELS)
         .flat_map(|m| candidates(m).map(move |c| (m, c)))
         .collect();
-    let values: Vec<Vec<[[f64; 3]; 2]>> = tasks
+    // One job per (task, pixel), so that the threads share the work evenly.
+    let jobs: Vec<(usize, (usize, usize))> =
+        tasks.iter().enumerate().flat_map(|(t, &(m, _))| found[m].iter().map(move |&p| (t, p))).collect();
+    let rendered: Vec<[[f64; 3]; 2]> = jobs
         .par_iter()
-        .map(|&(m, c)| {
+        .map(|&(t, (x, y))| {
+            let (m, c) = tasks[t];
             let mut plans: Vec<MaterialPlan> = defaults.to_vec();
             let (method, split, _) = PLANS[c];
             plans[m] = MaterialPlan { method, split, ..defaults[m] };
-            found[m]
-                .iter()
-                .map(|&(x, y)| {
-                    [0u64, 1].map(|rep| {
-                        let s = Settings { seed: hash_combine(settings.seed, 0x9170_0000 + rep), ..*settings };
-                        // A fresh scratch: no product sampler carried over from another
-                        // pixel or repetition (that would correlate the pair).
-                        let mut scratch = Scratch::new(materials, s.shading_points);
-                        pixel(scene, bvh, Some(env), None, camera, &s, &plans, x, y, &mut scratch).map(f64::from)
-                    })
-                })
-                .collect()
+            [0u64, 1].map(|rep| {
+                let s = Settings { seed: hash_combine(settings.seed, 0x9170_0000 + rep), ..*settings };
+                // A fresh scratch: no product sampler carried over from another pixel or
+                // repetition (that would correlate the pair).
+                let mut scratch = Scratch::new(materials, s.shading_points);
+                pixel(scene, bvh, Some(env), None, camera, &s, &plans, x, y, &mut scratch).map(f64::from)
+            })
         })
         .collect();
+    let mut values: Vec<Vec<[[f64; 3]; 2]>> = vec![Vec::new(); tasks.len()];
+    for ((t, _), v) in jobs.iter().zip(rendered) {
+        values[*t].push(v);
+    }
     let mut plans = defaults.to_vec();
     let mut results = Vec::new();
     for (m, pixels) in found.iter().enumerate() {
