@@ -135,10 +135,15 @@ pub(crate) fn choose(
             found[hit.material as usize].push((x, y));
         }
     }
-    // The cost of one pilot pixel of every candidate of every material, twice.
-    let candidates = |m: usize| (0..PLANS.len()).filter(move |&c| eligible(c, &scene.materials[m].bsdf, env_peak));
-    let measured = (0..materials).filter(|&m| found[m].len() >= MIN_PIXELS);
-    let cost_per_pixel: f64 = measured.flat_map(|m| candidates(m).map(|c| 2.0 * PLANS[c].2)).sum();
+    // Every (material, candidate) to measure, and the cost of one pilot pixel of all of them,
+    // twice.
+    let tasks: Vec<(usize, usize)> = (0..materials)
+        .filter(|&m| found[m].len() >= MIN_PIXELS)
+        .flat_map(|m| {
+            (0..PLANS.len()).filter(move |&c| eligible(c, &scene.materials[m].bsdf, env_peak)).map(move |c| (m, c))
+        })
+        .collect();
+    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].2).sum();
     let per_material = ((PILOT_SHARE * n as f64 / cost_per_pixel.max(1.0)) as usize).clamp(MIN_PIXELS, MAX_PIXELS);
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
         return (defaults.to_vec(), Vec::new());
@@ -146,12 +151,8 @@ pub(crate) fn choose(
     for f in &mut found {
         f.truncate(per_material);
     }
-    // Every (material, candidate) renders its pixels twice, in parallel; the values come back
-    // in a fixed order whatever the thread count.
-    let tasks: Vec<(usize, usize)> = (0..materials)
-        .filter(|&m| found[m].len() >= MIN_PIXELS)
-        .flat_map(|m| candidates(m).map(move |c| (m, c)))
-        .collect();
+    // Every task renders its pixels twice, in parallel; the values come back in a fixed order
+    // whatever the thread count (truncating kept every measured material at ≥ MIN_PIXELS).
     // One job per (task, pixel), so that the threads share the work evenly.
     let jobs: Vec<(usize, (usize, usize))> =
         tasks.iter().enumerate().flat_map(|(t, &(m, _))| found[m].iter().map(move |&p| (t, p))).collect();

@@ -36,9 +36,8 @@ pub fn product_mis_many<B: Brdf + ?Sized>(
     for start in (0..n).step_by(BATCH) {
         let end = (start + BATCH).min(n);
         let m = end - start;
-        let mut drawn = [None; BATCH];
-        sampler.sample_many(&u_product[start..end], &mut drawn[..m]);
-        let directions = drawn.map(|s| s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf)));
+        let mut directions = [None; BATCH];
+        sampler.draw(&u_product[start..end], &mut directions);
         let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
         let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
         mis_with_brdf_batch(sampler.env(), sp, &directions[..m], u_b, pdf_square_many, vis, o);
