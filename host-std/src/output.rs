@@ -27,14 +27,21 @@ fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> R
     Ok(())
 }
 
-/// Linear RGB as 32-bit float OpenEXR.
+/// Linear RGB as 32-bit float OpenEXR, byte for byte the same for the same pixels: the tiles
+/// are compressed in parallel but written in increasing order (the exr crate's default order,
+/// "unspecified", writes them as they finish, so the file's bytes varied from run to run).
 pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[[f32; 3]]) -> Result<(), WriteError> {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let p: [f32; 3] = pixels[y * width + x];
+        (p[0], p[1], p[2])
+    });
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
     atomically(path, |tmp| {
-        exr::prelude::write_rgb_file(tmp, width, height, |x, y| {
-            let p = pixels[y * width + x];
-            (p[0], p[1], p[2])
-        })
-        .map_err(|e| e.to_string())
+        Image::from_encoded_channels((width, height), encoding, channels)
+            .write()
+            .to_file(tmp)
+            .map_err(|e| e.to_string())
     })
 }
 
@@ -71,4 +78,33 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 /// Writes `text` atomically (stats files, reports).
 pub fn write_text(path: &Path, text: &str) -> Result<(), WriteError> {
     atomically(path, |tmp| std::fs::write(tmp, text).map_err(|e| e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_exr_is_written_byte_for_byte_the_same_and_reads_back_exactly() {
+        let (w, h) = (300, 200); // 5 × 4 tiles of 64², compressed in parallel
+        let pixels: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| [(i % 977) as f32 * 0.37, (i / w) as f32 / 7.0, if i % 13 == 0 { 1e5 } else { 0.0 }])
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files: Vec<Vec<u8>> = (0..4)
+            .map(|k| {
+                let path = dir.path().join(format!("{k}.exr"));
+                write_exr(&path, w, h, &pixels).unwrap();
+                std::fs::read(path).unwrap()
+            })
+            .collect();
+        assert!(files.iter().all(|f| f == &files[0]), "the same pixels made different files");
+        let image = exr::prelude::read_first_rgba_layer_from_file(
+            dir.path().join("0.exr"),
+            |size, _| vec![[0.0f32; 3]; size.0 * size.1],
+            move |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| px[pos.1 * w + pos.0] = [r, g, b],
+        )
+        .unwrap();
+        assert!(image.layer_data.channel_data.pixels == pixels);
+    }
 }

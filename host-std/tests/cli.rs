@@ -111,6 +111,28 @@ fn a_small_render_writes_exr_png_and_stats() {
     assert_eq!(stats["non_finite_pixels"], 0);
 }
 
+#[test]
+fn the_same_seed_writes_the_same_files_at_any_thread_count() {
+    let tmp = scratch("same");
+    let dir = tmp.path();
+    for threads in ["1", "2", "3"] {
+        let out = ppis()
+            .current_dir(dir)
+            .args(["render", "--width", "200", "--height", "130", "--spp", "4", "--threads", threads, "-o"])
+            .arg(format!("t{threads}.exr"))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    for ext in ["exr", "png"] {
+        let one = std::fs::read(dir.join(format!("t1.{ext}"))).unwrap();
+        for threads in [2, 3] {
+            let other = std::fs::read(dir.join(format!("t{threads}.{ext}"))).unwrap();
+            assert!(one == other, "{ext}: 1 and {threads} threads wrote different files");
+        }
+    }
+}
+
 /// Runs `ppis report` on a tiny image (24×14, 2 samples per shading point, a 16-spp rendered
 /// reference) into `dir/rep` with `args` added; asserts success and returns stderr.
 fn tiny_report(dir: &Path, args: &[&str]) -> String {
