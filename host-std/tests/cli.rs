@@ -63,6 +63,10 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["render", "--env", "odd.exr"], "odd.exr");
     // An output folder that does not exist.
     fails(dir, &["render", "-o", "no/such/folder/out.exr"], "no/such/folder");
+    fails(dir, &["render", "--stats-json", "no/such/folder/s.json"], "no/such/folder");
+    // The EXR and the PNG beside it would be one file.
+    fails(dir, &["render", "-o", "out.png"], "out.png");
+    fails(dir, &["render", "-o", "out"], ".exr");
 }
 
 #[test]

@@ -262,8 +262,19 @@ fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--shading-points {} must divide --spp {}", args.sampling.shading_points, args.spp);
     }
     let exr_path = args.output.clone().unwrap_or_else(|| PathBuf::from("render.exr"));
+    let is_exr = exr_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        // `-o out.png` would otherwise write the EXR there and then the PNG over it.
+        bail!(
+            "{}: the output is an OpenEXR file and must end in .exr (the PNG is written beside it)",
+            exr_path.display()
+        );
+    }
     let png_path = exr_path.with_extension("png");
     check_writable(&exr_path)?;
+    if let Some(stats) = &args.stats_json {
+        check_writable(stats)?;
+    }
 
     let t_load = Instant::now();
     let loaded = load_scene(&args.scene)?;
