@@ -162,6 +162,18 @@ fn report_writes_csv_plots_and_table() {
     assert!(md.contains("## Equal time") && md.contains("env relMSE"), "{md}");
     fails(dir, &["report", "--out", "rep2", "--methods", "product,nope"], "nope");
     fails(dir, &["report", "--out", "rep3", "--methods", "product,mis", "--base", "env"], "--base env");
+    // Bad input fails before the output folder is made.
+    fails(dir, &["report", "--out", "rep4", "--reference", "missing.exr"], "missing.exr");
+    assert!(!dir.join("rep4").exists(), "a failed report left its folder");
+}
+
+#[test]
+fn report_compares_against_the_first_method_when_product_is_not_among_them() {
+    let tmp = scratch("base");
+    let dir = tmp.path();
+    tiny_report(dir, &["--spp", "2", "--methods", "mis,env"]);
+    let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
+    assert!(md.contains("For the time mis takes at each spp"), "{md}");
 }
 
 /// `--repeat N` times every render N times and keeps the fastest: the same renders, the same

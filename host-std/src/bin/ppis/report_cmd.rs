@@ -35,8 +35,9 @@ pub(crate) struct ReportArgs {
     #[arg(long, default_value = "mis", value_parser = parse_method)]
     reference_method: Method,
     /// The method the equal-time tables compare every other one against (one of --methods).
-    #[arg(long, default_value = "product", value_parser = parse_method)]
-    base: Method,
+    /// Default: product, or the first of --methods when product is not among them.
+    #[arg(long, value_parser = parse_method)]
+    base: Option<Method>,
     /// Render every method faster than the base on at doubling spp (at most 8× its largest)
     /// until its time reaches the base's at its largest spp, so that its error at the base's
     /// times is interpolated, not extrapolated.
@@ -54,20 +55,35 @@ pub(crate) struct ReportArgs {
 }
 
 pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
-    if !args.methods.contains(&args.base) {
-        bail!("--base {} is not among --methods", args.base);
-    }
+    let base_method = match args.base {
+        Some(b) if !args.methods.contains(&b) => bail!("--base {b} is not among --methods"),
+        Some(b) => b,
+        None if args.methods.contains(&Method::Product) => Method::Product,
+        None => args.methods[0],
+    };
     use host_std::report;
     let loaded = load_scene(&args.scene)?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    // Everything that reads input comes first: bad input leaves no output folder behind.
+    let given = match &args.reference {
+        Some(path) => {
+            let image = host_std::env_io::load(path)?;
+            if (image.width, image.height) != (w, h) {
+                bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
+            }
+            Some((image.texels, format!("{}", path.display())))
+        }
+        None => None,
+    };
     let environment = match &scene.env {
         Some((source, placement)) => Some(Environment::build(source, *placement)?),
         None => None,
     };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
     let bvh = Bvh::build(&scene);
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
     let threads = args.sampling.threads();
@@ -82,15 +98,8 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         progress: false,
         shadows: !args.sampling.unshadowed,
     };
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let (reference, note) = match &args.reference {
-        Some(path) => {
-            let image = host_std::env_io::load(path)?;
-            if (image.width, image.height) != (w, h) {
-                bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
-            }
-            (image.texels, format!("{}", path.display()))
-        }
+    let (reference, note) = match given {
+        Some(given) => given,
         None => {
             let spp = args.reference_spp as usize;
             let settings = Settings {
@@ -114,7 +123,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         }
     };
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
-    let bracket = args.bracket.then_some(args.base);
+    let bracket = args.bracket.then_some(base_method);
     let measurements = pool.install(|| {
         let per_point = args.samples_per_point.map(|v| v as usize);
         let methods = &args.methods;
@@ -145,7 +154,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(&measurements))?;
     output::write_text(
         &args.out.join("report.md"),
-        &report::markdown(&scene.name, &measurements, args.base, threads, &timing_note(&note, args.repeat)),
+        &report::markdown(&scene.name, &measurements, base_method, threads, &timing_note(&note, args.repeat)),
     )?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
