@@ -115,6 +115,25 @@ fn a_small_render_writes_exr_png_and_stats() {
     assert_eq!(stats["non_finite_pixels"], 0);
 }
 
+/// Without --shading-points the default 4 primary rays shrink to a divisor of --spp (a P the
+/// user gives that does not divide it is an error: `bad_input_fails_cleanly`).
+#[test]
+fn the_default_shading_points_divide_any_spp() {
+    let tmp = scratch("divide");
+    let dir = tmp.path();
+    for (spp, p) in [("6", 2), ("7", 1), ("12", 4)] {
+        let out = ppis()
+            .current_dir(dir)
+            .args(["render", "--width", "8", "--height", "6", "--spp", spp, "--stats-json", "s.json"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).unwrap()).unwrap();
+        assert_eq!(stats["shading_points_per_pixel"], p, "--spp {spp}");
+    }
+}
+
 #[test]
 fn the_same_seed_writes_the_same_files_at_any_thread_count() {
     let tmp = scratch("same");

@@ -8,7 +8,7 @@ use host_std::environment::{EnvSource, Environment, Placement};
 use host_std::integrator::Method;
 use host_std::render::{self, Settings};
 use host_std::scene::Scene;
-use host_std::{default_scene, output, pilot, scene_json};
+use host_std::{default_scene, output, pilot, report, scene_json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -83,13 +83,17 @@ struct RenderArgs {
     stats_json: Option<PathBuf>,
 }
 
+/// Primary rays per pixel when `--shading-points` is not given (reduced to a divisor of spp).
+const DEFAULT_SHADING_POINTS: u32 = 4;
+
 /// How a render samples, shared by `render` and `report`.
 #[derive(Args)]
 struct SamplingArgs {
-    /// Primary rays (shading points) per pixel. `render`: must divide --spp, each shading point
-    /// spends spp/P visibility samples; `report`: reduced to a divisor of each spp.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    shading_points: u32,
+    /// Primary rays (shading points) per pixel, each spending spp/P visibility samples
+    /// [default: 4, or the largest divisor of --spp below it]. `render`: a P given must divide
+    /// --spp; `report`: reduced to a divisor of each spp.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    shading_points: Option<u32>,
     /// BRDF samples per product sampler (the paper's K).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
     brdf_samples: u32,
@@ -258,9 +262,11 @@ fn warn_notes(scene: &Scene, notes: &[String]) {
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
-    if !args.spp.is_multiple_of(args.sampling.shading_points) {
-        bail!("--shading-points {} must divide --spp {}", args.sampling.shading_points, args.spp);
-    }
+    let shading_points = match args.sampling.shading_points {
+        Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
+        Some(p) => p,
+        None => report::shading_points_for(args.spp as usize, DEFAULT_SHADING_POINTS as usize) as u32,
+    };
     let exr_path = args.output.clone().unwrap_or_else(|| PathBuf::from("render.exr"));
     let is_exr = exr_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if !is_exr {
@@ -306,7 +312,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let settings = Settings {
         method: args.method,
         spp: args.spp as usize,
-        shading_points: args.sampling.shading_points as usize,
+        shading_points: shading_points as usize,
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: true,
@@ -326,7 +332,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
             "scene": scene.name,
             "method": args.method.name(),
             "spp": args.spp,
-            "shading_points_per_pixel": args.sampling.shading_points,
+            "shading_points_per_pixel": shading_points,
             "brdf_samples": args.sampling.brdf_samples,
             "threads": threads,
             "seed": args.sampling.seed,
@@ -369,7 +375,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         image.width,
         image.height,
         args.spp,
-        args.sampling.shading_points,
+        shading_points,
         args.method,
         threads,
         image.render_seconds,

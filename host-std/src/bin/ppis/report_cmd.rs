@@ -92,7 +92,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let base = Settings {
         method: Method::Product,
         spp: 1,
-        shading_points: args.sampling.shading_points as usize,
+        shading_points: args.sampling.shading_points.unwrap_or(crate::DEFAULT_SHADING_POINTS) as usize,
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: false,
