@@ -38,7 +38,7 @@ fn main() {
     let mut scene = match path {
         None => host_std::default_scene::scene(),
         Some(p) if p.ends_with(".json") => host_std::scene_json::load(p.as_ref()).unwrap(),
-        Some(p) => host_std::usd_scene::load(p.as_ref(), None).unwrap().scene,
+        Some(p) => host_std::usd_scene::load(p.as_ref(), &Default::default()).unwrap().scene,
     };
     let tris = triangles(&scene);
     let aspect = scene.camera.width as f32 / scene.camera.height as f32;

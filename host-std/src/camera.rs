@@ -1,5 +1,6 @@
 //! Pinhole camera with the scene format's exact convention: f = normalize(target − origin),
-//! r = normalize(f × up), u = r × f, t = tan(fov_y/2), a = W/H; film position (x, y), x ∈ [0, W]
+//! r = normalize(f × up), u = r × f, t = tan(fov_y/2), a = W/H (times the pixel aspect ratio, 1 unless a USD stage's
+//! render settings say otherwise); film position (x, y), x ∈ [0, W]
 //! to the right, y ∈ [0, H] downwards, has direction normalize(f + (2x/W − 1)·t·a·r + (1 − 2y/H)·t·u).
 
 use crate::scene::CameraSpec;
@@ -29,7 +30,7 @@ impl Camera {
             right,
             up,
             tan_half: (spec.fov_y_deg.to_radians() * 0.5).tan(),
-            aspect: spec.width as f32 / spec.height as f32,
+            aspect: spec.width as f32 * spec.pixel_aspect / spec.height as f32,
             width: spec.width,
             height: spec.height,
             near_clip: spec.near_clip,

@@ -44,6 +44,7 @@ pub fn scene() -> Scene {
             fov_y_deg: 36.0,
             width: 640,
             height: 360,
+            pixel_aspect: 1.0,
             near_clip: 1e-3,
         },
         objects,

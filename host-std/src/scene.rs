@@ -14,6 +14,8 @@ pub struct CameraSpec {
     pub fov_y_deg: f32,
     pub width: u32,
     pub height: u32,
+    /// Pixel width over pixel height (1 for square pixels).
+    pub pixel_aspect: f32,
     pub near_clip: f32,
 }
 

@@ -180,6 +180,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         fov_y_deg: c.fov_y_deg,
         width: c.width,
         height: c.height,
+        pixel_aspect: 1.0,
         near_clip: c.near_clip.max(0.0),
     };
     let mut materials = Vec::new();

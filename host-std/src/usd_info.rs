@@ -55,6 +55,20 @@ pub fn print_import(u: &host_usd::UsdScene) {
         ),
         None => println!("  camera: none"),
     }
+    match &u.render_settings {
+        Some(s) => println!(
+            "  render settings: {} ({} × {}, pixel aspect {}, {:?}{})",
+            s.path,
+            s.resolution.0,
+            s.resolution.1,
+            s.pixel_aspect,
+            s.conform,
+            s.camera.as_ref().map_or(String::new(), |c| format!(", camera {c}"))
+        ),
+        None => {
+            println!("  render settings: none ({} wide, the camera's aperture aspect)", crate::usd_scene::DEFAULT_WIDTH)
+        }
+    }
 }
 
 /// `ppis info --expected DIR`: host-usd against Pixar's answers for every file that has them.

@@ -8,7 +8,7 @@ use crate::environment::{EnvSource, Placement};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
 use crate::texture::{ImageTexture, Wrap};
 use host_usd::{Lobes, TextureInput, UsdScene};
-use sampler_core::brdf::{CarPaint, Lambert, RoughConductor, microfacet::Ggx};
+use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::{Mat3, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -24,10 +24,38 @@ pub struct Converted {
     pub usd: UsdScene,
 }
 
+/// How a USD scene is to be imported and framed: the command line's choices.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// The camera prim (default: the render settings', else the stage's first camera).
+    pub camera: Option<String>,
+    /// The RenderSettings prim (default: the layer's `renderSettingsPrimPath`).
+    pub render_settings: Option<String>,
+    /// Image width and height, overriding the render settings' resolution.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
 /// Imports `path` and converts it.
-pub fn load(path: &Path, camera: Option<String>) -> anyhow::Result<Converted> {
-    let usd = host_usd::load_with(path, &host_usd::Options { camera })?;
-    Ok(convert(usd))
+pub fn load(path: &Path, options: &Options) -> anyhow::Result<Converted> {
+    let import = host_usd::Options { camera: options.camera.clone(), render_settings: options.render_settings.clone() };
+    let usd = host_usd::load_with(path, &import)?;
+    Ok(convert(usd, (options.width, options.height)))
+}
+
+/// The image size: `size`'s overrides, else the render settings' resolution, else
+/// [`DEFAULT_WIDTH`] wide; a dimension that neither gives follows the aperture's aspect.
+fn image_size(usd: &UsdScene, cam: &host_usd::Camera, size: (Option<u32>, Option<u32>)) -> (u32, u32) {
+    if let Some(s) = &usd.render_settings {
+        return (size.0.unwrap_or(s.resolution.0), size.1.unwrap_or(s.resolution.1));
+    }
+    let aspect = cam.horizontal_aperture / cam.vertical_aperture;
+    match size {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, ((w as f32 / aspect).round() as u32).max(1)),
+        (None, Some(h)) => (((h as f32 * aspect).round() as u32).max(1), h),
+        (None, None) => (DEFAULT_WIDTH, ((DEFAULT_WIDTH as f32 / aspect).round() as u32).max(1)),
+    }
 }
 
 /// A texture's file name with a usable extension (`pkg.usdz[tex/a.png]` → `pkg.usdz/tex/a.png`).
@@ -121,26 +149,21 @@ impl Textured for TexturedPreview {
 }
 
 /// The core BRDF for a UsdPreviewSurface's lobes: the cheapest one that represents them.
+/// The lobes' α are GGX roughness already (roughness², `host_usd::Lobes`), which is what the
+/// core's constructors take.
 fn bsdf(l: &Lobes) -> Bsdf {
     let zero = |v: Vec3| v.max_element() <= 0.0;
     if l.clearcoat <= 0.0 && zero(l.specular) {
         Bsdf::Diffuse(Lambert::new(l.diffuse))
     } else if l.clearcoat <= 0.0 && zero(l.diffuse) {
-        Bsdf::Conductor(RoughConductor::new(l.alpha.sqrt(), l.specular))
+        Bsdf::Conductor(RoughConductor::new(l.alpha, l.specular))
     } else {
-        Bsdf::CarPaint(CarPaint {
-            base: l.diffuse,
-            flake: l.specular,
-            flake_ggx: Ggx::new(l.alpha.sqrt()),
-            coat: l.clearcoat,
-            coat_ggx: Ggx::new(l.clearcoat_alpha.sqrt()),
-            coat_f0: 0.04,
-        })
+        Bsdf::CarPaint(CarPaint::new(l.diffuse, l.specular, l.alpha, l.clearcoat, l.clearcoat_alpha))
     }
 }
 
-/// Converts an imported USD scene.
-pub fn convert(mut usd: UsdScene) -> Converted {
+/// Converts an imported USD scene, rendered at `size` (width, height) where given.
+pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted {
     let mut notes: Vec<String> = usd.skipped.iter().map(|s| format!("{}: {}", s.path, s.what)).collect();
     // Decode each material's textures; the material's plain BRDF is its value at their means.
     let mut textured: Vec<Option<TextureHandle>> = Vec::with_capacity(usd.materials.len());
@@ -188,15 +211,18 @@ pub fn convert(mut usd: UsdScene) -> Converted {
         objects.push(Object { shape, material: material(m.material, m.double_sided) });
     }
     let cam = usd.camera.clone().unwrap_or_else(|| host_usd::camera::framing((Vec3::splat(-1.0), Vec3::ONE)));
-    let aspect = cam.horizontal_aperture / cam.vertical_aperture;
-    let height = ((DEFAULT_WIDTH as f32 / aspect).round() as u32).max(1);
+    let (width, height) = image_size(&usd, &cam, size);
+    let (pixel_aspect, conform) =
+        usd.render_settings.as_ref().map_or((1.0, Default::default()), |s| (s.pixel_aspect, s.conform));
+    let (fov_y_deg, pixel_aspect) = cam.conformed(width, height, pixel_aspect, conform);
     let camera = CameraSpec {
         origin: cam.origin,
         target: cam.origin + cam.forward,
         up: cam.up,
-        fov_y_deg: cam.fov_y_deg(aspect),
-        width: DEFAULT_WIDTH,
+        fov_y_deg,
+        width,
         height,
+        pixel_aspect,
         near_clip: cam.near,
     };
     let env = usd.dome.as_ref().map(|d| {

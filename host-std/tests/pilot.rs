@@ -24,6 +24,7 @@ fn sphere(bsdf: Bsdf) -> Scene {
             fov_y_deg: 10.0,
             width: 96,
             height: 96,
+            pixel_aspect: 1.0,
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],

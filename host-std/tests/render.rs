@@ -60,6 +60,7 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
             fov_y_deg: 10.0,
             width: 8,
             height: 8,
+            pixel_aspect: 1.0,
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],

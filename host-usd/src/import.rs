@@ -7,7 +7,7 @@ use crate::mesh::{self, LocalMesh};
 use crate::scene::{Counts, Mesh, Skip, Sphere, UpAxis, UsdScene};
 use crate::stage::{Stage, Value};
 use crate::xform::{WorldTransforms, uniform_scale, up_axis_conversion};
-use crate::{camera, dome, instancer, shapes};
+use crate::{camera, dome, instancer, render_settings, shapes};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -16,14 +16,27 @@ use std::time::Instant;
 /// Import options.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
-    /// The camera prim to use (default: the stage's first camera).
+    /// The camera prim to use (default: the render settings' camera, else the stage's first).
     pub camera: Option<String>,
+    /// The RenderSettings prim to use (default: the layer's `renderSettingsPrimPath`).
+    pub render_settings: Option<String>,
 }
 
 /// Gprim types the importer renders.
 pub const GPRIMS: [&str; 7] = ["Mesh", "Sphere", "Cube", "Cylinder", "Cone", "Capsule", "Plane"];
 /// Prim types that carry no geometry of their own.
-const STRUCTURE: [&str; 8] = ["", "Xform", "Scope", "Material", "Shader", "NodeGraph", "GeomSubset", "Camera"];
+const STRUCTURE: [&str; 10] = [
+    "",
+    "Xform",
+    "Scope",
+    "Material",
+    "Shader",
+    "NodeGraph",
+    "GeomSubset",
+    "Camera",
+    "RenderSettings",
+    "RenderProduct",
+];
 const OTHER_LIGHTS: [&str; 7] =
     ["SphereLight", "RectLight", "DiskLight", "DistantLight", "CylinderLight", "GeometryLight", "PortalLight"];
 const SKELETAL: [&str; 4] = ["SkelRoot", "Skeleton", "SkelAnimation", "BlendShape"];
@@ -90,6 +103,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         materials: Vec::new(),
         dome: None,
         camera: None,
+        render_settings: None,
         bounds: None,
         skipped,
         counts: Counts::default(),
@@ -103,12 +117,23 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         materials: HashMap::new(),
     };
     let prims = stage.prims().map_err(at("/"))?;
-    imp.walk(&prims, options).map_err(|(prim, message)| UsdError::Prim { file: file.to_owned(), prim, message })?;
+    let fail = |(prim, message)| UsdError::Prim { file: file.to_owned(), prim, message };
+    let (settings, notes) = render_settings::read(&stage, &prims, options.render_settings.as_deref()).map_err(fail)?;
+    let where_ = settings.as_ref().map_or("/", |s| s.path.as_str()).to_string();
+    notes.into_iter().for_each(|n| imp.skip(&where_, n));
+    let mut options = options.clone();
+    if let Some(s) = settings {
+        options.camera = options.camera.or_else(|| s.camera.clone());
+        imp.scene.render_settings = Some(s);
+    }
+    imp.walk(&prims, &options).map_err(fail)?;
     let mut scene = imp.scene;
     if let Some(name) = &options.camera
         && scene.camera.as_ref().is_none_or(|c| &c.path != name)
     {
-        return Err(UsdError::Prim { file: file.to_owned(), prim: name.clone(), message: "no such camera".into() });
+        let by = scene.render_settings.as_ref().filter(|s| s.camera.as_ref() == Some(name));
+        let message = by.map_or_else(|| "no such camera".into(), |s| format!("no such camera (named by {})", s.path));
+        return Err(UsdError::Prim { file: file.to_owned(), prim: name.clone(), message });
     }
     if scene.camera.is_none()
         && let Some(b) = scene.bounds

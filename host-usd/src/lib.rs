@@ -12,6 +12,7 @@ pub mod instancer;
 pub mod material;
 pub mod mesh;
 pub mod primvar;
+pub mod render_settings;
 pub mod scene;
 pub mod shapes;
 pub mod stage;

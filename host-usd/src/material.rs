@@ -46,8 +46,10 @@ pub struct Texture {
 pub struct Lobes {
     pub diffuse: Vec3,
     pub specular: Vec3,
+    /// The specular lobe's GGX α: roughness², to be used as is (not squared again).
     pub alpha: f32,
     pub clearcoat: f32,
+    /// The coat's GGX α: clearcoatRoughness².
     pub clearcoat_alpha: f32,
 }
 

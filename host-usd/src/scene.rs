@@ -2,6 +2,7 @@
 //! openusd types, so host-std converts it without knowing USD.
 
 pub use crate::material::{Lobes, Material, Texture, TextureInput};
+use crate::render_settings::Conform;
 use glam::{DMat3, Vec2, Vec3};
 use std::path::PathBuf;
 
@@ -73,9 +74,20 @@ impl Camera {
     /// Vertical field of view (degrees) for an image of `aspect` = width/height, conforming
     /// the aperture by expanding it (UsdRender's default `expandAperture`).
     pub fn fov_y_deg(&self, aspect: f32) -> f32 {
-        let (h, v) = (self.horizontal_aperture, self.vertical_aperture);
-        let v = if h / v > aspect { h / aspect } else { v };
-        (2.0 * (0.5 * v / self.focal_length).atan()).to_degrees()
+        let (_, v, _) = Conform::ExpandAperture.apply((self.horizontal_aperture, self.vertical_aperture), 1, 1, aspect);
+        self.fov_y_from_aperture(v)
+    }
+
+    /// The vertical field of view (degrees) and pixel aspect ratio of an image of `width` ×
+    /// `height` pixels of aspect `pixel_aspect`, the aperture fitted to it by `conform`.
+    pub fn conformed(&self, width: u32, height: u32, pixel_aspect: f32, conform: Conform) -> (f32, f32) {
+        let aperture = (self.horizontal_aperture, self.vertical_aperture);
+        let (_, v, pixel_aspect) = conform.apply(aperture, width, height, pixel_aspect);
+        (self.fov_y_from_aperture(v), pixel_aspect)
+    }
+
+    fn fov_y_from_aperture(&self, vertical_aperture: f32) -> f32 {
+        (2.0 * (0.5 * vertical_aperture / self.focal_length).atan()).to_degrees()
     }
 }
 
@@ -110,6 +122,8 @@ pub struct UsdScene {
     pub materials: Vec<Material>,
     pub dome: Option<Dome>,
     pub camera: Option<Camera>,
+    /// The UsdRenderSettings that apply (`render_settings`), if the stage has any.
+    pub render_settings: Option<crate::render_settings::RenderSettings>,
     /// World bounds of the geometry (min, max), Y up.
     pub bounds: Option<(Vec3, Vec3)>,
     pub skipped: Vec<Skip>,

@@ -137,6 +137,7 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
                     fov_y_deg: 40.0,
                     width: 8,
                     height: 8,
+                    pixel_aspect: 1.0,
                     near_clip: 1e-3,
                 },
                 objects: vec![Object {
@@ -182,6 +183,7 @@ fn views_down_to_n_dot_v_1e_6_shade_finite_values() {
                     fov_y_deg: 1e-4,
                     width: 5,
                     height: 5,
+                    pixel_aspect: 1.0,
                     near_clip: 1e-6,
                 },
                 objects: vec![Object {

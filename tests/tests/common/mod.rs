@@ -46,6 +46,7 @@ pub fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {
             fov_y_deg: 10.0,
             width: 8,
             height: 8,
+            pixel_aspect: 1.0,
             near_clip: 1e-3,
         },
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],

@@ -46,9 +46,14 @@ struct SceneArgs {
     /// Scene file: .json (docs/scene-format.md) or USD (.usda, .usdc, .usdz, .usd). Without
     /// it: the embedded default scene.
     scene: Option<PathBuf>,
-    /// USD: the camera prim to render through (default: the stage's first camera).
+    /// USD: the camera prim to render through (default: the render settings' camera, else
+    /// the stage's first camera).
     #[arg(long)]
     camera: Option<String>,
+    /// USD: the RenderSettings prim whose resolution and camera apply (default: the layer's
+    /// renderSettingsPrimPath, else the stage's only RenderSettings prim).
+    #[arg(long, value_name = "PRIM")]
+    render_settings: Option<String>,
     /// Environment map replacing the scene's (lat-long .exr/.hdr/.png/.jpg, or a square
     /// equal-area map).
     #[arg(long)]
@@ -115,6 +120,11 @@ struct SamplingArgs {
 }
 
 impl SamplingArgs {
+    /// --width and --height, as given.
+    fn size(&self) -> (Option<u32>, Option<u32>) {
+        (self.width, self.height)
+    }
+
     /// Applies --width/--height to the scene's camera.
     fn resize(&self, scene: &mut Scene) {
         if let Some(w) = self.width {
@@ -167,7 +177,7 @@ struct Loaded {
 }
 
 /// Loads the scene the arguments name (or the default scene) and applies `--env`.
-fn load_scene(args: &SceneArgs) -> Result<Loaded> {
+fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>)) -> Result<Loaded> {
     #[cfg(feature = "usd")]
     let mut usd = None;
     #[cfg_attr(not(feature = "usd"), allow(unused_mut))]
@@ -180,7 +190,13 @@ fn load_scene(args: &SceneArgs) -> Result<Loaded> {
                 "json" => scene_json::load(path)?,
                 #[cfg(feature = "usd")]
                 "usd" | "usda" | "usdc" | "usdz" => {
-                    let c = host_std::usd_scene::load(path, args.camera.clone())?;
+                    let options = host_std::usd_scene::Options {
+                        camera: args.camera.clone(),
+                        render_settings: args.render_settings.clone(),
+                        width: size.0,
+                        height: size.1,
+                    };
+                    let c = host_std::usd_scene::load(path, &options)?;
                     notes = c.notes;
                     usd = Some(c.usd);
                     c.scene
@@ -199,6 +215,9 @@ fn load_scene(args: &SceneArgs) -> Result<Loaded> {
         });
     if args.camera.is_some() && !is_usd {
         bail!("--camera applies to USD scenes only");
+    }
+    if args.render_settings.is_some() && !is_usd {
+        bail!("--render-settings applies to USD scenes only");
     }
     if let Some(env) = &args.env {
         if !env.exists() {
@@ -283,7 +302,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     }
 
     let t_load = Instant::now();
-    let loaded = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.scene, args.sampling.size())?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
@@ -413,7 +432,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
     if let Some(dir) = &args.expected {
         return conformance(dir);
     }
-    let loaded = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.scene, (None, None))?;
     #[cfg(feature = "usd")]
     if let Some(usd) = &loaded.usd {
         host_std::usd_info::print_import(usd);

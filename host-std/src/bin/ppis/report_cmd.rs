@@ -62,7 +62,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         None => args.methods[0],
     };
     use host_std::report;
-    let loaded = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.scene, args.sampling.size())?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
