@@ -1,5 +1,7 @@
 //! Ray intersection: spheres and triangles in a bounding volume hierarchy built with the binned
-//! surface-area heuristic (16 bins, up to 4 primitives per leaf), flattened depth-first.
+//! surface-area heuristic (`build.rs`), flattened depth-first.
+
+mod build;
 
 use crate::scene::{Scene, Shape};
 use sampler_core::glam::{Vec2, Vec3};
@@ -100,7 +102,7 @@ impl Primitive {
 
 /// Axis-aligned box.
 #[derive(Clone, Copy, Debug)]
-struct Aabb {
+pub(crate) struct Aabb {
     min: Vec3,
     max: Vec3,
 }
@@ -128,7 +130,7 @@ impl Aabb {
 }
 
 #[derive(Clone, Copy, Debug)]
-struct Node {
+pub(crate) struct Node {
     bounds: Aabb,
     /// Leaf: first primitive; inner: index of the second child (the first follows the node).
     offset: u32,
@@ -198,95 +200,9 @@ impl Bvh {
                 }
             }
         }
-        let mut bvh = Bvh { prims, nodes: Vec::new(), corner_attrs };
-        if !bvh.prims.is_empty() {
-            let n = bvh.prims.len();
-            let mut centroids: Vec<(Aabb, Vec3)> = bvh
-                .prims
-                .iter()
-                .map(|p| {
-                    let b = p.bounds();
-                    (b, 0.5 * (b.min + b.max))
-                })
-                .collect();
-            let mut order: Vec<usize> = (0..n).collect();
-            bvh.nodes.reserve(2 * n);
-            bvh.build_node(&mut centroids, &mut order, 0, n, 0);
-            let prims = order.iter().map(|&i| bvh.prims[i]).collect();
-            bvh.prims = prims;
-        }
-        bvh
-    }
-
-    /// Recursively builds the node for `order[lo..hi]`; returns its index.
-    fn build_node(
-        &mut self,
-        info: &mut [(Aabb, Vec3)],
-        order: &mut [usize],
-        lo: usize,
-        hi: usize,
-        depth: u32,
-    ) -> usize {
-        let bounds = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| b.union(info[i].0));
-        let index = self.nodes.len();
-        self.nodes.push(Node { bounds, offset: lo as u32, count: (hi - lo) as u32, axis: 0 });
-        if hi - lo <= 4 {
-            return index;
-        }
-        let cb = order[lo..hi].iter().fold(Aabb::EMPTY, |b, &i| b.union(Aabb { min: info[i].1, max: info[i].1 }));
-        let extent = cb.max - cb.min;
-        let axis = if extent.x >= extent.y && extent.x >= extent.z {
-            0
-        } else if extent.y >= extent.z {
-            1
-        } else {
-            2
-        };
-        if extent[axis] <= 0.0 {
-            return index; // all centroids coincide: keep one leaf
-        }
-        const BINS: usize = 16;
-        let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
-        let mut bins = [(Aabb::EMPTY, 0usize); BINS];
-        for &i in &order[lo..hi] {
-            let b = &mut bins[bin_of(info[i].1)];
-            b.0 = b.0.union(info[i].0);
-            b.1 += 1;
-        }
-        // Sweep: cost of splitting after bin k.
-        let mut best = (f32::INFINITY, 0);
-        for k in 0..BINS - 1 {
-            let (l, r) = (&bins[..=k], &bins[k + 1..]);
-            let (lb, ln) = l.iter().fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
-            let (rb, rn) = r.iter().fold((Aabb::EMPTY, 0), |(b, n), x| (b.union(x.0), n + x.1));
-            if ln == 0 || rn == 0 {
-                continue;
-            }
-            let cost = lb.area() * ln as f32 + rb.area() * rn as f32;
-            if cost < best.0 {
-                best = (cost, k);
-            }
-        }
-        let leaf_cost = bounds.area() * (hi - lo) as f32;
-        if best.0 >= leaf_cost && hi - lo <= 16 {
-            return index;
-        }
-        // Past depth 40, median splits keep the depth logarithmic (≤ 40 + log₂ n), so the stack of 128
-        // always suffices (checked in debug builds).
-        let mid = if depth < 40 { lo + partition(&mut order[lo..hi], |&i| bin_of(info[i].1) <= best.1) } else { lo };
-        let mid = if mid == lo || mid == hi {
-            let m = (lo + hi) / 2;
-            order[lo..hi].select_nth_unstable_by(m - lo, |&a, &b| info[a].1[axis].total_cmp(&info[b].1[axis]));
-            m
-        } else {
-            mid
-        };
-        self.build_node(info, order, lo, mid, depth + 1);
-        let right = self.build_node(info, order, mid, hi, depth + 1);
-        self.nodes[index].offset = right as u32;
-        self.nodes[index].count = 0;
-        self.nodes[index].axis = axis as u8;
-        index
+        let nodes;
+        (prims, nodes) = build::build(prims);
+        Bvh { prims, nodes, corner_attrs }
     }
 
     /// Number of primitives.
@@ -401,14 +317,39 @@ impl Bvh {
     }
 }
 
-/// Stable-enough partition: elements satisfying `pred` first; returns their count.
-fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
-    let mut k = 0;
-    for i in 0..v.len() {
-        if pred(&v[i]) {
-            v.swap(i, k);
-            k += 1;
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, Object};
+    use sampler_core::brdf::Lambert;
+
+    #[test]
+    fn nearest_hits_and_occlusion_agree_with_testing_every_primitive() {
+        let mut objects = Vec::new();
+        for k in 0..400 {
+            let c = Vec3::new((k % 20) as f32, ((k / 20) % 20) as f32, (k % 7) as f32) * 0.7;
+            let shape = if k % 3 == 0 {
+                Shape::Sphere { center: c, radius: 0.3 }
+            } else {
+                Shape::Rectangle { p0: c, e1: Vec3::new(0.5, 0.1, 0.0), e2: Vec3::new(0.0, 0.2, 0.5) }
+            };
+            objects.push(Object { shape, material: 0 });
         }
+        let material = Material::new(crate::scene::Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
+        let scene = Scene { objects, materials: vec![material], ..crate::default_scene::scene() };
+        let bvh = Bvh::build(&scene);
+        let mut hits = 0;
+        for k in 0..2000 {
+            let f = k as f32;
+            let o = Vec3::new(-3.0 + (f * 0.37) % 20.0, -2.0 + (f * 0.11) % 16.0, -5.0);
+            let d = Vec3::new((f * 0.013).sin() * 0.3, (f * 0.029).cos() * 0.3, 1.0).normalize();
+            let brute =
+                bvh.prims.iter().filter_map(|p| p.intersect(o, d, 1e-4, f32::INFINITY)).fold(f32::INFINITY, f32::min);
+            let hit = bvh.intersect(o, d, 1e-4, f32::INFINITY).map_or(f32::INFINITY, |h| h.t);
+            assert_eq!(hit, brute, "ray {k}");
+            assert_eq!(bvh.occluded(o, d, 1e-4, 50.0), brute < 50.0, "ray {k}");
+            hits += usize::from(brute.is_finite());
+        }
+        assert!(hits > 300 && hits < 1900, "{hits} of 2000 rays hit: the test would miss some failures");
     }
-    k
 }
