@@ -21,6 +21,7 @@ pub const DEFAULT_WIDTH: u32 = 640;
 pub struct Converted {
     pub scene: Scene,
     pub notes: Vec<String>,
+    /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
     pub usd: UsdScene,
 }
 
@@ -201,13 +202,9 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted
         let shape = Shape::Sphere { center: s.center, radius: s.radius };
         objects.push(Object { shape, material: material(s.material, s.double_sided) });
     }
-    for m in &usd.meshes {
-        let shape = Shape::Mesh {
-            positions: m.positions.clone(),
-            triangles: m.triangles.clone(),
-            normals: m.normals.clone(),
-            uvs: m.uvs.clone(),
-        };
+    // The geometry moves into the scene: a large mesh is held once.
+    for m in std::mem::take(&mut usd.meshes) {
+        let shape = Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs };
         objects.push(Object { shape, material: material(m.material, m.double_sided) });
     }
     let cam = usd.camera.clone().unwrap_or_else(|| host_usd::camera::framing((Vec3::splat(-1.0), Vec3::ONE)));
