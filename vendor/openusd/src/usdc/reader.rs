@@ -355,10 +355,11 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         debug_assert_eq!(jumps.len(), count);
 
         // ppis patch: the path slots are allocated once the encoded paths that fill them are
-        // decoded (Pixar writes one encoded path per slot), and every index is checked as
-        // Pixar's PXR_PREFER_SAFETY_OVER_SPEED build does.
+        // decoded. Pixar's writer encodes every path of its table but the empty one, which
+        // the table holds at most once; every index is checked as Pixar's
+        // PXR_PREFER_SAFETY_OVER_SPEED build does.
         ensure!(
-            path_count <= count,
+            path_count <= count.saturating_add(1),
             "corrupt file: {path_count} paths but {count} encoded paths"
         );
         if let Some(i) = path_indexes.iter().find(|&&i| i as usize >= path_count) {
