@@ -136,17 +136,6 @@ def looks(stage, n):
     return mats
 
 
-def place(xformable, i, n):
-    """A grid position and a scale that vary with i; every tenth prim also turns (the others'
-    matrices stay short in the answers)."""
-    side = max(1, int(math.ceil(n ** (1 / 3))))
-    x, y, z = i % side, (i // side) % side, i // (side * side)
-    xformable.AddTranslateOp().Set(Gf.Vec3d(2.5 * x, 2.5 * y, 2.5 * z))
-    turn = Gf.Vec3f(i % 7 * 10.0, i % 11 * 5.0, i % 13 * 3.0) if i % 10 == 0 else Gf.Vec3f(0, 0, 0)
-    xformable.AddRotateXYZOp().Set(turn)
-    xformable.AddScaleOp().Set(Gf.Vec3f(1.0 + i % 3 * 0.25, 1.0, 1.0))
-
-
 def quad(stage, path, offset):
     mesh = UsdGeom.Mesh.Define(stage, path)
     o = offset
@@ -157,28 +146,77 @@ def quad(stage, path, offset):
     return mesh
 
 
+# The kinds with the most prims are authored through Sdf in one change block: through
+# UsdGeom, each new prim recomposes the stage, which makes 100 000 prims take many minutes.
+T = Sdf.ValueTypeNames
+
+
+def sdf_prim(layer, path, type_name, attrs, material=None):
+    """A `def` prim spec with default values (name: (type, value, uniform)) and a direct
+    material binding, as UsdGeom and UsdShade author them."""
+    spec = Sdf.CreatePrimInLayer(layer, path)
+    spec.specifier = Sdf.SpecifierDef
+    spec.typeName = type_name
+    for name, (kind, value, uniform) in attrs.items():
+        attr = Sdf.AttributeSpec(spec, name, kind, Sdf.VariabilityUniform if uniform else Sdf.VariabilityVarying)
+        attr.default = value
+    if material is not None:
+        spec.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=["MaterialBindingAPI"]))
+        rel = Sdf.RelationshipSpec(spec, "material:binding", custom=False)
+        rel.targetPathList.explicitItems = [material]
+
+
+def sdf_place(i, n):
+    """A grid position and a scale that vary with i; every tenth prim also turns (the others'
+    matrices stay short in the answers)."""
+    side = max(1, int(math.ceil(n ** (1 / 3))))
+    x, y, z = i % side, (i // side) % side, i // (side * side)
+    turn = Gf.Vec3f(i % 7 * 10.0, i % 11 * 5.0, i % 13 * 3.0) if i % 10 == 0 else Gf.Vec3f(0, 0, 0)
+    ops = ["xformOp:translate", "xformOp:rotateXYZ", "xformOp:scale"]
+    return {
+        "xformOp:translate": (T.Double3, Gf.Vec3d(2.5 * x, 2.5 * y, 2.5 * z), False),
+        "xformOp:rotateXYZ": (T.Float3, turn, False),
+        "xformOp:scale": (T.Float3, Gf.Vec3f(1.0 + i % 3 * 0.25, 1.0, 1.0), False),
+        "xformOpOrder": (T.TokenArray, ops, True),
+    }
+
+
+def sdf_quad(offset):
+    o = offset
+    points = [(o, 0, 0), (o + 1, 0, 0), (o + 1, 1, o * 0.5), (o, 1, 0), (o + 2, 0.5, 0)]
+    return {
+        "points": (T.Point3fArray, points, False),
+        "faceVertexCounts": (T.IntArray, [4, 3], False),
+        "faceVertexIndices": (T.IntArray, [0, 1, 2, 3, 1, 4, 2], False),
+        "subdivisionScheme": (T.Token, "none", True),
+    }
+
+
 def kind_spheres(stage, n, _dir):
     world_root(stage)
-    mats = looks(stage, 3)
-    for i in range(n):
-        s = UsdGeom.Sphere.Define(stage, f"/World/Sphere_{i}")
-        s.GetRadiusAttr().Set(0.5 + (i % 5) * 0.1)
-        place(s, i, n)
-        UsdShade.MaterialBindingAPI.Apply(s.GetPrim()).Bind(mats[i % 3])
+    mats = [m.GetPath() for m in looks(stage, 3)]
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            attrs = {"radius": (T.Double, 0.5 + (i % 5) * 0.1, False), **sdf_place(i, n)}
+            sdf_prim(layer, f"/World/Sphere_{i}", "Sphere", attrs, mats[i % 3])
 
 
 def kind_meshes_varying(stage, n, _dir):
     world_root(stage)
-    mats = looks(stage, 2)
-    for i in range(n):
-        m = quad(stage, f"/World/Mesh_{i}", i * 0.001)
-        UsdShade.MaterialBindingAPI.Apply(m.GetPrim()).Bind(mats[i % 2])
+    mats = [m.GetPath() for m in looks(stage, 2)]
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            sdf_prim(layer, f"/World/Mesh_{i}", "Mesh", sdf_quad(i * 0.001), mats[i % 2])
 
 
 def kind_meshes_identical(stage, n, _dir):
     world_root(stage)
-    for i in range(n):
-        place(quad(stage, f"/World/Mesh_{i}", 0.0), i, n)
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            sdf_prim(layer, f"/World/Mesh_{i}", "Mesh", {**sdf_quad(0.0), **sdf_place(i, n)})
 
 
 def kind_instancer(stage, n, _dir):
@@ -228,40 +266,45 @@ def asset(directory, name):
 def kind_references(stage, n, directory):
     world_root(stage)
     name = asset(directory, "asset.usda")
-    for i in range(n):
-        x = UsdGeom.Xform.Define(stage, f"/World/Ref_{i}")
-        x.GetPrim().GetReferences().AddReference(name)
-        place(x, i, n)
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            sdf_prim(layer, f"/World/Ref_{i}", "Xform", sdf_place(i, n))
+            layer.GetPrimAtPath(f"/World/Ref_{i}").referenceList.prependedItems = [Sdf.Reference(name)]
 
 
 def kind_payloads(stage, n, directory):
     world_root(stage)
     name = asset(directory, "asset.usda")
-    for i in range(n):
-        x = UsdGeom.Xform.Define(stage, f"/World/Payload_{i}")
-        x.GetPrim().GetPayloads().AddPayload(name)
-        place(x, i, n)
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            sdf_prim(layer, f"/World/Payload_{i}", "Xform", sdf_place(i, n))
+            layer.GetPrimAtPath(f"/World/Payload_{i}").payloadList.prependedItems = [Sdf.Payload(name)]
 
 
 def kind_variants(stage, n, _dir):
     world_root(stage)
     choices = ["ball", "box", "tile"]
-    for i in range(n):
-        x = UsdGeom.Xform.Define(stage, f"/World/Var_{i}")
-        place(x, i, n)
-        vset = x.GetPrim().GetVariantSets().AddVariantSet("shape")
-        for c in choices:
-            vset.AddVariant(c)
-            vset.SetVariantSelection(c)
-            with vset.GetVariantEditContext():
-                p = x.GetPath().AppendChild("Shape")
-                if c == "ball":
-                    UsdGeom.Sphere.Define(stage, p)
-                elif c == "box":
-                    UsdGeom.Cube.Define(stage, p).AddTranslateOp().Set(Gf.Vec3d(0, 1, 0))
-                else:
-                    quad(stage, p, 0.0)
-        vset.SetVariantSelection(choices[i % 3])
+    shapes = {
+        "ball": ("Sphere", {}),
+        "box": ("Cube", {"xformOp:translate": (T.Double3, Gf.Vec3d(0, 1, 0), False),
+                         "xformOpOrder": (T.TokenArray, ["xformOp:translate"], True)}),
+        "tile": ("Mesh", sdf_quad(0.0)),
+    }
+    layer = stage.GetRootLayer()
+    with Sdf.ChangeBlock():
+        for i in range(n):
+            path = f"/World/Var_{i}"
+            sdf_prim(layer, path, "Xform", sdf_place(i, n))
+            spec = layer.GetPrimAtPath(path)
+            vset = Sdf.VariantSetSpec(spec, "shape")
+            for c in choices:
+                Sdf.VariantSpec(vset, c)
+                type_name, attrs = shapes[c]
+                sdf_prim(layer, f"{path}{{shape={c}}}Shape", type_name, attrs)
+            spec.variantSetNameList.prependedItems = ["shape"]
+            spec.variantSelections["shape"] = choices[i % 3]
 
 
 KINDS = {
