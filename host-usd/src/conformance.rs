@@ -1,12 +1,15 @@
 //! Conformance against Pixar's answers: a `*.expected.json` beside a USD file holds what
 //! Pixar's own library computes (stage metadata; per prim its type, world matrix, bound
-//! material, point and face counts). [`check`] recomputes each with host-usd and reports
-//! every difference; world matrices must agree to 1e-9.
+//! material, point and face counts; PointInstancer instance transforms; how many gprims,
+//! meshes and instances a renderer draws). [`check`] recomputes each with host-usd and
+//! reports every difference; world matrices must agree to 1e-9.
 
 use crate::import;
+use crate::instancer;
 use crate::mesh;
-use crate::stage::Value;
+use crate::stage::{Stage, Value};
 use crate::xform::WorldTransforms;
+use glam::DMat4;
 use serde_json::Value as Json;
 use std::path::{Path, PathBuf};
 
@@ -20,6 +23,8 @@ pub struct Report {
     pub matrices: usize,
     pub materials: usize,
     pub meshes: usize,
+    /// PointInstancer instance transforms compared.
+    pub instances: usize,
     pub max_matrix_error: f64,
     pub mismatches: Vec<String>,
 }
@@ -37,7 +42,8 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     let want: Json = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", expected.display()))?;
     let stage = import::open(usd).map_err(|e| e.to_string())?;
     let mut r = Report::default();
-    let mut mismatch = |m: String| r.mismatches.push(m);
+    let mut mismatches = Vec::new();
+    let mut mismatch = |m: String| mismatches.push(m);
 
     let meta = &want["stage"];
     let up = stage.metadata("upAxis")?.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| "Y".into());
@@ -76,18 +82,9 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
                 mismatch(format!("{path}: {key} Pixar {} host-usd {ours}", want[key]));
             }
         }
-        if let Some(rows) = want["world"].as_array() {
+        if want.get("world").is_some() {
             n_mat += 1;
-            let m = worlds.world(&stage, path)?.to_cols_array();
-            // glam's columns are USD's rows.
-            let mut prim_err = 0.0f64;
-            for (i, row) in rows.iter().enumerate() {
-                for (j, w) in row.as_array().into_iter().flatten().enumerate() {
-                    let w = w.as_f64().unwrap_or(f64::NAN);
-                    let err = (m[4 * i + j] - w).abs() / w.abs().max(1.0);
-                    prim_err = prim_err.max(if err.is_nan() { f64::INFINITY } else { err });
-                }
-            }
+            let prim_err = matrix_error(&worlds.world(&stage, path)?, &want["world"]);
             if prim_err > MATRIX_TOLERANCE {
                 mismatch(format!("{path}: world matrix differs from Pixar's by {prim_err:.3e}"));
             }
@@ -130,12 +127,98 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
             }
         }
     }
+    if let Some(instancers) = want["instancers"].as_object() {
+        for (path, w) in instancers {
+            let (n, err) = check_instancer(&stage, path, w, &mut mismatch)?;
+            r.instances += n;
+            max_err = max_err.max(err);
+        }
+    }
+    if let Some(counts) = want.get("counts") {
+        check_counts(usd, counts, &mut mismatch)?;
+    }
+    r.mismatches = mismatches;
     r.prims = prims.len();
     r.matrices = n_mat;
     r.materials = n_bind;
     r.meshes = n_mesh;
     r.max_matrix_error = max_err;
     Ok(r)
+}
+
+/// The largest difference of a matrix entry from Pixar's rows (relative to max(1, |entry|));
+/// infinite when Pixar's answer is not a 4 × 4 matrix of numbers.
+fn matrix_error(ours: &DMat4, rows: &Json) -> f64 {
+    // glam's columns are USD's rows.
+    let m = ours.to_cols_array();
+    let mut err = 0.0f64;
+    for i in 0..4 {
+        for j in 0..4 {
+            let w = rows[i][j].as_f64().unwrap_or(f64::NAN);
+            let e = (m[4 * i + j] - w).abs() / w.abs().max(1.0);
+            err = err.max(if e.is_nan() { f64::INFINITY } else { e });
+        }
+    }
+    err
+}
+
+/// One PointInstancer: which instances are visible, their prototypes, and the transforms Pixar
+/// saved (those of the first visible instances, in order; Pixar's include the prototype root's
+/// own transform). Returns the transforms compared and their largest error.
+fn check_instancer(
+    stage: &Stage,
+    path: &str,
+    w: &Json,
+    mismatch: &mut impl FnMut(String),
+) -> Result<(usize, f64), String> {
+    let (protos, instances) = instancer::read(stage, path)?;
+    let mask: Vec<bool> = w["mask"].as_array().into_iter().flatten().filter_map(Json::as_bool).collect();
+    let visible: Vec<usize> = instances.iter().map(|i| i.index).collect();
+    // An empty mask: every instance is visible.
+    let n = w["protoIndices"].as_array().map_or(0, Vec::len);
+    let want_visible: Vec<usize> = (0..n).filter(|&i| mask.get(i).copied().unwrap_or(mask.is_empty())).collect();
+    if visible != want_visible {
+        mismatch(format!(
+            "{path}: visible instances differ from Pixar's ({} vs {})",
+            visible.len(),
+            want_visible.len()
+        ));
+        return Ok((0, 0.0));
+    }
+    let transforms = w["transforms"].as_array().map_or(&[][..], Vec::as_slice);
+    let total = w["instanceCount"].as_u64().map_or(transforms.len(), |c| c as usize);
+    if total != instances.len() || transforms.len() > instances.len() {
+        mismatch(format!("{path}: {} instances, Pixar {total}", instances.len()));
+        return Ok((0, 0.0));
+    }
+    let mut worlds = WorldTransforms::default();
+    let mut max_err = 0.0f64;
+    for (inst, rows) in instances.iter().zip(transforms) {
+        if w["protoIndices"][inst.index].as_u64() != Some(inst.prototype as u64) {
+            mismatch(format!("{path}: instance {} prototype differs from Pixar's", inst.index));
+        }
+        let root = &protos[inst.prototype];
+        let ours = inst.transform * worlds.relative_to(stage, root, root)?;
+        let err = matrix_error(&ours, rows);
+        if err > MATRIX_TOLERANCE {
+            mismatch(format!("{path}: instance {} transform differs from Pixar's by {err:.3e}", inst.index));
+        }
+        max_err = max_err.max(err);
+    }
+    Ok((transforms.len(), max_err))
+}
+
+/// How many gprims, meshes and instances the import draws, against Pixar's count of those a
+/// viewer draws.
+fn check_counts(usd: &Path, want: &Json, mismatch: &mut impl FnMut(String)) -> Result<(), String> {
+    let scene = import::load(usd).map_err(|e| e.to_string())?;
+    let c = &scene.counts;
+    for (key, ours) in [("gprims", c.gprims), ("meshes", c.meshes), ("instances", c.instances)] {
+        if want[key].as_u64() != Some(ours as u64) {
+            mismatch(format!("{key}: Pixar {} host-usd {ours}", want[key]));
+        }
+    }
+    Ok(())
 }
 
 /// Every USD file under `dir` (recursively) with a `<stem>.expected.json` beside it.

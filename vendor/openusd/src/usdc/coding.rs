@@ -14,15 +14,6 @@ const SMALL: u8 = 1;
 const MEDIUM: u8 = 2;
 const LARGE: u8 = 3;
 
-pub fn encoded_buffer_size<T: PrimInt>(count: usize) -> usize {
-    if count == 0 {
-        0
-    } else {
-        let sz = mem::size_of::<T>();
-        sz + (count * 2).div_ceil(8) + (sz * count)
-    }
-}
-
 pub fn decode_ints<T: PrimInt + 'static>(data: &[u8], count: usize) -> Result<Vec<T>>
 where
     i64: AsPrimitive<T>,

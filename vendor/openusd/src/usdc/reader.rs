@@ -16,7 +16,6 @@ use crate::{
     gf,
     sdf::{self, Value},
     tf,
-    usdc::coding,
 };
 
 use super::layout::*;
@@ -60,46 +59,10 @@ impl<R> CrateFile<R> {
     }
 }
 
-/// ppis patch: a corrupt count must not size an allocation larger than the file could
-/// hold. LZ4 expands at most 255×, so no count read from the file may exceed 256 × its
-/// length, and a plain array read must fit in the bytes that remain. (Unpatched, a flipped
-/// byte made 0.6.0 allocate terabytes and abort the process.)
-const MAX_EXPANSION: u64 = 256;
+#[path = "bounded.rs"]
+mod bounded;
 
 impl<R: io::Read + io::Seek> CrateFile<R> {
-    /// (position, length) of the underlying stream.
-    fn stream_bounds(&mut self) -> Result<(u64, u64)> {
-        let pos = self.reader.stream_position()?;
-        let len = self.reader.seek(io::SeekFrom::End(0))?;
-        self.reader.seek(io::SeekFrom::Start(pos))?;
-        Ok((pos, len))
-    }
-
-    /// A count no larger than the file could hold, even compressed.
-    fn check_count(&mut self, count: usize) -> Result<usize> {
-        let (_, len) = self.stream_bounds()?;
-        ensure!(
-            (count as u64) <= MAX_EXPANSION.saturating_mul(len).saturating_add(1024),
-            "corrupt file: a count of {count} exceeds what {len} bytes can hold"
-        );
-        Ok(count)
-    }
-
-    fn read_bounded_count(&mut self) -> Result<usize> {
-        let count = self.reader.read_count()?;
-        self.check_count(count)
-    }
-
-    fn read_bounded_vec<T: Default + NoUninit + AnyBitPattern>(&mut self, count: usize) -> Result<Vec<T>> {
-        let (pos, len) = self.stream_bounds()?;
-        let bytes = (count as u64).saturating_mul(mem::size_of::<T>() as u64);
-        ensure!(
-            bytes <= len.saturating_sub(pos),
-            "corrupt file: an array of {count} elements runs past the end of the file"
-        );
-        self.reader.read_vec(count)
-    }
-
     /// Read structural sections of a crate file.
     pub fn open(mut reader: R) -> Result<Self> {
         let bootstrap = Self::read_header(&mut reader)?;
@@ -202,7 +165,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     fn read_sections(&mut self) -> Result<()> {
         self.set_position(self.bootstrap.toc_offset)?;
 
-        let count = self.read_bounded_count()?;
+        let count = self.reader.read_count()?;
         ensure!(count > 0, "Crate file has no sections");
         ensure!(count < 64, "Suspiciously large number of sections: {count}");
 
@@ -221,12 +184,12 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         let file_ver = self.version();
 
         // Read the number of tokens.
-        let count = self.read_bounded_count()?;
+        let count = self.reader.read_count()?;
 
         self.tokens = if file_ver < version(0, 4, 0) {
             todo!("Support TOKENS reader for < 0.4.0 files");
         } else {
-            let uncompressed_size = self.read_bounded_count()?;
+            let uncompressed_size = self.reader.read_count()?;
             let mut buffer = self.read_compressed(uncompressed_size)?;
 
             ensure!(
@@ -278,7 +241,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
         self.set_position(section.start)?;
 
-        let count = self.read_bounded_count()?;
+        let count = self.reader.read_count()?;
         ensure!(
             count < 128 * 1024 * 1024,
             "Suspiciously large number of strings: {count}"
@@ -304,23 +267,19 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         self.fields = if file_ver < version(0, 4, 0) {
             todo!("Support FIELDS reader before < 0.4.0")
         } else {
-            let field_count = self.read_bounded_count()?;
+            let field_count = self.reader.read_count()?;
 
             // Compressed fields in 0.4.0.
-            let indices = self.read_encoded_ints(field_count)?;
+            let indices: Vec<u32> = self.read_encoded_ints(field_count)?;
 
             // Compressed value reps.
-            let reps = self.read_compressed(field_count)?;
+            let reps: Vec<u64> = self.read_compressed(field_count)?;
 
-            let fields: Vec<_> = indices
+            indices
                 .iter()
                 .zip(reps.iter())
                 .map(|(index, value)| Field::new(*index, *value))
-                .collect();
-
-            debug_assert_eq!(fields.len(), field_count);
-
-            fields
+                .collect()
         };
 
         Ok(())
@@ -338,7 +297,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         self.fieldsets = if file_ver < version(0, 4, 0) {
             todo!("Support FIELDSETS reader for < 0.4.0 files");
         } else {
-            let count = self.read_bounded_count()?;
+            let count = self.reader.read_count()?;
 
             let decoded = self.read_encoded_ints::<u32>(count)?;
 
@@ -372,19 +331,17 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             todo!("Support PATHS reader for < 0.4.0 files");
         } else {
             // Read # of paths.
-            let path_count = self.read_bounded_count()?;
-            self.paths = vec![sdf::Path::default(); path_count];
-
-            self.read_compressed_paths()?;
+            let path_count = self.reader.read_count()?;
+            self.read_compressed_paths(path_count)?;
         };
 
         Ok(())
     }
 
     /// Read compressed paths.
-    fn read_compressed_paths(&mut self) -> Result<()> {
+    fn read_compressed_paths(&mut self, path_count: usize) -> Result<()> {
         // Read number of encoded paths.
-        let count: usize = self.read_bounded_count()?;
+        let count: usize = self.reader.read_count()?;
 
         // Read compressed data.
 
@@ -396,6 +353,22 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
         let jumps = self.read_encoded_ints::<i32>(count)?;
         debug_assert_eq!(jumps.len(), count);
+
+        // ppis patch: the path slots are allocated once the encoded paths that fill them are
+        // decoded. Pixar's writer encodes every path of its table but the empty one, which
+        // the table holds at most once; every index is checked as Pixar's
+        // PXR_PREFER_SAFETY_OVER_SPEED build does.
+        ensure!(
+            path_count <= count.saturating_add(1),
+            "corrupt file: {path_count} paths but {count} encoded paths"
+        );
+        if let Some(i) = path_indexes.iter().find(|&&i| i as usize >= path_count) {
+            bail!("corrupt file: path index {i} of {path_count} paths");
+        }
+        if let Some(i) = element_token_indexes.iter().find(|i| i.unsigned_abs() as usize >= self.tokens.len()) {
+            bail!("corrupt file: path element token {i} of {} tokens", self.tokens.len());
+        }
+        self.paths = vec![sdf::Path::default(); path_count];
 
         self.build_compressed_paths(&path_indexes, &element_token_indexes, &jumps)?;
 
@@ -427,11 +400,19 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         }
 
         let mut pending = vec![(0usize, sdf::Path::default())];
+        // ppis patch: a valid jump table visits each entry once; a corrupt one may point past
+        // the end or make subtrees overlap, which would take exponential time.
+        let mut visits = 0usize;
 
         while let Some((mut current_index, mut parent_path)) = pending.pop() {
             loop {
                 let index = current_index;
                 current_index += 1;
+                visits += 1;
+                ensure!(
+                    index < jumps.len() && visits <= jumps.len(),
+                    "corrupt file: the paths' jump table does not describe a tree"
+                );
 
                 if parent_path.is_empty() {
                     parent_path = sdf::Path::new("/")?;
@@ -493,7 +474,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         } else {
             // Version 0.4.0 specs are compressed
 
-            let spec_count = self.read_bounded_count()?;
+            let spec_count = self.reader.read_count()?;
 
             let path_indexes = self.read_encoded_ints::<u32>(spec_count)?;
             let fieldset_indexes = self.read_encoded_ints::<u32>(spec_count)?;
@@ -577,56 +558,6 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
     /// Reads a lz4 compressed data and returns decompressed raw bytes.
     ///
-    /// Format expected:
-    /// - u64 uncompressed size
-    /// - lz4 compressed block of data.
-    ///
-    /// # Arguments:
-    /// - `estimated_size`: Size enough to hold uncompressed data.
-    fn read_compressed<T: Default + NoUninit + AnyBitPattern>(&mut self, estimated_count: usize) -> Result<Vec<T>> {
-        // Read data to memory.
-        let compressed_size = self.read_bounded_count()?;
-        let (pos, len) = self.stream_bounds()?;
-        ensure!(
-            compressed_size as u64 <= len.saturating_sub(pos),
-            "corrupt file: a compressed block of {compressed_size} bytes runs past the end of the file"
-        );
-        ensure!(
-            (estimated_count as u64).saturating_mul(mem::size_of::<T>() as u64)
-                <= MAX_EXPANSION.saturating_mul(compressed_size as u64).saturating_add(1024),
-            "corrupt file: {estimated_count} elements cannot come out of {compressed_size} compressed bytes"
-        );
-        let mut input = vec![0_u8; compressed_size];
-        self.reader.read_exact(&mut input)?;
-
-        // Decompress to output buffer.
-        let mut output = vec![T::default(); estimated_count];
-        let actual_size = decompress_lz4(&input, cast_slice_mut(&mut output))?;
-
-        let actual_count = actual_size / mem::size_of::<T>();
-
-        if actual_count < output.len() {
-            output.truncate(actual_count);
-        }
-
-        Ok(output)
-    }
-
-    /// Reads sequence of compressed integers.
-    fn read_encoded_ints<T: PrimInt + 'static>(&mut self, count: usize) -> Result<Vec<T>>
-    where
-        i64: AsPrimitive<T>,
-    {
-        let estimated_size = coding::encoded_buffer_size::<u32>(count);
-
-        let buffer = self.read_compressed::<u8>(estimated_size)?;
-
-        let ints = coding::decode_ints(buffer.as_slice(), count)?;
-        debug_assert_eq!(ints.len(), count);
-
-        Ok(ints)
-    }
-
     const MIN_COMPRESSED_ARRAY_SIZE: usize = 4;
 
     // Implements various logic and compatibility checks to figure out the array length and whether it's compressed.
@@ -677,7 +608,8 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             self.reader.read_pod::<u64>()? as usize
         };
 
-        let count = self.check_count(count)?;
+        // The count is bounded where the elements are read: by the bytes that remain, or by
+        // what the compressed block decodes to.
         if count < Self::MIN_COMPRESSED_ARRAY_SIZE {
             compressed = false;
         }
@@ -732,12 +664,11 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                         "Read invalid number of indexes to decompress doubles array"
                     );
 
-                    let mut output = vec![T::zero(); count];
-                    for (i, index) in indexes.into_iter().enumerate() {
-                        output[i] = lut[index as usize];
-                    }
-
-                    output
+                    indexes
+                        .into_iter()
+                        .map(|i| lut.get(i as usize).copied())
+                        .collect::<Option<Vec<T>>>()
+                        .context("corrupt file: a lookup-table index out of range")?
                 }
                 _ => bail!("Invalid compressed double array code: {code}"),
             }
@@ -793,7 +724,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     /// Reads a count-prefixed vector of `u32` indices and maps each through
     /// `lookup` to produce the element value.
     fn read_indexed_vec<T>(&mut self, lookup: impl Fn(&Self, usize) -> T) -> Result<Vec<T>> {
-        let count = self.read_bounded_count()?;
+        let count = self.reader.read_count()?;
         let indices = self.read_bounded_vec::<u32>(count)?;
 
         Ok(indices.into_iter().map(|index| lookup(self, index as usize)).collect())
@@ -813,7 +744,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
     /// Reads a count-prefixed vector of POD values.
     fn read_pod_vec<T: Default + NoUninit + AnyBitPattern>(&mut self) -> Result<Vec<T>> {
-        let count = self.read_bounded_count()?;
+        let count = self.reader.read_count()?;
         self.read_bounded_vec(count)
     }
 
@@ -888,7 +819,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     /// depth (a guard or an explicit stack), as `build_compressed_paths` does
     /// for wide path trees.
     fn read_custom_data(&mut self) -> Result<HashMap<String, Value>> {
-        let mut count = self.read_bounded_count()?;
+        let mut count = self.read_count_of(20)?;
         let mut dict = HashMap::default();
 
         while count > 0 {
@@ -948,7 +879,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             return Ok(Vec::default());
         }
 
-        let flat: Vec<T> = self.read_bounded_vec(count * N)?;
+        let flat: Vec<T> = self.read_bounded_vec(count.saturating_mul(N))?;
 
         // Reinterpret the flat vec as a vec of fixed-size arrays. `chunks_exact(N)`
         // always yields slices of exactly N elements, so `try_into` cannot fail.
@@ -1253,7 +1184,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 ensure!(!value.is_inlined());
 
                 let list = self.read_list_op(value, |file: &mut Self| {
-                    let count = file.read_bounded_count()?;
+                    let count = file.read_count_of(32)?;
                     let mut vec = Vec::with_capacity(count);
 
                     for _ in 0..count {
@@ -1336,7 +1267,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
                 self.set_position(value.payload())?;
 
-                let count = self.read_bounded_count()?;
+                let count = self.reader.read_count()?;
                 let vec = self.read_bounded_vec(count)?;
 
                 sdf::Value::LayerOffsetVec(vec)
@@ -1355,7 +1286,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
             Type::PayloadListOp => {
                 let list = self.read_list_op(value, |file: &mut Self| {
-                    let count = file.read_bounded_count()?;
+                    let count = file.read_count_of(8)?;
                     let mut vec = Vec::with_capacity(count);
                     for _ in 0..count {
                         let payload = file.read_payload()?;
@@ -1375,7 +1306,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
                 self.set_position(value.payload())?;
 
-                let count = self.read_bounded_count()?;
+                let count = self.read_count_of(8)?;
                 let mut map = HashMap::with_capacity(count);
 
                 for _ in 0..count {
@@ -1416,7 +1347,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
                 self.apply_recursive_offset()?;
 
-                let count = self.read_bounded_count()?;
+                let count = self.reader.read_count()?;
                 ensure!(count == times.len(), "Invalid time samples count");
 
                 let value_reps = self.read_bounded_vec::<ValueRep>(count)?;
@@ -1479,7 +1410,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             Type::Relocates => {
                 ensure!(!value.is_inlined());
                 self.set_position(value.payload())?;
-                let count = self.read_bounded_count()?;
+                let count = self.read_count_of(8)?;
                 let mut pairs = Vec::with_capacity(count);
                 for _ in 0..count {
                     let src_idx: u32 = self.reader.read_pod()?;
