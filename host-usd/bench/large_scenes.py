@@ -108,7 +108,8 @@ def measure(ppis, scene):
                "-o", os.path.join(tmp, "r.exr"), "--stats-json", stats]
         run = subprocess.run(cmd, capture_output=True, text=True)
         if run.returncode != 0:
-            return {"error": run.stderr.strip().splitlines()[-1]}
+            errors = [line for line in run.stderr.splitlines() if line.startswith("ppis: error")]
+            return {"error": (errors or ["exit status %d" % run.returncode])[0]}
         peak_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", run.stderr).group(1))
         wall = re.search(r"Elapsed \(wall clock\) time.*: (.*)", run.stderr).group(1)
         with open(stats) as f:
