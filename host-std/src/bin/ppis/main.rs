@@ -104,7 +104,7 @@ struct SamplingArgs {
     brdf_samples: u32,
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Worker threads (default: all cores).
+    /// Worker threads, for the BVH and environment builds and the render (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
     threads: Option<u32>,
     /// Image width, overriding the scene's camera.
@@ -308,13 +308,16 @@ fn render_command(args: RenderArgs) -> Result<()> {
     args.sampling.resize(&mut scene);
     let load_seconds_scene = t_load.elapsed().as_secs_f64();
 
-    // Preprocess: only what this render uses.
+    // Preprocess (only what this render uses) and render on --threads threads.
+    let threads = args.sampling.threads();
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let environment = match &scene.env {
-        Some((source, placement)) => Some(Environment::build(source, *placement)?),
+        Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
         None => None,
     };
     let t_bvh = Instant::now();
-    let bvh = Bvh::build(&scene);
+    let bvh = pool.install(|| Bvh::build(&scene));
     let bvh_seconds = t_bvh.elapsed().as_secs_f64();
     if let Some(env) = &environment
         && env.stats.sanitized > 0
@@ -325,9 +328,6 @@ fn render_command(args: RenderArgs) -> Result<()> {
         );
     }
 
-    let threads = args.sampling.threads();
-    let pool =
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let settings = Settings {
         method: args.method,
         spp: args.spp as usize,
