@@ -21,6 +21,8 @@ fn fails(dir: &Path, args: &[&str], needle: &str) {
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(stderr.contains(needle), "{args:?}: stderr does not mention {needle:?}: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: one line: {stderr}");
+    assert!(stderr.starts_with("ppis: error: "), "{args:?}: {stderr}");
     // Each cause said once (an error's source printed again after its own message read
     // "…: No such file or directory (os error 2): No such file or directory (os error 2)").
     for line in stderr.lines() {
@@ -41,6 +43,11 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["render", "--spp", "6", "--shading-points", "4"], "--shading-points");
     fails(dir, &["render", "--env", "nothere.exr"], "nothere.exr");
     fails(dir, &["render", "scene.txt"], "scene.txt");
+    // Usage errors too.
+    fails(dir, &["render", "--no-such-flag"], "--no-such-flag");
+    fails(dir, &["bogus"], "bogus");
+    fails(dir, &[], "render");
+    fails(dir, &["render", "--render-settings", "/Render/S"], "USD");
 
     // Broken files.
     std::fs::write(dir.join("bad.json"), "{ \"camera\": 3 }").unwrap();

@@ -155,8 +155,32 @@ fn parse_method(s: &str) -> Result<Method, String> {
     s.parse()
 }
 
+/// The command line, or the one-line error (exit 2) a failure to parse it is; help and the
+/// version print as clap prints them.
+fn parse_command_line() -> Cli {
+    use clap::error::ErrorKind;
+    match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => e.exit(),
+        Err(e) => {
+            let line = match e.kind() {
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    "no command given: render, info or report (see ppis --help)".to_string()
+                }
+                _ => {
+                    let text = e.render().to_string();
+                    let first = text.lines().next().unwrap_or_default().trim_start_matches("error: ").to_string();
+                    format!("{first} (see --help)")
+                }
+            };
+            eprintln!("ppis: error: {line}");
+            std::process::exit(2);
+        }
+    }
+}
+
 fn main() {
-    let cli = Cli::parse();
+    let cli = parse_command_line();
     let result = match cli.command {
         Command::Render(args) => render_command(args),
         Command::Info(args) => info_command(args),
