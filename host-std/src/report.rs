@@ -178,13 +178,20 @@ pub fn sweep(
     if let Some(target) = bracket {
         bracket_base(&mut out, methods, target, &mut measure);
     }
+    keep_fastest(&mut out, repeat, |method, spp| {
+        render::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }).render_seconds
+    });
+    out
+}
+
+/// Times every measurement `repeat − 1` more times with `time`, in rounds over all of them
+/// (a slow spell of the machine falls on every method alike), and keeps each one's fastest.
+fn keep_fastest(out: &mut [Measurement], repeat: usize, mut time: impl FnMut(Method, usize) -> f64) {
     for _ in 1..repeat {
-        for m in &mut out {
-            let again = render::render(scene, bvh, env, &Settings { progress: false, ..settings(m.method, m.spp) });
-            m.seconds = m.seconds.min(again.render_seconds);
+        for m in out.iter_mut() {
+            m.seconds = m.seconds.min(time(m.method, m.spp));
         }
     }
-    out
 }
 
 /// Renders every method but `target` on at doubling spp until it reaches `target`'s time at its
@@ -411,6 +418,23 @@ mod tests {
     fn m(method: Method, spp: usize, seconds: f64, relmse: f64) -> Measurement {
         let regions = vec![("carpaint".into(), 0.0, relmse / 2.0)];
         Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse, regions, plans: Vec::new() }
+    }
+
+    #[test]
+    fn repeats_keep_each_renders_fastest_time_in_rounds() {
+        let mut out = [m(Method::Env, 4, 3.0, 0.1), m(Method::Mis, 4, 2.0, 0.1)];
+        // Round 1: a slow spell (both slower than their first run); round 2: both faster.
+        let times = [9.0, 9.0, 1.5, 0.5];
+        let (mut calls, mut order) = (0, Vec::new());
+        keep_fastest(&mut out, 3, |method, _| {
+            order.push(method);
+            calls += 1;
+            times[calls - 1]
+        });
+        assert_eq!(order, [Method::Env, Method::Mis, Method::Env, Method::Mis], "rounds over all renders");
+        assert_eq!((out[0].seconds, out[1].seconds), (1.5, 0.5));
+        // One run: no more timing.
+        keep_fastest(&mut out, 1, |_, _| panic!("timed again"));
     }
 
     #[test]
