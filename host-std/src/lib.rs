@@ -10,6 +10,7 @@ pub mod integrator;
 pub mod mesh;
 pub mod output;
 pub mod pilot;
+pub mod ply;
 pub mod render;
 pub mod report;
 pub mod resample;

@@ -1,4 +1,4 @@
-//! Triangle meshes from OBJ (`tobj`) and PLY (`ply-rs-bw`) files: positions and triangles only
+//! Triangle meshes from OBJ (`tobj`) and PLY (`ply.rs`) files: positions and triangles only
 //! (the scene format uses face normals). Polygons are fan-triangulated; indices are checked.
 
 use sampler_core::glam::Vec3;
@@ -54,51 +54,5 @@ fn load_obj(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), Mes
 }
 
 fn load_ply(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), MeshError> {
-    use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
-    let decode = |message: String| MeshError::Decode { path: path.to_owned(), format: "PLY", message };
-    let mut reader = std::io::BufReader::new(bytes);
-    let ply = Parser::<DefaultElement>::new().read_ply(&mut reader).map_err(|e| decode(e.to_string()))?;
-    let scalar = |p: Option<&Property>| -> Option<f32> {
-        Some(match p? {
-            Property::Float(v) => *v,
-            Property::Double(v) => *v as f32,
-            Property::Int(v) => *v as f32,
-            Property::UInt(v) => *v as f32,
-            Property::Short(v) => *v as f32,
-            Property::UShort(v) => *v as f32,
-            Property::Char(v) => *v as f32,
-            Property::UChar(v) => *v as f32,
-            _ => return None,
-        })
-    };
-    let vertices = ply.payload.get("vertex").ok_or_else(|| decode("no vertex element".into()))?;
-    let mut positions = Vec::with_capacity(vertices.len());
-    for v in vertices {
-        let p = (scalar(v.get("x")), scalar(v.get("y")), scalar(v.get("z")));
-        match p {
-            (Some(x), Some(y), Some(z)) => positions.push(Vec3::new(x, y, z)),
-            _ => return Err(decode("a vertex lacks numeric x, y, z".into())),
-        }
-    }
-    let mut triangles = Vec::new();
-    for f in ply.payload.get("face").map(Vec::as_slice).unwrap_or(&[]) {
-        let list = f.get("vertex_indices").or_else(|| f.get("vertex_index"));
-        let idx: Vec<i64> = match list {
-            Some(Property::ListInt(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(Property::ListUInt(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(Property::ListShort(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(Property::ListUShort(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(Property::ListChar(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(Property::ListUChar(l)) => l.iter().map(|&i| i as i64).collect(),
-            _ => return Err(decode("a face lacks an integer vertex_indices list".into())),
-        };
-        if idx.iter().any(|&i| i < 0 || i > u32::MAX as i64) {
-            return Err(decode("a face has a negative vertex index".into()));
-        }
-        for k in 2..idx.len() {
-            triangles.push([idx[0] as u32, idx[k - 1] as u32, idx[k] as u32]);
-        }
-    }
-    Ok((positions, triangles))
+    crate::ply::parse(bytes).map_err(|message| MeshError::Decode { path: path.to_owned(), format: "PLY", message })
 }
