@@ -1,6 +1,6 @@
 //! `auto`'s pilot checks the rules' plan per material by measurement: not env sampling for a
 //! glossy sphere under a smooth sky (measured away), not BRDF sampling for a matte one under a
-//! sun (never a candidate there: a pilot would not see the rare sun hits), env sampling in a
+//! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
 //! matte studio where it measures twice as good as the rules' MIS.
 
 use host_std::bvh::Bvh;
@@ -70,8 +70,16 @@ fn a_glossy_sphere_under_a_smooth_sky_is_not_env_sampled() {
 
 #[test]
 fn a_matte_sphere_under_the_sun_is_not_brdf_sampled() {
-    let env = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
-    let plan = chosen(&sphere(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5)))), &env, 64, 3);
+    // BRDF sampling is a candidate only where the lighting is smooth: a pilot of a few dozen
+    // pixels would not see the rare cosine samples that hit the sun, and would score BRDF
+    // sampling by the sky alone. Under a constant dome it is a candidate; under the sun not.
+    let matte = Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5)));
+    let brdf = pilot::PLANS.iter().position(|p| p.0 == Method::Brdf).expect("BRDF sampling is a plan");
+    let sun = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
+    let dome = Environment::build(&EnvSource::Constant { level: 3 }, Placement::default()).unwrap();
+    assert!(!pilot::eligible(brdf, &matte, sun.hierarchy().peak(5)), "not a candidate under the sun");
+    assert!(pilot::eligible(brdf, &matte, dome.hierarchy().peak(5)), "a candidate under a constant dome");
+    let plan = chosen(&sphere(matte), &sun, 64, 3);
     assert!(!plan.starts_with("brdf"), "matte under the sun → {plan}");
 }
 

@@ -30,8 +30,10 @@ fn variance(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (mean, m2 / n)
 }
 
+/// Both claims of the module's note: product ≤ 0.5× the better baseline on the wide and glossy
+/// lobes, product-MIS ≤ ⅓× plain product on the needles.
 #[test]
-fn product_sampling_beats_env_and_brdf_sampling() {
+fn product_beats_env_and_brdf_sampling_and_product_mis_beats_product_on_needles() {
     let envs = [("smooth", TestEnv::random_smooth(7, 21)), ("sun", TestEnv::sun(8, (150, 90), 1e4))];
     let brdfs: Vec<(&str, Box<dyn Brdf>, bool)> = vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.6))), false),
