@@ -22,7 +22,7 @@ pub enum LoadError {
     Decode { path: PathBuf, format: &'static str, message: String },
     #[error("{path}: the image is empty (zero width or height)")]
     Empty { path: PathBuf },
-    #[error("{path}: unsupported image format (expected .exr, .hdr, .png, .jpg or .jpeg)")]
+    #[error("{path}: unsupported image format (expected .exr, .hdr, .png, .jpg, .jpeg or .tga)")]
     Unsupported { path: PathBuf },
     #[error("{path}: support for {format} images was left out of this build (cargo feature `{feature}`)")]
     FeatureDisabled { path: PathBuf, format: &'static str, feature: &'static str },
@@ -56,6 +56,7 @@ pub fn load_bytes_as(path: &Path, bytes: &[u8], srgb: Option<bool>) -> Result<Rg
         "hdr" => load_with_image(path, bytes, "Radiance HDR", image_format("hdr", path)?, srgb),
         "png" => load_with_image(path, bytes, "PNG", image::ImageFormat::Png, srgb),
         "jpg" | "jpeg" => load_with_image(path, bytes, "JPEG", image_format("jpeg", path)?, srgb),
+        "tga" => load_with_image(path, bytes, "TGA", image_format("tga", path)?, srgb),
         _ => Err(LoadError::Unsupported { path: path.to_owned() }),
     }
 }
@@ -66,9 +67,15 @@ fn image_format(which: &'static str, path: &Path) -> Result<image::ImageFormat, 
         "hdr" => Ok(image::ImageFormat::Hdr),
         #[cfg(feature = "jpeg")]
         "jpeg" => Ok(image::ImageFormat::Jpeg),
+        #[cfg(feature = "tga")]
+        "tga" => Ok(image::ImageFormat::Tga),
         _ => Err(LoadError::FeatureDisabled {
             path: path.to_owned(),
-            format: if which == "hdr" { "Radiance HDR" } else { "JPEG" },
+            format: match which {
+                "hdr" => "Radiance HDR",
+                "tga" => "TGA",
+                _ => "JPEG",
+            },
             feature: which,
         }),
     }

@@ -1,4 +1,4 @@
-//! Bad files never panic: valid EXR, Radiance HDR and PNG files, truncated and with bytes
+//! Bad files never panic: valid EXR, Radiance HDR, PNG and TGA files, truncated and with bytes
 //! flipped (proptest), decode to `Ok` or a clean error — never a panic — and no single
 //! allocation made while decoding exceeds what the file could hold (decoded RGB of 1000× the
 //! file's size or 64 MB, the loader's own bound, plus the decoders' fixed buffers).
@@ -56,12 +56,16 @@ fn make_files() -> Vec<(&'static str, Vec<u8>)> {
     image::DynamicImage::ImageRgb32F(image.clone())
         .write_to(&mut std::io::Cursor::new(&mut hdr), image::ImageFormat::Hdr)
         .unwrap();
-    let mut png = Vec::new();
-    image::DynamicImage::ImageRgb32F(image)
-        .to_rgb8()
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .unwrap();
-    vec![("x.exr", exr), ("x.hdr", hdr), ("x.png", png)]
+    let encode = |format| {
+        let mut out = Vec::new();
+        image::DynamicImage::ImageRgb32F(image.clone())
+            .to_rgb8()
+            .write_to(&mut std::io::Cursor::new(&mut out), format)
+            .unwrap();
+        out
+    };
+    let (png, tga) = (encode(image::ImageFormat::Png), encode(image::ImageFormat::Tga));
+    vec![("x.exr", exr), ("x.hdr", hdr), ("x.png", png), ("x.tga", tga)]
 }
 
 /// Decodes `bytes` as `name`; returns the decoder's largest single allocation, or the panic.
@@ -102,7 +106,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 600, failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
-    fn mutated_files_never_panic(kind in 0usize..3, cut in 0.0f64..1.0, flips in proptest::collection::vec((0.0f64..1.0, any::<u8>()), 0..8)) {
+    fn mutated_files_never_panic(kind in 0usize..4, cut in 0.0f64..1.0, flips in proptest::collection::vec((0.0f64..1.0, any::<u8>()), 0..8)) {
         let files = valid_files();
         let (name, original) = &files[kind];
         let mut bytes = original.clone();
