@@ -2,6 +2,7 @@
 //! [`UsdScene`], recording everything it leaves out.
 
 use crate::error::UsdError;
+use crate::inherit::Hidden;
 use crate::material::Material;
 use crate::mesh::{self, LocalMesh};
 use crate::scene::{Counts, Mesh, Skip, Sphere, UpAxis, UsdScene};
@@ -32,6 +33,7 @@ struct Importer<'a> {
     stage: &'a Stage,
     conversion: DMat4,
     worlds: WorldTransforms,
+    hidden: Hidden,
     scene: UsdScene,
     materials: HashMap<String, usize>,
 }
@@ -99,6 +101,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         stage: &stage,
         conversion: up_axis_conversion(up_axis == UpAxis::Z),
         worlds: WorldTransforms::default(),
+        hidden: Hidden::default(),
         scene,
         materials: HashMap::new(),
     };
@@ -194,11 +197,8 @@ impl Importer<'_> {
     }
 
     /// Invisible, or a proxy/guide purpose.
-    fn hidden(&self, prim: &str) -> Result<bool, String> {
-        if self.stage.is_invisible(prim)? {
-            return Ok(true);
-        }
-        Ok(matches!(self.stage.purpose(prim)?.as_str(), "proxy" | "guide"))
+    fn hidden(&mut self, prim: &str) -> Result<bool, String> {
+        self.hidden.hidden(self.stage, prim)
     }
 
     fn instancer(&mut self, prim: &str, prims: &[String], world: &DMat4) -> Result<(), Failure> {
