@@ -38,7 +38,7 @@ pub fn resolve_down<T: Clone>(
 #[derive(Default)]
 pub struct Hidden {
     invisible: HashMap<String, bool>,
-    purpose: HashMap<String, String>,
+    purpose: HashMap<String, &'static str>,
 }
 
 impl Hidden {
@@ -50,9 +50,9 @@ impl Hidden {
         if invisible {
             return Ok(true);
         }
-        let purpose = resolve_down(&mut self.purpose, prim, "default".to_string(), |p, above| {
-            Ok(stage.authored_purpose(p)?.unwrap_or_else(|| above.clone()))
+        let purpose = resolve_down(&mut self.purpose, prim, "default", |p, above| {
+            Ok(stage.authored_purpose(p)?.unwrap_or(*above))
         })?;
-        Ok(matches!(purpose.as_str(), "proxy" | "guide"))
+        Ok(matches!(purpose, "proxy" | "guide"))
     }
 }

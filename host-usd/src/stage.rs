@@ -249,12 +249,14 @@ impl Stage {
 
     /// The purpose the prim itself authors, if any (an unknown token reads as
     /// `default`, as ComputePurpose does).
-    pub fn authored_purpose(&self, prim: &str) -> Result<Option<String>> {
-        Ok(match self.attr_metadata(prim, "purpose", "default")? {
-            Some(Value::Token(t)) if ["default", "render", "proxy", "guide"].contains(&t.as_str()) => Some(t),
-            Some(_) => Some("default".into()),
-            None => None,
-        })
+    pub fn authored_purpose(&self, prim: &str) -> Result<Option<&'static str>> {
+        let v = self.attr_metadata(prim, "purpose", "default")?;
+        Ok(v.map(|v| match v.token() {
+            Some("render") => "render",
+            Some("proxy") => "proxy",
+            Some("guide") => "guide",
+            _ => "default",
+        }))
     }
 
     /// The computed purpose token (`default`, `render`, `proxy`, `guide`).
