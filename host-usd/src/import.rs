@@ -135,20 +135,21 @@ impl Importer<'_> {
             let prim = prim.to_string();
             move |m: String| (prim, m)
         };
+        // Each prim's type, read once for both passes.
+        let types = prims.iter().map(|p| stage.type_name(p).map_err(fail(p))).collect::<Result<Vec<_>, _>>()?;
         // Prototypes render only through their instancers.
         let mut prototypes: Vec<String> = Vec::new();
-        for prim in prims {
-            if stage.type_name(prim).map_err(fail(prim))? == "PointInstancer" {
+        for (prim, t) in prims.iter().zip(&types) {
+            if t == "PointInstancer" {
                 prototypes.extend(stage.targets(prim, "prototypes").map_err(fail(prim))?);
             }
         }
         let in_prototype = |p: &str| prototypes.iter().any(|r| p == r || p.starts_with(&format!("{r}/")));
-        for prim in prims {
+        for (prim, type_name) in prims.iter().zip(&types) {
             self.scene.counts.prims += 1;
             if in_prototype(prim) {
                 continue;
             }
-            let type_name = stage.type_name(prim).map_err(fail(prim))?;
             let t = type_name.as_str();
             if GPRIMS.contains(&t) || t == "PointInstancer" {
                 if self.hidden(prim).map_err(fail(prim))? {
