@@ -2,6 +2,7 @@
 //! [`UsdScene`], recording everything it leaves out.
 
 use crate::error::UsdError;
+use crate::inherit::Hidden;
 use crate::material::Material;
 use crate::mesh::{self, LocalMesh};
 use crate::scene::{Counts, Mesh, Skip, Sphere, UpAxis, UsdScene};
@@ -45,6 +46,7 @@ struct Importer<'a> {
     stage: &'a Stage,
     conversion: DMat4,
     worlds: WorldTransforms,
+    hidden: Hidden,
     scene: UsdScene,
     materials: HashMap<String, usize>,
 }
@@ -113,6 +115,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         stage: &stage,
         conversion: up_axis_conversion(up_axis == UpAxis::Z),
         worlds: WorldTransforms::default(),
+        hidden: Hidden::default(),
         scene,
         materials: HashMap::new(),
     };
@@ -157,20 +160,21 @@ impl Importer<'_> {
             let prim = prim.to_string();
             move |m: String| (prim, m)
         };
+        // Each prim's type, read once for both passes.
+        let types = prims.iter().map(|p| stage.type_name(p).map_err(fail(p))).collect::<Result<Vec<_>, _>>()?;
         // Prototypes render only through their instancers.
         let mut prototypes: Vec<String> = Vec::new();
-        for prim in prims {
-            if stage.type_name(prim).map_err(fail(prim))? == "PointInstancer" {
+        for (prim, t) in prims.iter().zip(&types) {
+            if t == "PointInstancer" {
                 prototypes.extend(stage.targets(prim, "prototypes").map_err(fail(prim))?);
             }
         }
         let in_prototype = |p: &str| prototypes.iter().any(|r| p == r || p.starts_with(&format!("{r}/")));
-        for prim in prims {
+        for (prim, type_name) in prims.iter().zip(&types) {
             self.scene.counts.prims += 1;
             if in_prototype(prim) {
                 continue;
             }
-            let type_name = stage.type_name(prim).map_err(fail(prim))?;
             let t = type_name.as_str();
             if GPRIMS.contains(&t) || t == "PointInstancer" {
                 if self.hidden(prim).map_err(fail(prim))? {
@@ -219,11 +223,8 @@ impl Importer<'_> {
     }
 
     /// Invisible, or a proxy/guide purpose.
-    fn hidden(&self, prim: &str) -> Result<bool, String> {
-        if self.stage.is_invisible(prim)? {
-            return Ok(true);
-        }
-        Ok(matches!(self.stage.purpose(prim)?.as_str(), "proxy" | "guide"))
+    fn hidden(&mut self, prim: &str) -> Result<bool, String> {
+        self.hidden.hidden(self.stage, prim)
     }
 
     fn instancer(&mut self, prim: &str, prims: &[String], world: &DMat4) -> Result<(), Failure> {

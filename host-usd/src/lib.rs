@@ -8,6 +8,7 @@ pub mod dome;
 pub mod error;
 mod guard;
 pub mod import;
+pub mod inherit;
 pub mod instancer;
 pub mod material;
 pub mod mesh;

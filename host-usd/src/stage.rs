@@ -160,9 +160,11 @@ impl Stage {
 
     /// Every active, loaded, defined, non-abstract prim, depth first, including the
     /// contents of instanceable prims (as instance proxies).
+    /// A namespace deeper than [`MAX_DEPTH`] is an error naming the first such prim.
     pub fn prims(&self) -> Result<Vec<String>> {
         let mut out = Vec::new();
         self.inner.traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| out.push(p.as_str().to_string())).map_err(err)?;
+        check_depth(&out)?;
         Ok(out)
     }
 
@@ -236,6 +238,25 @@ impl Stage {
     pub fn is_invisible(&self, prim: &str) -> Result<bool> {
         let x = AnyXformable(self.inner.prim(path(prim)?));
         Ok(x.compute_visibility().map_err(err)? == openusd::schemas::geom::Visibility::Invisible)
+    }
+
+    /// Whether the prim itself authors `visibility = invisible` (its default value, as
+    /// UsdGeomImageable's ComputeVisibility reads it).
+    pub fn authored_invisible(&self, prim: &str) -> Result<bool> {
+        let v = self.attr_metadata(prim, "visibility", "default")?;
+        Ok(matches!(v, Some(Value::Token(t)) if t == "invisible"))
+    }
+
+    /// The purpose the prim itself authors, if any (an unknown token reads as
+    /// `default`, as ComputePurpose does).
+    pub fn authored_purpose(&self, prim: &str) -> Result<Option<&'static str>> {
+        let v = self.attr_metadata(prim, "purpose", "default")?;
+        Ok(v.map(|v| match v.token() {
+            Some("render") => "render",
+            Some("proxy") => "proxy",
+            Some("guide") => "guide",
+            _ => "default",
+        }))
     }
 
     /// The computed purpose token (`default`, `render`, `proxy`, `guide`).
@@ -439,6 +460,22 @@ fn map_input<T>(i: Input<Vec<f64>>, f: impl Fn(&[f64]) -> T) -> Input<T> {
         Input::Unset => Input::Unset,
         Input::Value(v) => Input::Value(f(&v)),
         Input::Texture(t) => Input::Texture(t),
+    }
+}
+
+/// The deepest prim namespace imported: the usda parser's nesting limit, applied to
+/// every format. Deeper stages are refused with an error rather than imported slowly
+/// (each path is as long as its depth).
+pub const MAX_DEPTH: usize = openusd::usda::parser::MAX_NAMESPACE_DEPTH;
+
+fn check_depth(prims: &[String]) -> Result<()> {
+    let too_deep = prims.iter().find(|p| p.bytes().filter(|&b| b == b'/').count() > MAX_DEPTH);
+    match too_deep {
+        Some(p) => {
+            let cut = p.match_indices('/').nth(3).map_or(p.len(), |(i, _)| i);
+            Err(format!("{}/…: namespace deeper than {MAX_DEPTH} levels", &p[..cut]))
+        }
+        None => Ok(()),
     }
 }
 

@@ -1,6 +1,7 @@
 //! World transforms: each prim's local transform composed with its parent's, up to the root
-//! or a `!resetXformStack!`, memoised per path. Matrices are glam's column-vector form
-//! (the transpose of USD's row-vector matrices), so `world = parent · local`.
+//! or a `!resetXformStack!`, memoised per path and resolved top-down (`inherit.rs`).
+//! Matrices are glam's column-vector form (the transpose of USD's row-vector matrices), so
+//! `world = parent · local`.
 
 use crate::stage::Stage;
 use glam::{DMat3, DMat4, DVec3};
@@ -23,21 +24,10 @@ pub fn parent_path(path: &str) -> Option<&str> {
 impl WorldTransforms {
     /// Local-to-world of `prim` in the stage's own frame (before any up-axis conversion).
     pub fn world(&mut self, stage: &Stage, prim: &str) -> Result<DMat4, String> {
-        if prim == "/" {
-            return Ok(DMat4::IDENTITY);
-        }
-        if let Some(m) = self.cache.get(prim) {
-            return Ok(*m);
-        }
-        let (local, resets) = crate::xform_ops::local_transform(stage, prim)?;
-        let m = if resets {
-            local
-        } else {
-            let parent = parent_path(prim).unwrap_or("/");
-            self.world(stage, parent)? * local
-        };
-        self.cache.insert(prim.to_string(), m);
-        Ok(m)
+        crate::inherit::resolve_down(&mut self.cache, prim, DMat4::IDENTITY, |p, parent| {
+            let (local, resets) = crate::xform_ops::local_transform(stage, p)?;
+            Ok(if resets { local } else { *parent * local })
+        })
     }
 
     /// The transform of `prim` relative to `root`'s parent: the locals from `prim` up to and

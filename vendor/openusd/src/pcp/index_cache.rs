@@ -101,6 +101,11 @@ pub struct IndexCache {
     // concurrent reader needs only a shared snapshot rather than a lock on the
     // hot path. Keep population off the critical section when that lands.
     pub(super) redirected_prims: HashMap<Path, Path>,
+    /// The nearest instance at or above each prim path (`None`: not inside an
+    /// instance), so finding a prim's enclosing instance costs one step past its
+    /// parent's answer instead of a walk to the root (ppis patch, see
+    /// PATCHED.md). Invalidated exactly as `redirected_prims` is.
+    pub(super) instance_at_or_above: HashMap<Path, Option<Path>>,
     /// One-shot errors from layer collection that the [`LayerGraph`](super::layer_graph::LayerGraph)
     /// cannot regenerate (e.g. `UnresolvedSublayer`). Set once at construction;
     /// never cleared, since nothing recomputes them.
@@ -230,6 +235,7 @@ impl IndexCache {
             clip_cache: ClipCache::default(),
             prototypes: PrototypeRegistry::default(),
             redirected_prims: HashMap::new(),
+            instance_at_or_above: HashMap::new(),
             collection_errors,
             query_errors: Vec::new(),
             in_progress: HashSet::new(),
@@ -1901,7 +1907,10 @@ impl IndexCache {
             return;
         };
 
-        let ancestor_arcs = self.collect_ancestor_arcs(&parent);
+        // (ppis patch.) The ancestor arcs are collected only when a target needs
+        // them: collecting walks every ancestor, and most prims author no
+        // inherit or specialize arc.
+        let mut ancestor_arcs = None;
 
         // Scan each parent composition node for inherit/specialize targets: the
         // parent's own path in that node's namespace, and the prim's path there
@@ -1937,7 +1946,8 @@ impl IndexCache {
                     // composed parent would mis-resolve `../` targets by a level.
                     let raw = scan_path.make_absolute(target);
                     // Try composed-namespace versions via ancestor arcs.
-                    for a in &ancestor_arcs {
+                    let arcs = ancestor_arcs.get_or_insert_with(|| self.collect_ancestor_arcs(&parent));
+                    for a in arcs.iter() {
                         if let Some(composed) = a.map.map_source_to_target(&raw) {
                             if composed != raw && !targets_to_cache.contains(&composed) {
                                 targets_to_cache.push(composed);
@@ -1982,7 +1992,10 @@ impl IndexCache {
         // so every strict ancestor is checked, not just the parent. Defer without
         // caching an under-seeded result; a later query composes it correctly once
         // the ancestor is cached, and the cycle-closing arc finds no cached target.
-        if path.strict_ancestors().any(|a| self.in_progress.contains(&a)) {
+        // (ppis patch.) The few paths in progress are tested as prefixes, rather than
+        // every ancestor of `path` looked up in the set: the latter clones and
+        // hashes d paths of length up to d for a prim at depth d.
+        if self.in_progress.iter().any(|a| a != path && path.has_prefix(a)) {
             return Ok(());
         }
         // A re-entrant call for a path already mid-build is a class-hierarchy

@@ -327,6 +327,7 @@ impl IndexCache {
         // dropped prototypes may have defined, so clear it wholesale; it is
         // repopulated lazily on the next descendant query.
         self.redirected_prims.clear();
+        self.instance_at_or_above.clear();
     }
 
     /// Returns `true` if `path` resolves as an instance prim (spec 11.3.3):
@@ -402,6 +403,7 @@ impl IndexCache {
         if minted {
             self.drop_index_subtree(&prototype);
             self.redirected_prims.retain(|path, _| !path.has_prefix(&prototype));
+            self.instance_at_or_above.retain(|path, _| !path.has_prefix(&prototype));
             self.materialize_prototype(graph, &canonical, &prototype);
         }
         Ok((canonical, prototype))
@@ -540,25 +542,51 @@ impl IndexCache {
     /// Returns the nearest strict ancestor of `path` that resolves as an
     /// instance prim (spec 11.3.3), or `None` when `path` is not inside an
     /// instance.
-    //
-    // TODO(perf): each [`is_instance`](Self::is_instance) here itself redirects
-    // through `effective_path`, which walks back up via this function — so a cold
-    // first query on a depth-d path is O(d²) (cheap path/hashmap ops, no extra
-    // composition). The `redirected_prims` memo collapses it to O(d) once the
-    // ancestors are warm, which a top-down traversal keeps it; a dedicated
-    // `is_instance` memo would remove the cold-cache factor entirely.
+    ///
+    /// (ppis patch.) The answer for each ancestor is memoized in
+    /// `instance_at_or_above`: the walk climbs only to the nearest ancestor already
+    /// answered, then decides the ancestors below it top-down, so each
+    /// [`is_instance`](Self::is_instance) finds its own parent's answer memoized and
+    /// neither recurses nor walks again. An answer reached while a not-yet-loaded
+    /// layer was demanded is provisional (as in [`Self::effective_path`]) and is
+    /// dropped again.
     fn enclosing_instance(&mut self, graph: &LayerGraph, path: &Path) -> Result<Option<Path>> {
-        let mut ancestor = path.parent();
-        while let Some(current) = ancestor {
+        let Some(parent) = path.parent() else {
+            return Ok(None);
+        };
+        let mut unanswered = Vec::new();
+        let mut current = parent;
+        let mut found = loop {
             if current.is_abs_root() {
-                break;
+                break None;
             }
-            if self.is_instance(graph, &current)? {
-                return Ok(Some(current));
+            if let Some(hit) = self.instance_at_or_above.get(&current) {
+                break hit.clone();
             }
-            ancestor = current.parent();
+            let next = current.parent();
+            unanswered.push(current);
+            match next {
+                Some(next) => current = next,
+                None => break None,
+            }
+        };
+        let pending_before = self.pending_loads.len();
+        let mut inserted = Vec::new();
+        while let Some(ancestor) = unanswered.pop() {
+            if self.is_instance(graph, &ancestor)? {
+                found = Some(ancestor.clone());
+            }
+            if !self.instance_at_or_above.contains_key(&ancestor) {
+                self.instance_at_or_above.insert(ancestor.clone(), found.clone());
+                inserted.push(ancestor);
+            }
         }
-        Ok(None)
+        if self.pending_loads.len() != pending_before {
+            for ancestor in &inserted {
+                self.instance_at_or_above.remove(ancestor);
+            }
+        }
+        Ok(found)
     }
 
     /// Maps a prim path to the path that actually composes it. An instance proxy

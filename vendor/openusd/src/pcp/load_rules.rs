@@ -201,6 +201,10 @@ impl LoadRules {
     /// first), doing a point lookup at each step, since only that chain can
     /// ever match.
     fn nearest_prefix_entry(&self, path: &Path) -> Option<(Path, Rule)> {
+        // (ppis patch.) No rules: no walk up the ancestors.
+        if self.rules.is_empty() {
+            return None;
+        }
         path.ancestors().find_map(|p| self.rules.get(&p).map(|&r| (p, r)))
     }
 

@@ -160,7 +160,10 @@ impl<V> PathTable<V> {
     /// the entries an inserted value actually sits at. The companion of
     /// [`subtree`](Self::subtree), which fans out downward.
     pub fn ancestors<'a>(&'a self, path: &Path) -> impl Iterator<Item = (&'a Path, &'a V)> {
-        path.ancestors().filter_map(move |p| {
+        // (ppis patch.) An empty table answers without walking (and cloning) the
+        // ancestors, which most queries on a stage without prototypes would do.
+        let walk = (self.len != 0).then(|| path.ancestors());
+        walk.into_iter().flatten().filter_map(move |p| {
             let (key, node) = self.nodes.get_key_value(&p)?;
             node.value.as_ref().map(|v| (key, v))
         })

@@ -17,6 +17,7 @@ mod relationship;
 mod schema;
 mod sink;
 mod stage;
+mod status;
 mod timecode;
 
 pub use attribute::{Attribute, AttributeQuery};

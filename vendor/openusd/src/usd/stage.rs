@@ -49,6 +49,7 @@ use crate::tf::Token;
 use crate::{ar, pcp, sdf};
 
 use super::interp::{self, InterpolationType};
+use super::status::Inherited;
 use super::sink::{Payload, PendingChange, Provenance, StageSink, StageSinkId};
 
 bitflags! {
@@ -3132,18 +3133,15 @@ impl Stage {
     /// excludes those regions.
     pub fn traverse(&self, predicate: PrimPredicate, mut visitor: impl FnMut(&sdf::Path)) -> Result<()> {
         let needed = predicate.consulted_bits();
-        let mut stack = vec![sdf::Path::abs_root()];
+        // Each entry carries what its ancestors resolved to, so a prim's inherited
+        // status costs its own opinions only (ppis patch, see `status.rs`).
+        let mut stack = vec![(sdf::Path::abs_root(), Inherited::ROOT)];
 
-        while let Some(path) = stack.pop() {
+        while let Some((path, above)) = stack.pop() {
+            let mut below = above;
             if path != sdf::Path::abs_root() {
-                // TODO(perf): each `prim_status_masked` call recomputes the
-                // inherited bits (active/loaded/defined/abstract/model) by
-                // walking this prim's ancestor chain to the root, and several
-                // predicates re-walk it for the same fields. Since traversal is
-                // top-down, the parent's resolved inherited status could be
-                // threaded down the stack so each prim only consults its own
-                // local opinion — turning the per-prim O(depth) walk into O(1).
-                let status = self.prim_status_masked(&path, needed)?;
+                let (status, inherited) = self.prim_status_inherited(&path, needed, above)?;
+                below = inherited;
                 if predicate.matches(status) {
                     visitor(&path);
                 }
@@ -3162,7 +3160,7 @@ impl Stage {
             // Push in reverse so first child is visited first.
             for name in children.iter().rev() {
                 if let Ok(child) = path.append_path(name.as_str()) {
-                    stack.push(child);
+                    stack.push((child, below));
                 }
             }
         }

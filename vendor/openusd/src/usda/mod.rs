@@ -18,8 +18,22 @@ use crate::{ar, sdf, tf};
 /// Parse `usda` text into an in-memory [`sdf::Data`] store.
 pub fn parse(text: &str) -> Result<sdf::Data> {
     let mut parser = Parser::new(text);
-    let specs = parser.parse()?;
+    let specs = parse_on_own_stack(&mut parser)?;
     Ok(sdf::Data::from_specs(specs))
+}
+
+/// Runs the recursive-descent parser on a thread whose stack holds
+/// [`parser::MAX_NESTING`] levels (ppis patch, see PATCHED.md), so the depth a layer
+/// may nest does not depend on the caller's stack.
+fn parse_on_own_stack(parser: &mut Parser) -> Result<std::collections::HashMap<sdf::Path, sdf::SpecData>> {
+    std::thread::scope(|scope| {
+        let worker = std::thread::Builder::new()
+            .name("usda-parser".into())
+            .stack_size(parser::PARSER_STACK_BYTES)
+            .spawn_scoped(scope, || parser.parse())
+            .context("Unable to start the usda parser thread")?;
+        worker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
 }
 
 /// Read a `usda` file from disk into an in-memory [`sdf::Data`] store.
@@ -28,7 +42,7 @@ pub fn read_file(path: impl AsRef<Path>) -> Result<sdf::Data> {
     let text = fs::read_to_string(path).with_context(|| format!("Unable to read file: {}", path.display()))?;
 
     let mut parser = Parser::new(&text);
-    let specs = parser.parse().map_err(|e| match parser.last_error_highlight() {
+    let specs = parse_on_own_stack(&mut parser).map_err(|e| match parser.last_error_highlight() {
         Some(h) => e.context(format!("{}:{}: {}", path.display(), h.line, h.column)),
         None => e.context(format!("{}: parse error", path.display())),
     })?;

@@ -17,10 +17,37 @@ use super::token::Token;
 type LexResult<'source> = std::result::Result<Token<'source>, ()>;
 
 /// Parser translates a list of tokens into structured data.
+/// The deepest prim namespace a layer may author (ppis patch, see PATCHED.md).
+pub const MAX_NAMESPACE_DEPTH: usize = 4096;
+
+/// The deepest nesting of blocks (`{}` prim and variant bodies, dictionaries, `[]`,
+/// `()`) a layer may have: a namespace of [`MAX_NAMESPACE_DEPTH`] with room for
+/// variants and values inside it. The parser recurses once per level; the limit
+/// turns a pathological file into an error instead of a stack overflow.
+pub const MAX_NESTING: usize = 2 * MAX_NAMESPACE_DEPTH;
+
+/// The stack a parser thread gets: room for [`MAX_NESTING`] levels of recursion
+/// with a wide margin, whatever the calling thread's own stack is. Reserved, not
+/// committed: only the pages a deep file touches are used.
+pub const PARSER_STACK_BYTES: usize = 64 << 20;
+
 pub struct Parser<'a> {
     iter: Peekable<logos::SpannedIter<'a, Token<'a>>>,
     source: &'a str,
     last_span: Option<Range<usize>>,
+    /// Blocks open at the current token (ppis patch).
+    depth: usize,
+}
+
+/// A path for an error message: long ones keep their start and end.
+fn abbreviated(path: &sdf::Path) -> String {
+    let s = path.as_str();
+    if s.len() <= 120 {
+        return s.to_string();
+    }
+    let head: String = s.chars().take(60).collect();
+    let tail: String = s.chars().rev().take(40).collect::<Vec<_>>().into_iter().rev().collect();
+    format!("{head}…{tail}")
 }
 
 /// Captures the line context for the most recent token consumed by the parser.
@@ -48,6 +75,7 @@ impl<'a> Parser<'a> {
             iter: Token::lexer(data).spanned().peekable(),
             source: data,
             last_span: None,
+            depth: 0,
         }
     }
 
@@ -393,6 +421,11 @@ impl<'a> Parser<'a> {
         owner_spec: &mut sdf::SpecData,
         data: &mut HashMap<sdf::Path, sdf::SpecData>,
     ) -> Result<(Vec<String>, Vec<String>, Vec<String>)> {
+        ensure!(
+            path.prim_element_count() <= MAX_NAMESPACE_DEPTH,
+            "{}: namespace deeper than {MAX_NAMESPACE_DEPTH} levels",
+            abbreviated(path)
+        );
         let mut children = Vec::new();
         let mut properties = Vec::new();
         let mut suffixed_properties = Vec::<String>::new();
@@ -1768,6 +1801,8 @@ impl<'a> Parser<'a> {
     /// Handles empty blocks and trailing commas.
     fn parse_block(&mut self, open: char, close: char, mut entry: impl FnMut(&mut Self) -> Result<()>) -> Result<()> {
         self.ensure_pun(open)?;
+        ensure!(self.depth < MAX_NESTING, "blocks nested deeper than {MAX_NESTING} levels");
+        self.depth += 1;
         loop {
             if self.try_consume(Token::Punctuation(close)) {
                 break;
@@ -1775,6 +1810,7 @@ impl<'a> Parser<'a> {
             entry(self)?;
             while self.try_consume(Token::Punctuation(',')) || self.try_consume(Token::Punctuation(';')) {}
         }
+        self.depth -= 1;
         Ok(())
     }
 

@@ -1,0 +1,58 @@
+//! Values a prim inherits from its ancestors (world transform, visibility, purpose),
+//! memoised per path and resolved top-down: a prim costs one step from its parent's
+//! answer, never a walk to the root, and no recursion, however deep the namespace.
+
+use crate::stage::Stage;
+use crate::xform::parent_path;
+use std::collections::HashMap;
+
+/// The value of `prim`: the unresolved ancestors (nearest memoised one or the
+/// pseudo-root, whose value is `root`, excluded) are resolved top-down, each by
+/// `step(path, parent's value)`, and memoised.
+pub fn resolve_down<T: Clone>(
+    memo: &mut HashMap<String, T>,
+    prim: &str,
+    root: T,
+    mut step: impl FnMut(&str, &T) -> Result<T, String>,
+) -> Result<T, String> {
+    let mut chain = Vec::new();
+    let mut here = prim;
+    let mut value = loop {
+        if here == "/" {
+            break root;
+        }
+        if let Some(v) = memo.get(here) {
+            break v.clone();
+        }
+        chain.push(here);
+        here = parent_path(here).unwrap_or("/");
+    };
+    for path in chain.into_iter().rev() {
+        value = step(path, &value)?;
+        memo.insert(path.to_string(), value.clone());
+    }
+    Ok(value)
+}
+
+/// Computed visibility and purpose (UsdGeomImageable's rules), memoised.
+#[derive(Default)]
+pub struct Hidden {
+    invisible: HashMap<String, bool>,
+    purpose: HashMap<String, &'static str>,
+}
+
+impl Hidden {
+    /// Invisible (the prim or an ancestor authors `visibility = invisible`), or of
+    /// purpose `proxy` or `guide` (the nearest authored purpose).
+    pub fn hidden(&mut self, stage: &Stage, prim: &str) -> Result<bool, String> {
+        let invisible =
+            resolve_down(&mut self.invisible, prim, false, |p, above| Ok(*above || stage.authored_invisible(p)?))?;
+        if invisible {
+            return Ok(true);
+        }
+        let purpose = resolve_down(&mut self.purpose, prim, "default", |p, above| {
+            Ok(stage.authored_purpose(p)?.unwrap_or(*above))
+        })?;
+        Ok(matches!(purpose, "proxy" | "guide"))
+    }
+}
