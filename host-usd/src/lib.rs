@@ -1,5 +1,5 @@
 //! `host-usd`: USD scene import (usda, usdc, usdz) for ppis through the pure-Rust `openusd`
-//! crate (pinned to 0.6.0). `stage.rs` is the only file that touches openusd; the rest
+//! crate (pinned to 0.6.0). `stage/` is the only module that touches openusd; the rest
 //! works on its plain values and yields a [`UsdScene`] of plain data.
 
 pub mod camera;

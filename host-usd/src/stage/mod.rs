@@ -1,0 +1,204 @@
+//! The one module that talks to `openusd` (pinned to 0.6.0): opening a stage, walking its
+//! prims and reading composed values as plain numbers, tokens and resolved asset paths
+//! (`value.rs`), and the material bindings and UsdPreviewSurface networks (`shading.rs`). A
+//! version bump of openusd touches this module only; the rest of host-usd sees [`Stage`] and
+//! [`Value`].
+
+mod shading;
+mod value;
+
+pub use shading::{Input, PreviewInputs, TextureRef};
+pub use value::Value;
+use value::convert;
+
+use openusd::ar::{self, Resolver};
+use openusd::schemas::geom::{Imageable, Xformable};
+use openusd::{sdf, usd};
+use std::path::Path;
+
+/// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
+struct AnyXformable(usd::Prim);
+
+impl usd::SchemaBase for AnyXformable {
+    const KIND: usd::SchemaKind = usd::SchemaKind::ConcreteTyped;
+    fn prim(&self) -> &usd::Prim {
+        &self.0
+    }
+}
+impl Imageable for AnyXformable {}
+impl Xformable for AnyXformable {}
+
+/// An opened, composed USD stage.
+pub struct Stage {
+    inner: usd::Stage,
+    time: usd::TimeCode,
+}
+
+type Result<T> = std::result::Result<T, String>;
+
+fn err(e: impl std::fmt::Display) -> String {
+    format!("{e:#}")
+}
+
+fn path(p: &str) -> Result<sdf::Path> {
+    sdf::path(p).map_err(err)
+}
+
+impl Stage {
+    /// Opens `file` (usda, usdc or usdz), composing sublayers, references, payloads and
+    /// variants. Values are read at the stage's start time code.
+    pub fn open(file: &Path) -> Result<Self> {
+        let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
+        let inner = usd::Stage::open(name).map_err(err)?;
+        let time = usd::TimeCode::new(inner.start_time_code());
+        Ok(Self { inner, time })
+    }
+
+    /// Recoverable composition problems (a missing reference, payload or sublayer).
+    pub fn composition_errors(&self) -> Vec<String> {
+        self.inner.composition_errors().iter().map(|e| e.to_string()).collect()
+    }
+
+    /// Root-layer metadata as a value (`upAxis`, `metersPerUnit`, …).
+    pub fn metadata(&self, field: &str) -> Result<Option<Value>> {
+        Ok(self.inner.stage_metadata(field).map_err(err)?.map(convert))
+    }
+
+    pub fn default_prim(&self) -> Option<String> {
+        self.inner.default_prim().map(|t| t.as_str().to_string())
+    }
+
+    pub fn time(&self) -> f64 {
+        self.time.value()
+    }
+
+    /// Every active, loaded, defined, non-abstract prim, depth first, including the
+    /// contents of instanceable prims (as instance proxies).
+    /// A namespace deeper than [`MAX_DEPTH`] is an error naming the first such prim.
+    pub fn prims(&self) -> Result<Vec<String>> {
+        let mut out = Vec::new();
+        self.inner.traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| out.push(p.as_str().to_string())).map_err(err)?;
+        check_depth(&out)?;
+        Ok(out)
+    }
+
+    /// Every composed prim, defined or not (`over`s, classes, inactive), without
+    /// instance proxies: Pixar's `TraverseAll`.
+    pub fn all_prims(&self) -> Result<Vec<String>> {
+        let mut out = Vec::new();
+        self.inner.traverse(usd::PrimPredicate::ALL, |p| out.push(p.as_str().to_string())).map_err(err)?;
+        Ok(out)
+    }
+
+    pub fn type_name(&self, prim: &str) -> Result<String> {
+        let t = self.inner.prim(path(prim)?).type_name().map_err(err)?;
+        Ok(t.map(|t| t.as_str().to_string()).unwrap_or_default())
+    }
+
+    pub fn children(&self, prim: &str) -> Result<Vec<String>> {
+        let children = self.inner.prim(path(prim)?).children().map_err(err)?;
+        Ok(children.iter().map(|c| c.path().as_str().to_string()).collect())
+    }
+
+    pub fn is_instance(&self, prim: &str) -> Result<bool> {
+        self.inner.prim(path(prim)?).is_instance().map_err(err)
+    }
+
+    pub fn is_instance_proxy(&self, prim: &str) -> Result<bool> {
+        self.inner.prim(path(prim)?).is_instance_proxy().map_err(err)
+    }
+
+    pub fn applied_schemas(&self, prim: &str) -> Result<Vec<String>> {
+        let s = self.inner.prim(path(prim)?).api_schemas().map_err(err)?;
+        Ok(s.iter().map(|t| t.as_str().to_string()).collect())
+    }
+
+    /// Names of the prim's properties.
+    pub fn property_names(&self, prim: &str) -> Result<Vec<String>> {
+        let names = self.inner.prim(path(prim)?).property_names().map_err(err)?;
+        Ok(names.iter().map(|t| t.as_str().to_string()).collect())
+    }
+
+    /// The composed value of `prim.attr` at the stage's start time (time samples
+    /// interpolated), or its default; `None` when unauthored.
+    pub fn value(&self, prim: &str, attr: &str) -> Result<Option<Value>> {
+        let a = self.inner.prim(path(prim)?).attribute(attr);
+        let v = a.get_at::<sdf::Value>(self.time).map_err(|e| format!("{prim}.{attr}: {}", err(e)))?;
+        let v = match v {
+            Some(v) => Some(v),
+            None => a.get::<sdf::Value>().map_err(|e| format!("{prim}.{attr}: {}", err(e)))?,
+        };
+        Ok(v.map(convert))
+    }
+
+    /// A metadata field of an attribute (`interpolation`, `elementSize`).
+    pub fn attr_metadata(&self, prim: &str, attr: &str, key: &str) -> Result<Option<Value>> {
+        let a = self.inner.prim(path(prim)?).attribute(attr);
+        Ok(a.get_metadata::<sdf::Value>(key).map_err(err)?.map(convert))
+    }
+
+    /// Targets of a relationship, as paths.
+    pub fn targets(&self, prim: &str, rel: &str) -> Result<Vec<String>> {
+        let r = self.inner.prim(path(prim)?).relationship(rel);
+        Ok(r.targets().map_err(err)?.iter().map(|p| p.as_str().to_string()).collect())
+    }
+
+    /// The composed `xformOpOrder` (list edits applied), or `None` when unauthored.
+    pub fn xform_op_order(&self, prim: &str) -> Result<Option<Vec<String>>> {
+        AnyXformable(self.inner.prim(path(prim)?)).xform_op_order().map_err(err)
+    }
+
+    /// True when the prim or an ancestor is `invisible`.
+    pub fn is_invisible(&self, prim: &str) -> Result<bool> {
+        let x = AnyXformable(self.inner.prim(path(prim)?));
+        Ok(x.compute_visibility().map_err(err)? == openusd::schemas::geom::Visibility::Invisible)
+    }
+
+    /// Whether the prim itself authors `visibility = invisible` (its default value, as
+    /// UsdGeomImageable's ComputeVisibility reads it).
+    pub fn authored_invisible(&self, prim: &str) -> Result<bool> {
+        let v = self.attr_metadata(prim, "visibility", "default")?;
+        Ok(matches!(v, Some(Value::Token(t)) if t == "invisible"))
+    }
+
+    /// The purpose the prim itself authors, if any (an unknown token reads as
+    /// `default`, as ComputePurpose does).
+    pub fn authored_purpose(&self, prim: &str) -> Result<Option<&'static str>> {
+        let v = self.attr_metadata(prim, "purpose", "default")?;
+        Ok(v.map(|v| match v.token() {
+            Some("render") => "render",
+            Some("proxy") => "proxy",
+            Some("guide") => "guide",
+            _ => "default",
+        }))
+    }
+
+    /// The computed purpose token (`default`, `render`, `proxy`, `guide`).
+    pub fn purpose(&self, prim: &str) -> Result<String> {
+        let x = AnyXformable(self.inner.prim(path(prim)?));
+        Ok(x.compute_purpose().map_err(err)?.as_token().to_string())
+    }
+
+    /// The bytes of a resolved asset (a file, or an entry inside a usdz package).
+    pub fn read_asset(&self, resolved: &str) -> std::io::Result<Vec<u8>> {
+        let resolver = ar::DefaultResolver::new();
+        let mut asset = resolver.open_asset(&ar::ResolvedPath::new(resolved))?;
+        asset.read_all()
+    }
+}
+
+/// The deepest prim namespace imported: the usda parser's nesting limit, applied to
+/// every format. Deeper stages are refused with an error rather than imported slowly
+/// (each path is as long as its depth).
+pub const MAX_DEPTH: usize = openusd::usda::parser::MAX_NAMESPACE_DEPTH;
+
+fn check_depth(prims: &[String]) -> Result<()> {
+    let too_deep = prims.iter().find(|p| p.bytes().filter(|&b| b == b'/').count() > MAX_DEPTH);
+    match too_deep {
+        Some(p) => {
+            let cut = p.match_indices('/').nth(3).map_or(p.len(), |(i, _)| i);
+            Err(format!("{}/…: namespace deeper than {MAX_DEPTH} levels", &p[..cut]))
+        }
+        None => Ok(()),
+    }
+}
