@@ -45,34 +45,25 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     let mut mismatches = Vec::new();
     let mut mismatch = |m: String| mismatches.push(m);
 
-    let meta = &want["stage"];
-    let up = stage.metadata("upAxis")?.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| "Y".into());
-    if meta["upAxis"].as_str() != Some(up.as_str()) {
-        mismatch(format!("upAxis: Pixar {} host-usd {up}", meta["upAxis"]));
-    }
-    let mpu = stage.metadata("metersPerUnit")?.and_then(|v| v.scalar()).unwrap_or(0.01);
-    if meta["metersPerUnit"].as_f64().is_none_or(|m| (m - mpu).abs() > 1e-12 * m.abs()) {
-        mismatch(format!("metersPerUnit: Pixar {} host-usd {mpu}", meta["metersPerUnit"]));
-    }
-    let default_prim = stage.default_prim().map(|d| if d.starts_with('/') { d } else { format!("/{d}") });
-    if meta["defaultPrim"].as_str().map(str::to_string) != default_prim {
-        mismatch(format!("defaultPrim: Pixar {} host-usd {default_prim:?}", meta["defaultPrim"]));
-    }
+    check_stage(&stage, &want["stage"], &mut mismatch)?;
 
-    let ours = stage.all_prims()?;
+    // A set: the traversals hold 100 000 prims and more.
+    let ours: std::collections::HashSet<String> = stage.all_prims()?.into_iter().collect();
     let Some(prims) = want["prims"].as_object() else {
         return Err(format!("{}: no \"prims\" object", expected.display()));
     };
-    for p in prims.keys().filter(|p| !ours.contains(p)) {
+    for p in prims.keys().filter(|p| !ours.contains(*p)) {
         mismatch(format!("{p}: in Pixar's traversal, not in ours"));
     }
-    for p in ours.iter().filter(|p| !prims.contains_key(*p)) {
+    let mut extra: Vec<&String> = ours.iter().filter(|p| !prims.contains_key(*p)).collect();
+    extra.sort();
+    for p in extra {
         mismatch(format!("{p}: in our traversal, not in Pixar's"));
     }
     let mut worlds = WorldTransforms::default();
     let mut max_err = 0.0f64;
     let (mut n_mat, mut n_bind, mut n_mesh) = (0, 0, 0);
-    for (path, want) in prims.iter().filter(|(p, _)| ours.contains(p)) {
+    for (path, want) in prims.iter().filter(|(p, _)| ours.contains(*p)) {
         let t = stage.type_name(path)?;
         if want["type"].as_str() != Some(t.as_str()) {
             mismatch(format!("{path}: type Pixar {} host-usd {t:?}", want["type"]));
@@ -99,32 +90,7 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
         }
         if want.get("points").is_some() {
             n_mesh += 1;
-            let points = match stage.value(path, "points")? {
-                Some(Value::Numbers { values, .. }) => values.len() / 3,
-                _ => 0,
-            };
-            if want["points"].as_u64() != Some(points as u64) {
-                mismatch(format!("{path}: points Pixar {} host-usd {points}", want["points"]));
-            }
-            let counts: Vec<i64> = match stage.value(path, "faceVertexCounts")? {
-                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
-                _ => Vec::new(),
-            };
-            // Pixar's answer lists the counts, or for large meshes their number and sum.
-            let fvc = &want["faceVertexCounts"];
-            let same = match fvc.as_array() {
-                Some(a) => a.iter().filter_map(Json::as_i64).eq(counts.iter().copied()),
-                None => {
-                    fvc["faces"].as_u64() == Some(counts.len() as u64)
-                        && fvc["sum"].as_i64() == Some(counts.iter().sum::<i64>())
-                }
-            };
-            if !same {
-                mismatch(format!("{path}: faceVertexCounts differ from Pixar's {fvc}"));
-            }
-            if let Err(e) = mesh::read(&stage, path, Some("st")) {
-                mismatch(format!("{path}: {e}"));
-            }
+            check_mesh(&stage, path, want, &mut mismatch)?;
         }
     }
     if let Some(instancers) = want["instancers"].as_object() {
@@ -144,6 +110,55 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     r.meshes = n_mesh;
     r.max_matrix_error = max_err;
     Ok(r)
+}
+
+/// Stage metadata: upAxis, metersPerUnit, defaultPrim.
+fn check_stage(stage: &Stage, meta: &Json, mismatch: &mut impl FnMut(String)) -> Result<(), String> {
+    let up = stage.metadata("upAxis")?.and_then(|v| v.token().map(str::to_string)).unwrap_or_else(|| "Y".into());
+    if meta["upAxis"].as_str() != Some(up.as_str()) {
+        mismatch(format!("upAxis: Pixar {} host-usd {up}", meta["upAxis"]));
+    }
+    let mpu = stage.metadata("metersPerUnit")?.and_then(|v| v.scalar()).unwrap_or(0.01);
+    if meta["metersPerUnit"].as_f64().is_none_or(|m| (m - mpu).abs() > 1e-12 * m.abs()) {
+        mismatch(format!("metersPerUnit: Pixar {} host-usd {mpu}", meta["metersPerUnit"]));
+    }
+    let default_prim = stage.default_prim().map(|d| if d.starts_with('/') { d } else { format!("/{d}") });
+    if meta["defaultPrim"].as_str().map(str::to_string) != default_prim {
+        mismatch(format!("defaultPrim: Pixar {} host-usd {default_prim:?}", meta["defaultPrim"]));
+    }
+
+    Ok(())
+}
+
+/// A mesh's point and face counts, and that host-usd reads its topology.
+fn check_mesh(stage: &Stage, path: &str, want: &Json, mismatch: &mut impl FnMut(String)) -> Result<(), String> {
+    let points = match stage.value(path, "points")? {
+        Some(Value::Numbers { values, .. }) => values.len() / 3,
+        _ => 0,
+    };
+    if want["points"].as_u64() != Some(points as u64) {
+        mismatch(format!("{path}: points Pixar {} host-usd {points}", want["points"]));
+    }
+    let counts: Vec<i64> = match stage.value(path, "faceVertexCounts")? {
+        Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
+        _ => Vec::new(),
+    };
+    // Pixar's answer lists the counts, or for large meshes their number and sum.
+    let fvc = &want["faceVertexCounts"];
+    let same = match fvc.as_array() {
+        Some(a) => a.iter().filter_map(Json::as_i64).eq(counts.iter().copied()),
+        None => {
+            fvc["faces"].as_u64() == Some(counts.len() as u64)
+                && fvc["sum"].as_i64() == Some(counts.iter().sum::<i64>())
+        }
+    };
+    if !same {
+        mismatch(format!("{path}: faceVertexCounts differ from Pixar's {fvc}"));
+    }
+    if let Err(e) = mesh::read(stage, path, Some("st")) {
+        mismatch(format!("{path}: {e}"));
+    }
+    Ok(())
 }
 
 /// The largest difference of a matrix entry from Pixar's rows (relative to max(1, |entry|));

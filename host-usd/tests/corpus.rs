@@ -116,7 +116,8 @@ fn a_wrong_answer_is_a_mismatch() {
     let text = std::fs::read_to_string(committed().join("spheres_10.expected.json")).unwrap();
     let right: serde_json::Value = serde_json::from_str(&text).unwrap();
     let expected = dir.path().join("spheres_10.expected.json");
-    let edits: [(&str, fn(&mut serde_json::Value)); 3] = [
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(&str, Edit); 3] = [
         ("gprims", |w| w["counts"]["gprims"] = 9.into()),
         ("world matrix", |w| w["prims"]["/World/Sphere_3"]["world"][3][0] = 7.6.into()),
         ("material", |w| w["prims"]["/World/Sphere_3"]["material"] = "/World/Looks/M1".into()),

@@ -123,3 +123,46 @@ proptest! {
         }
     }
 }
+
+/// The sections of a usdc file: (name, start), from its table of contents.
+fn sections(bytes: &[u8]) -> Vec<(String, usize)> {
+    let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    let toc = u64_at(16);
+    (0..u64_at(toc))
+        .map(|k| {
+            let entry = toc + 8 + 32 * k;
+            let name = bytes[entry..entry + 16].iter().take_while(|&&b| b != 0).map(|&b| b as char).collect();
+            (name, u64_at(entry + 16))
+        })
+        .collect()
+}
+
+/// Each structural section's leading counts set to what no decoding can back: a clean error,
+/// and no allocation beyond the cap. A Pixar-written file of many similar prims included, whose
+/// valid counts far exceed 256 × its compressed bytes.
+#[test]
+fn counts_the_file_cannot_back_are_errors() {
+    for file in ["corpus/meshes_identical_1000.usdc", "corpus/spheres_10.usdc", "fixtures/instancing.usdc"] {
+        let original = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join(file)).unwrap();
+        let found = sections(&original);
+        for section in ["TOKENS", "FIELDS", "FIELDSETS", "PATHS", "SPECS"] {
+            let &(_, start) = found.iter().find(|(n, _)| n == section).unwrap();
+            for (at, value) in [(0, 1u64 << 33), (0, u64::MAX), (8, 1 << 40), (8, u64::MAX >> 1)] {
+                let mut bytes = original.clone();
+                bytes[start + at..start + at + 8].copy_from_slice(&value.to_le_bytes());
+                let dir = scratch();
+                let path = dir.path().join("x.usdc");
+                std::fs::write(&path, &bytes).unwrap();
+                PEAK.with(|p| p.set(0));
+                ARMED.with(|a| a.set(true));
+                let result = host_usd::load(&path);
+                ARMED.with(|a| a.set(false));
+                let peak = PEAK.with(|p| p.get());
+                let what = format!("{file}: {section} + {at} = {value}");
+                let e = result.err().unwrap_or_else(|| panic!("{what}: imported"));
+                assert!(e.to_string().contains("x.usdc"), "{what}: {e}");
+                assert!(peak <= max_allocation(bytes.len()), "{what}: one allocation of {peak} bytes");
+            }
+        }
+    }
+}
