@@ -65,3 +65,38 @@ fn deeply_nested_dictionaries_and_arrays_are_errors() {
     let e = r.expect_err("a 20 000-deep array is refused");
     assert!(e.contains("array.usda"), "{e}");
 }
+
+/// A usdc file's values are read by recursion, one frame per level of nesting: a prim's
+/// `customData` of dictionaries nested 3 000 deep (written by Pixar's library) is refused as
+/// corrupt when it is read, on a 2 MB stack; 50 levels read as they are.
+#[test]
+fn deeply_nested_usdc_dictionaries_are_errors() {
+    use openusd::sdf::{self, AbstractData};
+    let read = |name: &'static str| {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name);
+        let run = move || -> Result<usize, String> {
+            let data = openusd::usdc::read_file(&file).map_err(|e| e.to_string())?;
+            let prim = sdf::path("/P").unwrap();
+            let chain = |e: &dyn std::error::Error| {
+                let mut s = e.to_string();
+                let mut cause = e.source();
+                while let Some(c) = cause {
+                    s += &format!(": {c}");
+                    cause = c.source();
+                }
+                s
+            };
+            let mut value = data.get_field(&prim, "customData").map_err(|e| chain(&e))?.into_owned();
+            let mut depth = 0;
+            while let sdf::Value::Dictionary(d) = value {
+                let Some(inner) = d.into_values().next() else { break };
+                (value, depth) = (inner, depth + 1);
+            }
+            Ok(depth)
+        };
+        std::thread::Builder::new().stack_size(TWO_MB).spawn(run).unwrap().join().expect("no stack overflow")
+    };
+    assert_eq!(read("nested_dictionary_50.usdc"), Ok(51), "50 dictionaries inside customData's own");
+    let e = read("nested_dictionary_3000.usdc").unwrap_err();
+    assert!(e.contains("nested deeper than"), "{e}");
+}

@@ -49,7 +49,14 @@ pub struct CrateFile<R> {
     pub paths: Vec<sdf::Path>,
     // All specs.
     pub specs: Vec<Spec>,
+    /// ppis patch: how many values enclose the one being read (see [`MAX_VALUE_DEPTH`]).
+    value_depth: usize,
 }
+
+/// ppis patch: values nest (a dictionary in a dictionary, time samples of values) by
+/// recursion on the caller's stack, one frame per level of file-controlled data; deeper
+/// nesting than this is refused as corrupt instead of overflowing the stack.
+pub const MAX_VALUE_DEPTH: usize = 128;
 
 impl<R> CrateFile<R> {
     /// Returns file's version extracted from bootstrap header.
@@ -77,6 +84,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             fieldsets: Vec::new(),
             paths: Vec::new(),
             specs: Vec::new(),
+            value_depth: 0,
         };
 
         file.read_sections().context("Unable to read sections")?;
@@ -811,13 +819,8 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     }
 
     /// Reads a crate dictionary value (`customData`, `assetInfo`, and nested
-    /// dictionaries).
-    ///
-    /// TODO: this recurses through `value`, which re-enters here for a nested
-    /// `Type::Dictionary`, so a deeply nested dictionary overflows the stack —
-    /// one Rust frame per nesting level over file-controlled data. Bound the
-    /// depth (a guard or an explicit stack), as `build_compressed_paths` does
-    /// for wide path trees.
+    /// dictionaries). It recurses through `value`, which bounds the depth
+    /// ([`MAX_VALUE_DEPTH`]).
     fn read_custom_data(&mut self) -> Result<HashMap<String, Value>> {
         let mut count = self.read_count_of(20)?;
         let mut dict = HashMap::default();
@@ -892,6 +895,17 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     }
 
     pub fn value(&mut self, value: ValueRep) -> Result<sdf::Value> {
+        ensure!(
+            self.value_depth < MAX_VALUE_DEPTH,
+            "corrupt file: values nested deeper than {MAX_VALUE_DEPTH} levels"
+        );
+        self.value_depth += 1;
+        let v = self.value_at_depth(value);
+        self.value_depth -= 1;
+        v
+    }
+
+    fn value_at_depth(&mut self, value: ValueRep) -> Result<sdf::Value> {
         let ty = value.ty()?;
         ensure!(ty != Type::Invalid, "Invalid value type");
 
