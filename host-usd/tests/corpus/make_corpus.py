@@ -267,24 +267,24 @@ def asset(directory, name):
     return name
 
 
-def kind_references(stage, n, directory):
+def arcs_to_asset(stage, n, directory, prefix, list_of, arc):
+    """n Xforms, each bringing in the asset through one composition arc (a reference or a
+    payload: `list_of` names the prim spec's list op, `arc` makes its item)."""
     world_root(stage)
     name = asset(directory, "asset.usda")
     layer = stage.GetRootLayer()
     with Sdf.ChangeBlock():
         for i in range(n):
-            sdf_prim(layer, f"/World/Ref_{i}", "Xform", sdf_place(i, n))
-            layer.GetPrimAtPath(f"/World/Ref_{i}").referenceList.prependedItems = [Sdf.Reference(name)]
+            sdf_prim(layer, f"/World/{prefix}_{i}", "Xform", sdf_place(i, n))
+            getattr(layer.GetPrimAtPath(f"/World/{prefix}_{i}"), list_of).prependedItems = [arc(name)]
+
+
+def kind_references(stage, n, directory):
+    arcs_to_asset(stage, n, directory, "Ref", "referenceList", Sdf.Reference)
 
 
 def kind_payloads(stage, n, directory):
-    world_root(stage)
-    name = asset(directory, "asset.usda")
-    layer = stage.GetRootLayer()
-    with Sdf.ChangeBlock():
-        for i in range(n):
-            sdf_prim(layer, f"/World/Payload_{i}", "Xform", sdf_place(i, n))
-            layer.GetPrimAtPath(f"/World/Payload_{i}").payloadList.prependedItems = [Sdf.Payload(name)]
+    arcs_to_asset(stage, n, directory, "Payload", "payloadList", Sdf.Payload)
 
 
 def kind_variants(stage, n, _dir):
