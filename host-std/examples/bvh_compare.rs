@@ -5,9 +5,9 @@
 //!     cargo run --release -p host-std --example bvh_compare -- [SCENE] [--width W]
 //!
 //! Spheres are left out (obvhs builds over triangles); rectangles count as two triangles.
-use host_std::bvh::Bvh;
-use host_std::camera::Camera;
 use host_std::scene::{Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
+use host_std::trace::camera::Camera;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use sampler_core::glam::{Vec3, Vec3A};
@@ -36,9 +36,9 @@ fn main() {
     let width: u32 = args.iter().position(|a| a == "--width").map_or(512, |i| args[i + 1].parse().unwrap());
     let path = args.iter().find(|a| !a.starts_with("--") && a.parse::<u32>().is_err());
     let mut scene = match path {
-        None => host_std::default_scene::scene(),
-        Some(p) if p.ends_with(".json") => host_std::scene_json::load(p.as_ref()).unwrap(),
-        Some(p) => host_std::usd_scene::load(p.as_ref(), &Default::default()).unwrap().scene,
+        None => host_std::scene::builtin::scene(),
+        Some(p) if p.ends_with(".json") => host_std::scene::json::load(p.as_ref()).unwrap(),
+        Some(p) => host_std::scene::usd::load(p.as_ref(), &Default::default()).unwrap().scene,
     };
     let tris = triangles(&scene);
     let aspect = scene.camera.width as f32 / scene.camera.height as f32;

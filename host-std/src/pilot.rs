@@ -24,11 +24,11 @@
 //! rules' split only: the splits differ by less than the pilot can tell apart
 //! ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the others.
 
-use crate::bvh::Bvh;
-use crate::camera::Camera;
 use crate::integrator::{Method, SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
 use crate::render::{MaterialPlan, Scratch, Settings, pixel};
 use crate::scene::{Bsdf, Scene};
+use crate::trace::bvh::Bvh;
+use crate::trace::camera::Camera;
 use rayon::prelude::*;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::points::permutation_element;

@@ -3,11 +3,11 @@
 //! which thread rendered which tile. Each pixel gets P shading points (primary rays jittered
 //! uniformly inside the pixel: a box filter) and each shading point spp/P visibility samples.
 
-use crate::bvh::Bvh;
-use crate::camera::Camera;
 use crate::integrator::{self, CountingVisibility, Method, Technique};
 use crate::pilot::PilotResult;
 use crate::scene::{Bsdf, Scene};
+use crate::trace::bvh::Bvh;
+use crate::trace::camera::Camera;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sampler_core::brdf::Brdf;

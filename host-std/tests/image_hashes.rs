@@ -12,12 +12,12 @@
 //! and replace [`EXPECTED`] with the table the failure prints, saying in the commit why the
 //! images changed.
 
-use host_std::bvh::Bvh;
-use host_std::default_scene;
-use host_std::environment::{EnvSource, Environment, Placement};
 use host_std::integrator::Method;
+use host_std::light::environment::Environment;
 use host_std::render::{Rendered, Settings, render};
+use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
@@ -92,7 +92,7 @@ fn rendered(scene: &Scene, env: &Environment, s: &Settings) -> Rendered {
 fn cases() -> Vec<(String, u64)> {
     let mut out = Vec::new();
     // Every method on the default scene, under its own sky.
-    let mut scene = default_scene::scene();
+    let mut scene = builtin::scene();
     scene.camera.width = 48;
     scene.camera.height = 32;
     let (source, placement) = scene.env.clone().unwrap();
@@ -107,7 +107,7 @@ fn cases() -> Vec<(String, u64)> {
     ));
     // The JSON-scene path with a lat-long EXR map (host-usd's twins fixture, read only).
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../host-usd/tests/fixtures");
-    let mut twins = host_std::scene_json::load(&dir.join("twins.json")).unwrap();
+    let mut twins = host_std::scene::json::load(&dir.join("twins.json")).unwrap();
     twins.camera.width = 48;
     twins.camera.height = 32;
     let (source, placement) = twins.env.clone().unwrap();

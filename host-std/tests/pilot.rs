@@ -3,12 +3,12 @@
 //! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
 //! matte studio where it measures twice as good as the rules' MIS.
 
-use host_std::bvh::Bvh;
-use host_std::environment::{EnvSource, Environment, Placement};
 use host_std::integrator::Method;
+use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::pilot;
 use host_std::render::{Settings, render};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::{Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
 
@@ -93,7 +93,7 @@ fn a_matte_studio_can_be_env_sampled() {
     // sampling more than twice as good (the real studio at 256², 1024 spp: 2.3× at equal
     // time, docs/perf.md session 8).
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes");
-    let mut scene = host_std::scene_json::load(&dir.join("studio.json")).unwrap();
+    let mut scene = host_std::scene::json::load(&dir.join("studio.json")).unwrap();
     scene.camera.width = 96;
     scene.camera.height = 96;
     scene.materials.truncate(1);

@@ -3,12 +3,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use host_std::bvh::Bvh;
-use host_std::environment::{EnvSource, Environment, Placement};
 use host_std::integrator::Method;
+use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::render::{self, Settings};
 use host_std::scene::Scene;
-use host_std::{default_scene, output, pilot, report, scene_json};
+use host_std::scene::{builtin, json};
+use host_std::trace::bvh::Bvh;
+use host_std::{output, pilot, report};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -207,20 +208,20 @@ fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>)) -> Result<Load
     #[cfg_attr(not(feature = "usd"), allow(unused_mut))]
     let mut notes = Vec::new();
     let mut scene = match &args.scene {
-        None => default_scene::scene(),
+        None => builtin::scene(),
         Some(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
             match ext.as_str() {
-                "json" => scene_json::load(path)?,
+                "json" => json::load(path)?,
                 #[cfg(feature = "usd")]
                 "usd" | "usda" | "usdc" | "usdz" => {
-                    let options = host_std::usd_scene::Options {
+                    let options = host_std::scene::usd::Options {
                         camera: args.camera.clone(),
                         render_settings: args.render_settings.clone(),
                         width: size.0,
                         height: size.1,
                     };
-                    let c = host_std::usd_scene::load(path, &options)?;
+                    let c = host_std::scene::usd::load(path, &options)?;
                     notes = c.notes;
                     usd = Some(c.usd);
                     c.scene
@@ -459,7 +460,7 @@ fn info_command(args: InfoArgs) -> Result<()> {
     let loaded = load_scene(&args.scene, (None, None))?;
     #[cfg(feature = "usd")]
     if let Some(usd) = &loaded.usd {
-        host_std::usd_info::print_import(usd);
+        host_std::scene::usd_info::print_import(usd);
     }
     if !loaded.notes.is_empty() {
         println!("not rendered as authored ({}):", loaded.notes.len());
@@ -525,7 +526,7 @@ fn pyramid_mb(level: u32) -> f64 {
 
 #[cfg(feature = "usd")]
 fn conformance(dir: &Path) -> Result<()> {
-    host_std::usd_info::conformance(dir)
+    host_std::scene::usd_info::conformance(dir)
 }
 
 #[cfg(not(feature = "usd"))]

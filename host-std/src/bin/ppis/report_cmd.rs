@@ -4,11 +4,11 @@
 use super::{MAX_SPP, SamplingArgs, SceneArgs, load_scene, parse_method, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use host_std::bvh::Bvh;
-use host_std::environment::Environment;
 use host_std::integrator::Method;
+use host_std::light::environment::Environment;
 use host_std::output;
 use host_std::render::{self, Settings};
+use host_std::trace::bvh::Bvh;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -70,7 +70,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     // Everything that reads input comes first: bad input leaves no output folder behind.
     let given = match &args.reference {
         Some(path) => {
-            let image = host_std::env_io::load(path)?;
+            let image = host_std::light::image_file::load(path)?;
             if (image.width, image.height) != (w, h) {
                 bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
             }

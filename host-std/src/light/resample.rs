@@ -7,7 +7,7 @@
 //! square lives in the same local frame: texel (x, y) is the direction `square_to_sphere` gives
 //! for its points, x along u, y along v of the square.
 
-use crate::env_io::RgbImage;
+use crate::light::image_file::RgbImage;
 use rayon::prelude::*;
 use sampler_core::glam::{Vec2, Vec3};
 use sampler_core::mapping::square_to_sphere;

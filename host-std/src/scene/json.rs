@@ -3,8 +3,8 @@
 //! car-paint materials. Unknown fields are errors: a misspelt key must not silently render
 //! something else.
 
-use crate::environment::{EnvSource, Placement};
-use crate::mesh;
+use crate::light::environment::{EnvSource, Placement};
+use crate::scene::mesh;
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Mat4, Vec3};

@@ -1,7 +1,7 @@
-//! The renderer's scene: camera, shapes with materials, and an optional environment light.
-//! Filled by the embedded default scene, the JSON reader, and (later) the USD importer.
+//! The scene model: camera, shapes with materials, and an optional environment light, as every
+//! loader fills it (the built-in scene, the JSON reader, the USD importer).
 
-use crate::environment::{EnvSource, Placement};
+use crate::light::environment::{EnvSource, Placement};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Vec2, Vec3};
 

@@ -336,7 +336,7 @@ mod tests {
             objects.push(Object { shape, material: 0 });
         }
         let material = Material::new(crate::scene::Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
-        let scene = Scene { objects, materials: vec![material], ..crate::default_scene::scene() };
+        let scene = Scene { objects, materials: vec![material], ..crate::scene::builtin::scene() };
         let bvh = Bvh::build(&scene);
         let mut hits = 0;
         for k in 0..2000 {

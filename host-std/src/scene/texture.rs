@@ -1,7 +1,7 @@
 //! Image textures for materials: bilinear lookups with USD's texture-coordinate convention
 //! (st = (0, 0) is the image's lower-left corner) and wrap modes.
 
-use crate::env_io::RgbImage;
+use crate::light::image_file::RgbImage;
 use sampler_core::glam::Vec2;
 
 /// How coordinates outside [0, 1] read the image.

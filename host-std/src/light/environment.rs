@@ -1,9 +1,9 @@
 //! The scene's environment light, owned by the host: the equal-area RGB map and its importance
 //! pyramid, built once; `sampler-core` borrows both through an `EnvHierarchy`.
 
-use crate::env_io::{self, LoadError, RgbImage};
-use crate::resample;
-use crate::sky::Sky;
+use crate::light::image_file::{self, LoadError, RgbImage};
+use crate::light::resample;
+use crate::light::sky::Sky;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::glam::Mat3;
 use std::path::{Path, PathBuf};
@@ -104,8 +104,8 @@ impl Environment {
             }
             EnvSource::File(_) | EnvSource::Bytes { .. } => {
                 let (path, image, latlong) = match source {
-                    EnvSource::File(path) => (path, env_io::load(path)?, false),
-                    EnvSource::Bytes { name, bytes, latlong } => (name, env_io::load_bytes(name, bytes)?, *latlong),
+                    EnvSource::File(path) => (path, image_file::load(path)?, false),
+                    EnvSource::Bytes { name, bytes, latlong } => (name, image_file::load_bytes(name, bytes)?, *latlong),
                     _ => unreachable!("matched above"),
                 };
                 let load_seconds = t0.elapsed().as_secs_f64();

@@ -54,5 +54,9 @@ fn load_obj(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), Mes
 }
 
 fn load_ply(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), MeshError> {
-    crate::ply::parse(bytes).map_err(|message| MeshError::Decode { path: path.to_owned(), format: "PLY", message })
+    crate::scene::ply::parse(bytes).map_err(|message| MeshError::Decode {
+        path: path.to_owned(),
+        format: "PLY",
+        message,
+    })
 }

@@ -5,10 +5,10 @@
 //! Errors are over all pixels and channels: RMSE = √mean (x − r)², relMSE = mean (x − r)²/(r² + ε)
 //! with ε = 0.01 (the usual guard for dark pixels).
 
-use crate::bvh::Bvh;
 use crate::integrator::Method;
 use crate::render::{self, Settings};
 use crate::scene::Scene;
+use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -47,7 +47,7 @@ pub struct Regions {
 
 impl Regions {
     pub fn of(scene: &Scene, bvh: &Bvh) -> Self {
-        let camera = crate::camera::Camera::new(&scene.camera);
+        let camera = crate::trace::camera::Camera::new(&scene.camera);
         let (w, h) = (camera.width as usize, camera.height as usize);
         let mut names: Vec<String> = Vec::new();
         let mut of_pixel = Vec::with_capacity(w * h);
@@ -335,7 +335,7 @@ pub fn markdown(
     s
 }
 
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// The log-log plot of relMSE against time, one line per method, as SVG and PNG.
 pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measurement]) -> Result<(), String> {

@@ -2,7 +2,7 @@
 //! Lambert, glossy GGX, very sharp GGX, car paint — on a grey ground plane under the built-in
 //! sky with its sun.
 
-use crate::environment::{EnvSource, Placement};
+use crate::light::environment::{EnvSource, Placement};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
