@@ -6,15 +6,16 @@
 //! * [`light`]: environment maps — image files, lat-long resampling, the built-in sky;
 //! * [`scene`]: the scene model and its loaders (built-in, JSON, USD, meshes, textures);
 //! * [`trace`]: camera rays and the BVH;
-//! * [`integrator`], [`render`], [`pilot`]: methods, shading, the tiled tracer and `auto`'s
-//!   pilot;
+//! * [`render`]: the tiles, the pixel pipeline, the sampler cache and shading, for materials
+//!   whose strategies are decided;
+//! * [`plan`]: the methods, `auto`'s rules and its pilot, and [`plan::render`], which plans a
+//!   render and runs it;
 //! * [`report`]: error against time over many renders;
 //! * [`output`]: writing images and text, used by the command line and the report.
 
-pub mod integrator;
 pub mod light;
 pub mod output;
-pub mod pilot;
+pub mod plan;
 pub mod render;
 pub mod report;
 pub mod scene;

@@ -12,9 +12,9 @@
 //! and replace [`EXPECTED`] with the table the failure prints, saying in the commit why the
 //! images changed.
 
-use host_std::integrator::Method;
 use host_std::light::environment::Environment;
-use host_std::render::{Rendered, Settings, render};
+use host_std::plan::Method;
+use host_std::plan::{Rendered, Settings, render};
 use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;

@@ -3,10 +3,11 @@
 //! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
 //! matte studio where it measures twice as good as the rules' MIS.
 
-use host_std::integrator::Method;
 use host_std::light::environment::{EnvSource, Environment, Placement};
-use host_std::pilot;
-use host_std::render::{Settings, render};
+use host_std::plan::Method;
+use host_std::plan::pilot;
+use host_std::plan::{Settings, render};
+use host_std::render::strategy::Strategy;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::{Lambert, RoughConductor};
@@ -74,7 +75,7 @@ fn a_matte_sphere_under_the_sun_is_not_brdf_sampled() {
     // pixels would not see the rare cosine samples that hit the sun, and would score BRDF
     // sampling by the sky alone. Under a constant dome it is a candidate; under the sun not.
     let matte = Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5)));
-    let brdf = pilot::PLANS.iter().position(|p| p.0 == Method::Brdf).expect("BRDF sampling is a plan");
+    let brdf = pilot::PLANS.iter().position(|p| p.strategy == Strategy::Brdf).expect("BRDF sampling is a plan");
     let sun = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
     let dome = Environment::build(&EnvSource::Constant { level: 3 }, Placement::default()).unwrap();
     assert!(!pilot::eligible(brdf, &matte, sun.hierarchy().peak(5)), "not a candidate under the sun");

@@ -1,9 +1,9 @@
 //! End-to-end properties of the tracer: the image does not depend on the thread count, every
 //! method converges to the analytic white-furnace answer, and nothing non-finite comes out.
 
-use host_std::integrator::Method;
 use host_std::light::environment::{EnvSource, Environment, Placement};
-use host_std::render::{Settings, render};
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
 use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;

@@ -3,9 +3,9 @@
 //! for what a scene uses.
 #![cfg(feature = "usd")]
 
-use host_std::integrator::Method;
 use host_std::light::environment::Environment;
-use host_std::render::{Settings, render};
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
 use host_std::scene::usd;
 use host_std::trace::bvh::Bvh;
 use host_std::trace::camera::Camera;

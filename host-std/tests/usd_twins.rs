@@ -5,9 +5,9 @@
 //! UsdRenderSettings pick the image size and the camera.
 #![cfg(feature = "usd")]
 
-use host_std::integrator::Method;
 use host_std::light::environment::Environment;
-use host_std::render::{Settings, render};
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
 use host_std::scene::{Bsdf, Scene, Shape};
 use host_std::scene::{json, usd};
 use host_std::trace::bvh::Bvh;

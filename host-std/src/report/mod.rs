@@ -5,8 +5,8 @@
 //! Errors are over all pixels and channels: RMSE = √mean (x − r)², relMSE = mean (x − r)²/(r² + ε)
 //! with ε = 0.01 (the usual guard for dark pixels).
 
-use crate::integrator::Method;
-use crate::render::{self, Settings};
+use crate::plan::Method;
+use crate::plan::{self, Settings};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
@@ -154,7 +154,7 @@ pub fn sweep(
         ..*base
     };
     let mut measure = |method: Method, spp: usize| {
-        let image = render::render(scene, bvh, env, &settings(method, spp));
+        let image = plan::render(scene, bvh, env, &settings(method, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
         let plans = image
@@ -162,7 +162,10 @@ pub fn sweep(
             .iter()
             .map(|r| {
                 let changed = if Some(r.chosen) == r.rule { "" } else { " (pilot)" };
-                (scene.materials[r.material].bsdf.label(), format!("{}{changed}", crate::pilot::plan_name(r.chosen)))
+                (
+                    scene.materials[r.material].bsdf.label(),
+                    format!("{}{changed}", crate::plan::pilot::plan_name(r.chosen)),
+                )
             })
             .collect();
         let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions, plans };
@@ -179,7 +182,7 @@ pub fn sweep(
         bracket_base(&mut out, methods, target, &mut measure);
     }
     keep_fastest(&mut out, repeat, |method, spp| {
-        render::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }).render_seconds
+        plan::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }).render_seconds
     });
     out
 }

@@ -3,13 +3,14 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use host_std::integrator::Method;
 use host_std::light::environment::{EnvSource, Environment, Placement};
-use host_std::render::{self, Settings};
+use host_std::plan::Method;
+use host_std::plan::pilot;
+use host_std::plan::{self, Settings};
 use host_std::scene::Scene;
 use host_std::scene::{builtin, json};
 use host_std::trace::bvh::Bvh;
-use host_std::{output, pilot, report};
+use host_std::{output, report};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -363,7 +364,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         shadows: !args.sampling.unshadowed,
     };
     let hierarchy = environment.as_ref().map(Environment::hierarchy);
-    let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+    let image = pool.install(|| plan::render(&scene, &bvh, hierarchy.as_ref(), &settings));
 
     output::write_exr(&exr_path, image.width, image.height, &image.pixels)?;
     output::write_png(&png_path, image.width, image.height, &image.pixels)?;
@@ -505,15 +506,15 @@ fn info_command(args: InfoArgs) -> Result<()> {
         "a render builds: {} BVH primitives{}; product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {} of its samples from the product on GGX conductors with α ≥ {} when the map's peak is under {}, half elsewhere); auto = product-mis on GGX conductors with α in {:?} ({:?} when the map's peak is under {}: no sun), mis on the other materials ({} of it env samples on diffuse surfaces when the peak is under {}), or BRDF sampling when the lighting is smooth (peak < {}) — then checked per material by a pilot render of 32–64 of its pixels with the candidate plans env, BRDF, MIS and product-MIS (those whose sample weights are bounded there, the two MIS methods at the rules' splits; of {} plans in all), which replaces the rule's plan where another measures {}× better at equal cost (about 2% of the render; images of at least ~96×96 per material)",
         Bvh::build(&scene).primitive_count(),
         if scene.env.is_some() { ", the env hierarchy" } else { "" },
-        host_std::integrator::WIDE_LOBE_PRODUCT_SHARE,
-        host_std::integrator::WIDE_LOBE,
-        host_std::integrator::SUN_PEAK,
-        host_std::integrator::PRODUCT_ALPHA,
-        host_std::integrator::PRODUCT_ALPHA_EXTENDED,
-        host_std::integrator::SUN_PEAK,
-        host_std::integrator::AUTO_DIFFUSE_ENV_SHARE,
-        host_std::integrator::SUN_PEAK,
-        host_std::integrator::SMOOTH_LIGHTING_PEAK,
+        host_std::plan::rules::WIDE_LOBE_PRODUCT_SHARE,
+        host_std::plan::rules::WIDE_LOBE,
+        host_std::plan::rules::SUN_PEAK,
+        host_std::plan::rules::PRODUCT_ALPHA,
+        host_std::plan::rules::PRODUCT_ALPHA_EXTENDED,
+        host_std::plan::rules::SUN_PEAK,
+        host_std::plan::rules::AUTO_DIFFUSE_ENV_SHARE,
+        host_std::plan::rules::SUN_PEAK,
+        host_std::plan::rules::SMOOTH_LIGHTING_PEAK,
         pilot::PLANS.len(),
         pilot::OVERRIDE_MARGIN
     );

@@ -4,10 +4,10 @@
 use super::{MAX_SPP, SamplingArgs, SceneArgs, load_scene, parse_method, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use host_std::integrator::Method;
 use host_std::light::environment::Environment;
 use host_std::output;
-use host_std::render::{self, Settings};
+use host_std::plan::Method;
+use host_std::plan::{self, Settings};
 use host_std::trace::bvh::Bvh;
 use std::path::PathBuf;
 
@@ -111,7 +111,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
                 ..base
             };
             eprintln!("ppis: rendering the reference ({}, {spp} spp)", args.reference_method);
-            let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
+            let image = pool.install(|| plan::render(&scene, &bvh, hierarchy.as_ref(), &settings));
             output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
             (
                 image.pixels,
