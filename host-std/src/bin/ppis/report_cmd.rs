@@ -1,7 +1,8 @@
 //! `ppis report`: every method at every sample count against a reference — error against
 //! render time as CSV, plot and equal-time tables.
 
-use super::{MAX_SPP, SamplingArgs, SceneArgs, load_scene, parse_method, warn_notes};
+use crate::args::{DEFAULT_SHADING_POINTS, MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::load::{load_scene, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
@@ -44,7 +45,7 @@ pub(crate) struct ReportArgs {
     #[arg(long)]
     bracket: bool,
     /// Time every render this many times in all (in rounds over all renders) and keep the
-    /// fastest: on a noisy machine single timings move by tens of per cent.
+    /// fastest: single timings vary with what else the machine is doing.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
     #[command(flatten)]
@@ -92,7 +93,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let base = Settings {
         method: Method::Product,
         spp: 1,
-        shading_points: args.sampling.shading_points.unwrap_or(crate::DEFAULT_SHADING_POINTS) as usize,
+        shading_points: args.sampling.shading_points.unwrap_or(DEFAULT_SHADING_POINTS) as usize,
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: false,
