@@ -5,13 +5,18 @@
 //! Errors are over all pixels and channels: RMSE = √mean (x − r)², relMSE = mean (x − r)²/(r² + ε)
 //! with ε = 0.01 (the usual guard for dark pixels).
 
-use crate::plan::Method;
-use crate::plan::{self, Settings};
+mod errors;
+mod plot;
+mod tables;
+
+pub use errors::{Regions, errors};
+pub use plot::plot;
+pub use tables::{csv, markdown, relmse_at};
+
+use crate::plan::{self, Method, Settings};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
-use std::fmt::Write as _;
-use std::path::Path;
 
 /// One render of the sweep: errors over all pixels (`rmse`, `relmse`) and per region.
 #[derive(Clone, Debug)]
@@ -35,73 +40,6 @@ impl Measurement {
         }
         self.regions.iter().find(|r| r.0 == region).map(|r| r.2)
     }
-}
-
-/// Pixels grouped by the material their centre ray hits, named by kind and lobe width
-/// ("diffuse", "roughconductor α=0.05", "phong n=200", "carpaint"); misses belong to no region.
-pub struct Regions {
-    pub names: Vec<String>,
-    /// Per pixel, the index into `names`, or `None`.
-    pub of_pixel: Vec<Option<usize>>,
-}
-
-impl Regions {
-    pub fn of(scene: &Scene, bvh: &Bvh) -> Self {
-        let camera = crate::trace::camera::Camera::new(&scene.camera);
-        let (w, h) = (camera.width as usize, camera.height as usize);
-        let mut names: Vec<String> = Vec::new();
-        let mut of_pixel = Vec::with_capacity(w * h);
-        for y in 0..h {
-            for x in 0..w {
-                let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
-                of_pixel.push(bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY).map(|hit| {
-                    let label = scene.materials[hit.material as usize].bsdf.label();
-                    names.iter().position(|n| *n == label).unwrap_or_else(|| {
-                        names.push(label);
-                        names.len() - 1
-                    })
-                }));
-            }
-        }
-        Self { names, of_pixel }
-    }
-
-    /// RMSE and relMSE of each region.
-    pub fn errors(&self, image: &[[f32; 3]], reference: &[[f32; 3]]) -> Vec<(String, f64, f64)> {
-        self.names
-            .iter()
-            .enumerate()
-            .map(|(k, name)| {
-                let (mut se, mut rel, mut n) = (0.0f64, 0.0f64, 0usize);
-                for ((p, r), region) in image.iter().zip(reference).zip(&self.of_pixel) {
-                    if *region == Some(k) {
-                        for c in 0..3 {
-                            let d = p[c] as f64 - r[c] as f64;
-                            se += d * d;
-                            rel += d * d / (r[c] as f64 * r[c] as f64 + 0.01);
-                        }
-                        n += 3;
-                    }
-                }
-                let n = n.max(1) as f64;
-                (name.clone(), (se / n).sqrt(), rel / n)
-            })
-            .collect()
-    }
-}
-
-/// RMSE and relMSE of `image` against `reference` (same size).
-pub fn errors(image: &[[f32; 3]], reference: &[[f32; 3]]) -> (f64, f64) {
-    let (mut se, mut rel) = (0.0f64, 0.0f64);
-    for (p, r) in image.iter().zip(reference) {
-        for c in 0..3 {
-            let d = p[c] as f64 - r[c] as f64;
-            se += d * d;
-            rel += d * d / (r[c] as f64 * r[c] as f64 + 0.01);
-        }
-    }
-    let n = (3 * image.len()) as f64;
-    ((se / n).sqrt(), rel / n)
 }
 
 /// Shading points per pixel for a given spp: with `per_point` visibility samples per shading
@@ -226,193 +164,6 @@ pub const BRACKET_DOUBLINGS: usize = 3;
 
 /// No bracketing render goes beyond this many visibility samples per pixel.
 const MAX_BRACKET_SPP: usize = 1 << 20;
-
-/// relMSE over `region` of `method` at time `t`, interpolated log-log between its
-/// measurements (outside their range: extended along the nearest segment; flagged).
-pub fn relmse_at(measurements: &[Measurement], method: Method, region: &str, t: f64) -> Option<(f64, bool)> {
-    let mut pts: Vec<(f64, f64)> = measurements
-        .iter()
-        .filter(|m| m.method == method && m.seconds > 0.0)
-        .filter_map(|m| m.relmse_in(region).filter(|e| *e > 0.0).map(|e| (m.seconds.ln(), e.ln())))
-        .collect();
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    if pts.is_empty() {
-        return None;
-    }
-    if pts.len() == 1 {
-        // One point: assume error ∝ 1/time.
-        let (t0, e0) = pts[0];
-        return Some(((e0 - (t.ln() - t0)).exp(), (t.ln() - t0).abs() > 1e-9));
-    }
-    let x = t.ln();
-    let k = pts.windows(2).position(|w| x <= w[1].0).unwrap_or(pts.len() - 2);
-    let ((x0, y0), (x1, y1)) = (pts[k], pts[k + 1]);
-    let outside = x < pts[0].0 || x > pts[pts.len() - 1].0;
-    let y = if x1 > x0 { y0 + (y1 - y0) * (x - x0) / (x1 - x0) } else { y0 };
-    Some((y.exp(), outside))
-}
-
-/// `error_vs_time.csv`: one row per render and region ("all" is the whole image).
-pub fn csv(measurements: &[Measurement]) -> String {
-    let mut s = String::from("method,spp,seconds,region,rmse,relmse\n");
-    for m in measurements {
-        let _ = writeln!(s, "{},{},{:.6},all,{:.6e},{:.6e}", m.method, m.spp, m.seconds, m.rmse, m.relmse);
-        for (region, rmse, relmse) in &m.regions {
-            let _ = writeln!(s, "{},{},{:.6},{region},{rmse:.6e},{relmse:.6e}", m.method, m.spp, m.seconds);
-        }
-    }
-    s
-}
-
-/// `report.md`: the measurements, then equal-time tables against `base` (e.g. `product`) for
-/// the whole image and for each region.
-pub fn markdown(
-    scene: &str,
-    measurements: &[Measurement],
-    base: Method,
-    threads: usize,
-    reference_note: &str,
-) -> String {
-    let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
-    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
-    let regions: Vec<String> =
-        measurements.first().map(|m| m.regions.iter().map(|r| r.0.clone()).collect()).unwrap_or_default();
-    s.push_str("| method | spp | seconds | RMSE | relMSE |");
-    for r in &regions {
-        let _ = write!(s, " relMSE {r} |");
-    }
-    s.push_str("\n|---|---|---|---|---|");
-    s.push_str(&"---|".repeat(regions.len()));
-    s.push('\n');
-    for m in measurements {
-        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.method, m.spp, m.seconds, m.rmse, m.relmse);
-        for r in &m.regions {
-            let _ = write!(s, " {:.4e} |", r.2);
-        }
-        s.push('\n');
-    }
-    for m in measurements.iter().filter(|m| !m.plans.is_empty()) {
-        let plans: Vec<String> = m.plans.iter().map(|(material, plan)| format!("{material} → {plan}")).collect();
-        let _ = writeln!(s, "\n{} at {} spp: {}.", m.method, m.spp, plans.join(", "));
-    }
-    let mut others: Vec<Method> = Vec::new();
-    for m in measurements {
-        if m.method != base && !others.contains(&m.method) {
-            others.push(m.method);
-        }
-    }
-    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == base).collect();
-    if product.is_empty() || others.is_empty() {
-        return s;
-    }
-    let _ = write!(
-        s,
-        "\n## Equal time\n\nFor the time {base} takes at each spp, every other method's relMSE at that time (log-log interpolation; * = extrapolated beyond its measured times) and its ratio to {base}'s (> 1: {base} is better).\n"
-    );
-    for region in std::iter::once("all".to_string()).chain(regions) {
-        let _ = write!(
-            s,
-            "\n### {}\n\n| {base} spp | seconds | {base} relMSE |",
-            if region == "all" { "whole image".to_string() } else { format!("pixels on {region}") }
-        );
-        for o in &others {
-            let _ = write!(s, " {o} relMSE | ratio |");
-        }
-        s.push_str("\n|---|---|---|");
-        s.push_str(&"---|---|".repeat(others.len()));
-        s.push('\n');
-        for p in &product {
-            let Some(pe) = p.relmse_in(&region) else { continue };
-            let _ = write!(s, "| {} | {:.3} | {:.4e} |", p.spp, p.seconds, pe);
-            for &o in &others {
-                match relmse_at(measurements, o, &region, p.seconds) {
-                    Some((e, outside)) => {
-                        let _ = write!(s, " {:.4e}{} | {:.2} |", e, if outside { "*" } else { "" }, e / pe);
-                    }
-                    None => s.push_str(" – | – |"),
-                }
-            }
-            s.push('\n');
-        }
-    }
-    s
-}
-
-static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
-
-/// The log-log plot of relMSE against time, one line per method, as SVG and PNG.
-pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measurement]) -> Result<(), String> {
-    use plotters::prelude::*;
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    let (mut t0, mut t1, mut e0, mut e1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for m in measurements.iter().filter(|m| m.seconds > 0.0 && m.relmse > 0.0) {
-        (t0, t1, e0, e1) = (t0.min(m.seconds), t1.max(m.seconds), e0.min(m.relmse), e1.max(m.relmse));
-    }
-    if !(t0 < t1 && e0 < e1) {
-        (t0, t1, e0, e1) = (t0.min(1e-3), t1.max(1.0), e0.min(1e-6), e1.max(1.0));
-    }
-    let methods: Vec<Method> = {
-        let mut v: Vec<Method> = measurements.iter().map(|m| m.method).collect();
-        v.dedup();
-        v
-    };
-    fn draw<DB: DrawingBackend>(
-        root: DrawingArea<DB, plotters::coord::Shift>,
-        title: &str,
-        ranges: (f64, f64, f64, f64),
-        methods: &[Method],
-        measurements: &[Measurement],
-    ) -> Result<(), String>
-    where
-        DB::ErrorType: 'static,
-    {
-        let (t0, t1, e0, e1) = ranges;
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
-            .build_cartesian_2d((t0 / 1.3..t1 * 1.3).log_scale(), (e0 / 1.5..e1 * 1.5).log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("render time (s)")
-            .y_desc("relMSE")
-            .x_label_formatter(&|x| format!("{x:.3}"))
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (k, &method) in methods.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
-            let mut pts: Vec<(f64, f64)> = measurements
-                .iter()
-                .filter(|m| m.method == method && m.seconds > 0.0 && m.relmse > 0.0)
-                .map(|m| (m.seconds, m.relmse))
-                .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(method.name())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
-            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled()))).map_err(|e| e.to_string())?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())
-    }
-    let ranges = (t0, t1, e0, e1);
-    draw(SVGBackend::new(path_svg, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
-    draw(BitMapBackend::new(path_png, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
-    Ok(())
-}
 
 #[cfg(test)]
 mod tests {
