@@ -13,6 +13,8 @@
 //! * [`report`]: error against time over many renders;
 //! * [`output`]: writing images and text, used by the command line and the report.
 
+#![warn(missing_docs)]
+
 pub mod light;
 pub mod output;
 pub mod plan;

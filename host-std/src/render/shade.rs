@@ -33,6 +33,9 @@ impl<F: FnMut(Vec3) -> bool> Visibility for CountingVisibility<F> {
 /// needs, built. A product sampler or two-stage partition may have been built for another
 /// shading point of the same pixel and material (still unbiased: it is a valid density that is
 /// positive wherever L > 0).
+// The two-stage partition makes one variant large; a `Sampling` lives on the stack for one
+// group of shading points, and boxing it would allocate per shading point.
+#[allow(clippy::large_enum_variant)]
 pub enum Sampling<'s, 'e> {
     /// Env samples only.
     Env,

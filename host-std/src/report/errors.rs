@@ -8,12 +8,14 @@ use crate::trace::camera::Camera;
 /// Pixels grouped by the material their centre ray hits, named by kind and lobe width
 /// ("diffuse", "roughconductor α=0.05", "phong n=200", "carpaint"); misses belong to no region.
 pub struct Regions {
+    /// The regions' names.
     pub names: Vec<String>,
     /// Per pixel, the index into `names`, or `None`.
     pub of_pixel: Vec<Option<usize>>,
 }
 
 impl Regions {
+    /// The regions of the scene's image, from one centre ray per pixel.
     pub fn of(scene: &Scene, bvh: &Bvh) -> Self {
         let camera = Camera::new(&scene.camera);
         let (w, h) = (camera.width as usize, camera.height as usize);

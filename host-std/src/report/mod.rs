@@ -21,10 +21,15 @@ use sampler_core::env::EnvHierarchy;
 /// One render of the sweep: errors over all pixels (`rmse`, `relmse`) and per region.
 #[derive(Clone, Debug)]
 pub struct Measurement {
+    /// The method.
     pub method: Method,
+    /// Visibility samples per pixel.
     pub spp: usize,
+    /// Render time (the fastest of the repeats).
     pub seconds: f64,
+    /// RMSE over all pixels and channels.
     pub rmse: f64,
+    /// relMSE over all pixels and channels.
     pub relmse: f64,
     /// (region, RMSE, relMSE) for each region of `Regions`.
     pub regions: Vec<(String, f64, f64)>,

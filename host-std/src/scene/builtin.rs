@@ -10,6 +10,7 @@ use sampler_core::glam::Vec3;
 /// Equal-area resolution of the built-in sky: 1024² keeps the 0.53° sun at ~6 texels.
 pub const SKY_LEVEL: u32 = 10;
 
+/// The built-in scene.
 pub fn scene() -> Scene {
     let material = |bsdf| Material::new(bsdf, false);
     let materials = vec![

@@ -11,14 +11,34 @@ use sampler_core::glam::{Mat4, Vec3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// Why a JSON scene cannot be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The file cannot be read.
     #[error("{path}: cannot read the scene: {error}")]
-    Io { path: PathBuf, error: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        error: std::io::Error,
+    },
+    /// The file is not valid scene JSON.
     #[error("{path}: invalid scene JSON: {message}")]
-    Json { path: PathBuf, message: String },
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file is well-formed but describes something invalid.
     #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A mesh the scene names cannot be loaded.
     #[error(transparent)]
     Mesh(#[from] mesh::MeshError),
 }

@@ -19,7 +19,9 @@ pub const DEFAULT_WIDTH: u32 = 640;
 
 /// A converted scene and the notes to show the user (skips, texture reductions).
 pub struct Converted {
+    /// The renderer's scene.
     pub scene: Scene,
+    /// What the import left out or reduced, one line each.
     pub notes: Vec<String>,
     /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
     pub usd: UsdScene,
@@ -32,8 +34,9 @@ pub struct Options {
     pub camera: Option<String>,
     /// The RenderSettings prim (default: the layer's `renderSettingsPrimPath`).
     pub render_settings: Option<String>,
-    /// Image width and height, overriding the render settings' resolution.
+    /// Image width, overriding the render settings' resolution.
     pub width: Option<u32>,
+    /// Image height, overriding the render settings' resolution.
     pub height: Option<u32>,
 }
 

@@ -10,16 +10,24 @@ use std::mem::MaybeUninit;
 /// One intersectable primitive.
 #[derive(Clone, Copy, Debug)]
 pub enum Primitive {
+    /// A sphere.
     Sphere {
+        /// Centre.
         center: Vec3,
+        /// Radius.
         radius: f32,
+        /// Index into the scene's materials.
         material: u32,
     },
     /// v0 and two edges; the front face is normalize(e1 × e2).
     Triangle {
+        /// A vertex.
         v0: Vec3,
+        /// The edge from `v0` to the second vertex.
         e1: Vec3,
+        /// The edge from `v0` to the third vertex.
         e2: Vec3,
+        /// Index into the scene's materials.
         material: u32,
         /// Index into the corner attributes, or `NO_ATTRS` (face normal, no texture
         /// coordinates).
@@ -143,7 +151,9 @@ pub(crate) struct Node {
 /// Where a ray hit.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
+    /// Distance along the ray (in units of its direction).
     pub t: f32,
+    /// The hit point.
     pub point: Vec3,
     /// Geometric normal, unit, on the front side of the surface.
     pub normal: Vec3,
@@ -152,6 +162,7 @@ pub struct Hit {
     pub shading_normal: Vec3,
     /// Interpolated texture coordinates, where the mesh has them.
     pub uv: Option<Vec2>,
+    /// Index into the scene's materials.
     pub material: u32,
 }
 
