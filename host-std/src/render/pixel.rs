@@ -155,6 +155,9 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, index: usize) -> Op
 /// sampler per shading point, or for product-MIS one per material, built at its first point.
 fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scratch: &mut Scratch, sum: &mut DVec3) {
     let Scratch { cache, hits, counters } = scratch;
+    let p = ctx.options.shading_points.max(1);
+    let budget = (ctx.options.spp / p).max(1);
+    let shadows = ctx.options.shadows;
     for first in 0..hits.len() {
         let lead = &hits[first];
         let group = lead.material;
@@ -171,13 +174,10 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         for (_, h) in members {
             counters.shading_points += 1;
             let origin = h.origin;
-            let shadows = ctx.options.shadows;
             let mut vis = CountingVisibility {
                 test: |d: Vec3| !shadows || !ctx.bvh.occluded(origin, d, 0.0, f32::INFINITY),
                 rays: 0,
             };
-            let p = ctx.options.shading_points.max(1);
-            let budget = (ctx.options.spp / p).max(1);
             let block = permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize;
             let run = Run { seed: seeds.light, block };
             *sum += shade::shade(&sampling, env, &shading_point(ctx.scene, h), budget, run, &mut vis);
