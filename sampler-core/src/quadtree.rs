@@ -253,7 +253,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         }
         // Empty children. With n samples over k non-empty children, add-α smoothing of the
         // counts gives an empty child (0 + α)/(n/k + α) of a non-empty child's density:
-        // fill = b̄·αk/(n + αk). Two samples in two children: b̄/2 (little evidence; a smooth
+        // fill = b̄·αk/(n + αk). Two samples in two children: 2b̄/3 (little evidence; a smooth
         // BRDF keeps most of it). But counts cannot tell a tail of 1e-2 from one of 1e-5, and
         // the chain of cells above a needle lobe (n = 256, k = 1) would still hand each empty
         // sibling ~1% of the lobe's mass, which a brighter sky there multiplies. So where the

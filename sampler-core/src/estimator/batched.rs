@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
 /// samples spends 8 pairs; a larger batch only zeroes more scratch per call, which a shading
-/// point with few samples pays in full: docs/perf.md#batch-size).
+/// point with few samples pays in full: docs/perf.md#batched-and-branch-free-sampling).
 pub const BATCH: usize = 16;
 
 /// A drawn direction: world direction, its point of the square, density (solid angle).
