@@ -1,6 +1,6 @@
 //! `cargo bench -p sampler-core`: mapping transforms, per-shading-point product build + warps,
-//! and env-only sampling through the same hierarchy as the yardstick. Numbers go to
-//! docs/perf.md.
+//! and env-only sampling through the same hierarchy as the yardstick. The numbers are in
+//! docs/perf.md#mapping-transforms and docs/perf.md#building-a-product-sampler.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, Vec2, Vec3};

@@ -23,6 +23,7 @@ impl Ggx {
         Self { alpha }
     }
 
+    /// The (clamped) roughness α.
     #[inline]
     #[must_use]
     pub fn alpha(&self) -> f32 {
