@@ -1,7 +1,7 @@
 //! `cargo bench -p sampler-core`: mapping transforms, per-shading-point product build + warps
 //! (the quadtree product, and the two-level product beside it), and env-only sampling through
-//! the same hierarchy as the yardstick. Numbers go to
-//! docs/perf.md.
+//! the same hierarchy as the yardstick. The numbers are in docs/perf.md#mapping-transforms,
+//! docs/perf.md#building-a-product-sampler and docs/perf.md#the-two-products.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, Vec2, Vec3};

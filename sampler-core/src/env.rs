@@ -66,9 +66,19 @@ pub fn luminance(c: Vec3) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvError {
     /// The finest level is larger than [`MAX_LEVEL`].
-    TooLarge { finest: u32 },
+    TooLarge {
+        /// The finest level asked for.
+        finest: u32,
+    },
     /// A buffer does not have the length its finest level implies.
-    WrongLength { buffer: &'static str, expected: usize, found: usize },
+    WrongLength {
+        /// Which buffer (`"pyramid"` or `"radiance"`).
+        buffer: &'static str,
+        /// The length the finest level implies.
+        expected: usize,
+        /// The length handed in.
+        found: usize,
+    },
     /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
     NotSanitized,
 }

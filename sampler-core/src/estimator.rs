@@ -17,6 +17,7 @@ pub use batched::{BATCH, brdf_many, env_many, mis_many, mis_split, product_mis_m
 
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {
+    /// True when nothing blocks the environment from the shading point in world direction `dir`.
     fn visible(&mut self, dir: Vec3) -> bool;
 }
 
@@ -30,9 +31,11 @@ impl<F: FnMut(Vec3) -> bool> Visibility for F {
 /// its BRDF.
 #[derive(Clone, Copy)]
 pub struct ShadingPoint<'b, B: Brdf + ?Sized> {
+    /// Shading frame (its normal is the BRDF's +z).
     pub frame: Frame,
     /// World-space unit direction towards the viewer.
     pub wo: Vec3,
+    /// The surface's BRDF, evaluated in `frame`'s local coordinates.
     pub brdf: &'b B,
 }
 

@@ -34,6 +34,7 @@
 //! ```
 
 #![no_std]
+#![warn(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 // Loops over the four children of a node read clearer with an index.
 #![allow(clippy::needless_range_loop)]

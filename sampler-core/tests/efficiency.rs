@@ -1,5 +1,6 @@
 //! Product sampling must earn its keep. χ² tests prove the warp matches its pdf; they cannot see
-//! a poor B̃ (an early empty-leaf rule gave needle lobes 36× fake mass and still passed them).
+//! a poor B̃ (an empty-leaf rule that hands the empty siblings along a needle lobe's chain the
+//! lobe's mass passes every one of them).
 //! Per-sample variance of the product estimator against env-only and BRDF-only sampling, same
 //! shading points, same number of samples:
 //! * wide and glossy lobes (Lambert, GGX 0.2, car paint): product ≤ 0.5× the better baseline;

@@ -2,9 +2,8 @@
 //! errors (plus the quadrature's own error estimate), at fixed shading points: sharp lobes (GGX
 //! α = 1e-3, Phong n = 1e5, car paint), grazing views, an occluder, and an environment with a
 //! bright texel. With 7 estimators × 12 cases, a 3σ excursion somewhere has a ~20% chance even
-//! for unbiased estimators; when one appeared (MIS, Lambert, 20°: 3.08σ with a stream shared by
-//! all estimators), 3 × 2M draws on independent streams gave 0.40164, 0.40165, 0.40137 ± 1.8e-4
-//! against the quadrature's 0.40169 — a fluke, and each estimator now has its own stream.
+//! for unbiased estimators, so each estimator draws from its own stream: one stream shared by
+//! all would tie their excursions together.
 
 mod common;
 

@@ -12,13 +12,20 @@ use crate::sampling::{reflect, square_to_cosine_hemisphere, square_to_cosine_hem
 use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
+/// Lambert base + GGX flakes under a GGX clear coat with Schlick Fresnel (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CarPaint {
+    /// Albedo of the Lambertian base.
     pub base: Vec3,
+    /// Reflectance of the metallic-flake lobe.
     pub flake: Vec3,
+    /// Roughness of the flake lobe.
     pub flake_ggx: Ggx,
+    /// Weight c of the clear coat in [0, 1]; 0 removes the coat.
     pub coat: f32,
+    /// Roughness of the clear coat.
     pub coat_ggx: Ggx,
+    /// Schlick F0 of the clear coat (0.04 from [`CarPaint::new`], i.e. η = 1.5).
     pub coat_f0: f32,
 }
 
@@ -31,6 +38,8 @@ impl Default for CarPaint {
 }
 
 impl CarPaint {
+    /// A car paint with base albedo, flake reflectance and roughness, coat weight and coat
+    /// roughness (GGX α, not squared); the coat's F0 is 0.04.
     #[must_use]
     pub fn new(base: Vec3, flake: Vec3, flake_alpha: f32, coat: f32, coat_alpha: f32) -> Self {
         Self { base, flake, flake_ggx: Ggx::new(flake_alpha), coat, coat_ggx: Ggx::new(coat_alpha), coat_f0: 0.04 }

@@ -8,9 +8,12 @@ use crate::env::luminance;
 use crate::sampling::reflect;
 use glam::{Vec2, Vec3};
 
+/// GGX rough conductor with Fresnel 1 (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughConductor {
+    /// The microfacet distribution (its α).
     pub ggx: Ggx,
+    /// Reflectance that scales the lobe.
     pub specular: Vec3,
 }
 

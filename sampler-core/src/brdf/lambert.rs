@@ -10,10 +10,12 @@ use glam::{Vec2, Vec3};
 /// f = albedo / π, sampled ∝ cosθ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambert {
+    /// Reflectance per channel, in [0, 1] for energy conservation.
     pub albedo: Vec3,
 }
 
 impl Lambert {
+    /// A Lambertian BRDF of the given albedo.
     #[must_use]
     pub fn new(albedo: Vec3) -> Self {
         Self { albedo }

@@ -24,6 +24,7 @@ impl Ggx {
         Self { alpha }
     }
 
+    /// The (clamped) roughness α.
     #[inline]
     #[must_use]
     pub fn alpha(&self) -> f32 {

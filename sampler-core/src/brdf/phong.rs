@@ -17,8 +17,11 @@ use glam::{Vec2, Vec3};
 /// f = kd/π + ks·(n+2)/(2π)·cos^n α, α the angle between ωi and the mirror of ωo.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Phong {
+    /// Diffuse reflectance.
     pub kd: Vec3,
+    /// Specular reflectance of the lobe.
     pub ks: Vec3,
+    /// Exponent n of the cos^n lobe.
     pub exponent: f32,
 }
 

@@ -12,8 +12,8 @@ use crate::sampler::{DirectionSample, ProductSampler};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
-/// samples spends 8 pairs; larger batches only zeroed more scratch per call — measured, 6 kB
-/// of contributions per call were a tenth of a 4-sample shading point's time).
+/// samples spends 8 pairs; a larger batch only zeroes more scratch per call, which a shading
+/// point with few samples pays in full: docs/perf.md#batched-and-branch-free-sampling).
 pub const BATCH: usize = 16;
 
 /// A drawn direction: world direction, its point of the square, density (solid angle).
@@ -190,7 +190,7 @@ fn brdf_draws<B: Brdf + ?Sized>(
 /// their count. Unbiased for any split: each technique's density covers what it samples, and
 /// together they cover every direction where L·B > 0 (the product through its defensive part).
 /// Where a wide lobe meets extended light, product samples are worth more than BRDF samples,
-/// and a split towards them lowers the error (docs/perf.md); with shares (½, ½) and as many
+/// and a split towards them lowers the error (docs/perf.md#budget-splits); with shares (½, ½) and as many
 /// points of each it is [`product_mis_many`]'s estimate.
 pub fn product_mis_split<B: Brdf + ?Sized>(
     sampler: &ProductSampler<'_, '_>,
@@ -207,7 +207,7 @@ pub fn product_mis_split<B: Brdf + ?Sized>(
 /// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
 /// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
 /// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
-/// than an env sample (docs/perf.md).
+/// than an env sample (docs/perf.md#budget-splits).
 pub fn mis_split<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
