@@ -110,7 +110,7 @@ const SLACK: f32 = 1e-3;
 
 /// A cone that contains every direction of cell `(x, y)` of `level`. The image of a cell is a
 /// disk-like region that does not reach its axis's antipode, so the angle from the axis is
-/// largest on the cell's boundary: measured there at 32 points per edge, plus what
+/// largest on the cell's boundary: measured there at evenly spaced points, plus what
 /// can hide between them.
 #[must_use]
 pub fn cell_cone(level: u32, x: u32, y: u32) -> Cone {
