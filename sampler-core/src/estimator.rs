@@ -8,6 +8,7 @@ use crate::env::{EnvHierarchy, EnvSample};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
 use crate::sampler::{DirectionSample, ProductSampler};
+use crate::two_level::TwoLevelSampler;
 use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
@@ -205,6 +206,33 @@ pub fn product_mis_drawn<B: Brdf + ?Sized>(
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
     let drawn = drawn.map(|s| (s.dir, s.uv, s.pdf));
+    mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
+}
+
+/// The two-level product (`two_level.rs`): one direction from the shading point's
+/// [`TwoLevelSampler`].
+pub fn two_level<B: Brdf + ?Sized>(
+    sampler: &TwoLevelSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u: DVec2,
+    vis: &mut impl Visibility,
+) -> Contribution {
+    let Some(s) = sampler.sample(u) else { return Contribution::default() };
+    let f = times(sampler.env().radiance_at(s.uv), sp.eval(s.dir));
+    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
+}
+
+/// MIS of the two-level product and BRDF sampling, balance heuristic, one sample each: within a
+/// coarse cell the product follows the light alone, so BRDF sampling carries the lobes sharper
+/// than a cell. The sum of the two contributions is the estimate.
+pub fn two_level_mis<B: Brdf + ?Sized>(
+    sampler: &TwoLevelSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    u_product: DVec2,
+    u_brdf: Vec2,
+    vis: &mut impl Visibility,
+) -> [Contribution; 2] {
+    let drawn = sampler.sample(u_product).map(|s| (s.dir, s.uv, s.pdf));
     mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
 }
 

@@ -44,6 +44,7 @@ extern crate std;
 
 pub mod bilinear;
 pub mod brdf;
+pub mod cone;
 pub mod env;
 pub mod estimator;
 pub mod frame;
@@ -54,6 +55,7 @@ pub mod quadtree;
 pub mod rng;
 pub mod sampler;
 pub mod sampling;
+pub mod two_level;
 pub mod two_stage;
 pub mod warp;
 pub mod wavelet;

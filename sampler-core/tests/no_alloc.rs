@@ -66,6 +66,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
     let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(level)];
     assert!(sampler_core::two_stage::build_sat(&env, &mut sat));
 
+    let mut cones = vec![sampler_core::cone::Cone::default(); 256];
+    assert!(sampler_core::cone::build_cell_cones(&mut cones));
+    let mut two_level: Box<sampler_core::two_level::TwoLevelArena> = Box::default();
     ARMED.with(|a| a.set(true));
     for i in 0..10_000u64 {
         let normal = square_to_sphere(glam::Vec2::new(rng.next_f32(), rng.next_f32()));
@@ -97,6 +100,11 @@ fn ten_thousand_shading_points_allocate_nothing() {
             let two: sampler_core::two_stage::TwoStageSampler<'_, '_> =
                 sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
             sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x;
+            let two = two_level.build(&env, &cones, brdf, &frame, wo).unwrap();
+            sink += two.pdf(wo) as f64;
+            sink += estimator::two_level(&two, &sp, u, &mut vis).value.x;
+            let [a, b] = estimator::two_level_mis(&two, &sp, u, u.as_vec2(), &mut vis);
+            sink += a.value.x + b.value.x;
         }
         // The batched paths the renderer takes.
         let mut pairs = [[estimator::Contribution::default(); 2]; 4];
