@@ -446,7 +446,7 @@ ppis_status ppis_latlong_to_equal_area(const float *src,
                                        float *dst,
                                        size_t dst_floats);
 
-// The unit direction (the map's frame) of a point of the equal-area square \[0,1\]².
+// The unit direction (the map's frame) of a point (u, v) of the equal-area unit square.
 ppis_vec3 ppis_square_to_sphere(ppis_vec2 p);
 
 // The point of the equal-area square of a unit direction (the map's frame).
@@ -764,7 +764,7 @@ ppis_status ppis_latlong_to_equal_area(const float *src,
                                        float *dst,
                                        size_t dst_floats);
 
-// The unit direction (the map's frame) of a point of the equal-area square \[0,1\]².
+// The unit direction (the map's frame) of a point (u, v) of the equal-area unit square.
 ppis_vec3 ppis_square_to_sphere(ppis_vec2 p);
 
 // The point of the equal-area square of a unit direction (the map's frame).

@@ -69,7 +69,7 @@ pub unsafe extern "C" fn ppis_latlong_to_equal_area(
     crate::status(run())
 }
 
-/// The unit direction (the map's frame) of a point of the equal-area square \[0,1\]².
+/// The unit direction (the map's frame) of a point (u, v) of the equal-area unit square.
 #[unsafe(no_mangle)]
 pub extern "C" fn ppis_square_to_sphere(p: crate::ppis_vec2) -> ppis_vec3 {
     sampler_core::mapping::square_to_sphere(p.into()).into()
