@@ -49,6 +49,7 @@ pub mod env;
 pub mod estimator;
 pub mod frame;
 mod lanes;
+pub mod latlong;
 pub mod mapping;
 pub mod points;
 pub mod quadtree;

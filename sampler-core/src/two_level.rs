@@ -79,6 +79,8 @@ impl core::error::Error for TwoLevelError {}
 #[derive(Clone, Debug)]
 pub struct TwoLevelArena<const CELLS: usize = 1024> {
     cumulative: [f64; CELLS],
+    /// The last build's level and whether its B̃ was a bound (`None` before the first).
+    built: Option<(u32, bool)>,
 }
 
 impl<const CELLS: usize> Default for TwoLevelArena<CELLS> {
@@ -91,7 +93,15 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
     /// An empty arena.
     #[must_use]
     pub const fn new() -> Self {
-        Self { cumulative: [0.0; CELLS] }
+        Self { cumulative: [0.0; CELLS], built: None }
+    }
+
+    /// The sampler the last [`build`](Self::build) made, again, without rebuilding it. `env`
+    /// must be the environment it was built on. `None` before the first build.
+    #[must_use]
+    pub fn last_built<'a, 'e>(&'a self, env: &'a EnvHierarchy<'e>) -> Option<TwoLevelSampler<'a, 'e>> {
+        let (level, bounded) = self.built?;
+        Some(TwoLevelSampler { env, level, cumulative: &self.cumulative[..cell_count(level)], bounded })
     }
 
     /// The product of one shading point (world-space `wo`) over the coarse level whose cell cones
@@ -112,6 +122,7 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
         if cells > CELLS {
             return Err(TwoLevelError::AboveCapacity { cells, capacity: CELLS });
         }
+        self.built = None;
         let cumulative = &mut self.cumulative[..cells];
         let bounded = brdf.cone_bounds(Vec3::Z, &[], &mut []);
         let wo = frame.to_local(wo);
@@ -145,7 +156,9 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
             total += b * f64::from(m);
             *w = total;
         }
-        Ok(TwoLevelSampler { env, level, cumulative, bounded })
+        self.built = Some((level, bounded));
+        let built: &'a Self = self;
+        Ok(built.last_built(env).expect("just built"))
     }
 }
 
