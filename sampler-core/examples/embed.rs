@@ -106,7 +106,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         let mut sum = Vec3::ZERO;
                         for (u, v) in u.iter().zip(&v) {
                             let mut visible = |dir: Vec3| !occluded(p, dir);
-                            let [a, b] = estimator::product_mis(&sampler, &sp, *u, v.as_vec2(), &mut visible);
+                            let [a, b] = estimator::sampled_mis(&sampler, &sp, *u, v.as_vec2(), &mut visible);
                             sum += (a.value + b.value).as_vec3();
                         }
                         out.push(sum / 16.0);

@@ -98,7 +98,7 @@ fn main() {
                 let (p, q) = points(seed);
                 (0..PAIRS)
                     .map(|k| {
-                        let [a, b] = estimator::mis(&env, &sp, p[k], q[k], &mut |_| true);
+                        let [a, b] = estimator::sampled_mis(&env, &sp, p[k], q[k], &mut |_| true);
                         luminance64(a.value + b.value)
                     })
                     .sum::<f64>()
@@ -110,7 +110,7 @@ fn main() {
                 let (p, q) = points(seed);
                 (0..PAIRS)
                     .map(|k| {
-                        let [a, b] = estimator::product_mis(&s, &sp, p[k], q[k], &mut |_| true);
+                        let [a, b] = estimator::sampled_mis(&s, &sp, p[k], q[k], &mut |_| true);
                         luminance64(a.value + b.value)
                     })
                     .sum::<f64>()
@@ -122,7 +122,7 @@ fn main() {
                     let (p, q) = points(seed);
                     (0..PAIRS)
                         .map(|k| {
-                            let [a, b] = estimator::two_level_mis(&s, &sp, p[k], q[k], &mut |_| true);
+                            let [a, b] = estimator::sampled_mis(&s, &sp, p[k], q[k], &mut |_| true);
                             luminance64(a.value + b.value)
                         })
                         .sum::<f64>()

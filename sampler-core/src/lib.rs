@@ -45,6 +45,7 @@ extern crate std;
 pub mod bilinear;
 pub mod brdf;
 pub mod cone;
+pub mod direction;
 pub mod env;
 pub mod estimator;
 pub mod frame;

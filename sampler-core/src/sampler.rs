@@ -84,7 +84,7 @@ impl Default for ProductParams {
 }
 
 impl ProductParams {
-    /// Settings for a product sampler used in MIS with BRDF sampling (`estimator::product_mis`;
+    /// Settings for a product sampler used in MIS with BRDF sampling (`estimator::sampled_mis`;
     /// docs/perf.md#product-mis-preset): leaves probed at their centres, leaves heavier than
     /// one BRDF sample's share (1/K of the mass) refined, and a defensive fraction of 0.25 —
     /// the BRDF half already covers the lobe, so environment samples are what the pair lacks
@@ -271,16 +271,7 @@ pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
     (column / total) * (m[dx + 2 * dy] / column)
 }
 
-/// A direction drawn by a sampler, with its density.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionSample {
-    /// World-space unit direction.
-    pub dir: Vec3,
-    /// Point of the equal-area square (map frame).
-    pub uv: Vec2,
-    /// Density with respect to solid angle (the same value [`ProductSampler::pdf`] gives).
-    pub pdf: f32,
-}
+pub use crate::direction::DirectionSample;
 
 /// The product distribution of one shading point, borrowing its arena.
 #[derive(Clone, Copy, Debug)]

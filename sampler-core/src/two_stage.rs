@@ -164,6 +164,12 @@ impl<'a, 'e, const R: usize> TwoStageSampler<'a, 'e, R> {
         (at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0)).max(0.0)
     }
 
+    /// The environment it samples.
+    #[must_use]
+    pub fn env(&self) -> &EnvHierarchy<'e> {
+        self.env
+    }
+
     /// Rectangles in the partition.
     #[must_use]
     pub fn rect_count(&self) -> usize {

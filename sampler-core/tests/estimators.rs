@@ -153,7 +153,7 @@ fn run(estimator: &str) {
                         let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
                         let mut pts = [DVec2::ZERO; 32];
                         sobol02(seed ^ 0xabc, 0, &mut pts);
-                        pts.iter().map(|p| lum(estimator::product(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0
+                        pts.iter().map(|p| lum(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0
                     })
                     .collect()
             }
@@ -175,10 +175,10 @@ fn run(estimator: &str) {
                 (0..units)
                     .map(|unit| {
                         if per_unit == 1 {
-                            return lum(estimator::env(&e, &sp, u(), &mut vis).value);
+                            return lum(estimator::sampled(&e, &sp, u(), &mut vis).value);
                         }
                         sobol02(0xe0 ^ unit as u64, 0, &mut pts);
-                        let sum: f64 = pts.iter().map(|p| lum(estimator::env(&e, &sp, *p, &mut vis).value)).sum();
+                        let sum: f64 = pts.iter().map(|p| lum(estimator::sampled(&e, &sp, *p, &mut vis).value)).sum();
                         sum / per_unit as f64
                     })
                     .collect()
@@ -202,14 +202,14 @@ fn run(estimator: &str) {
                 (0..units)
                     .map(|unit| {
                         if mis {
-                            let [a, b] = estimator::two_level_mis(&s, &sp, u(), u().as_vec2(), &mut vis);
+                            let [a, b] = estimator::sampled_mis(&s, &sp, u(), u().as_vec2(), &mut vis);
                             return lum(a.value + b.value);
                         }
                         if per_unit == 1 {
-                            return lum(estimator::two_level(&s, &sp, u(), &mut vis).value);
+                            return lum(estimator::sampled(&s, &sp, u(), &mut vis).value);
                         }
                         sobol02(0x7e0 ^ unit as u64, 0, &mut pts);
-                        let sum: f64 = pts.iter().map(|p| lum(estimator::two_level(&s, &sp, *p, &mut vis).value)).sum();
+                        let sum: f64 = pts.iter().map(|p| lum(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum();
                         sum / per_unit as f64
                     })
                     .collect()
@@ -230,12 +230,12 @@ fn run(estimator: &str) {
                             // The renderer's batched path.
                             let mut pairs = [[estimator::Contribution::default(); 2]; 32];
                             let q = qts.map(|q| q.as_vec2());
-                            estimator::product_mis_many(&s, &sp, &pts, &q, &mut vis, &mut pairs);
+                            estimator::sampled_mis_many(&s, &sp, &pts, &q, &mut vis, &mut pairs);
                             return pairs.iter().map(|[a, b]| lum(a.value + b.value)).sum::<f64>() / 32.0;
                         }
                         (0..32)
                             .map(|k| {
-                                let [a, b] = estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
+                                let [a, b] = estimator::sampled_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
                                 lum(a.value + b.value)
                             })
                             .sum::<f64>()
@@ -283,7 +283,7 @@ fn run(estimator: &str) {
             "brdf" => (0..200_000).map(|_| lum(estimator::brdf(&e, &sp, u(), &mut vis).value)).collect(),
             "mis" => (0..200_000)
                 .map(|_| {
-                    let [a, b] = estimator::mis(&e, &sp, u(), u().as_vec2(), &mut vis);
+                    let [a, b] = estimator::sampled_mis(&e, &sp, u(), u().as_vec2(), &mut vis);
                     lum(a.value + b.value)
                 })
                 .collect(),

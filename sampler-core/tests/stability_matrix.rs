@@ -220,10 +220,10 @@ fn every_estimator_on_every_extreme_case() {
                                 for i in 0..32 {
                                     push(if *method == "product-mis" {
                                         let [a, c] =
-                                            estimator::product_mis(&s, &sp, pts[i], qts[i].as_vec2(), &mut vis);
+                                            estimator::sampled_mis(&s, &sp, pts[i], qts[i].as_vec2(), &mut vis);
                                         lum(a.value + c.value)
                                     } else {
-                                        lum(estimator::product(&s, &sp, pts[i], &mut vis).value)
+                                        lum(estimator::sampled(&s, &sp, pts[i], &mut vis).value)
                                     });
                                 }
                             }
@@ -244,10 +244,11 @@ fn every_estimator_on_every_extreme_case() {
                             _ => {
                                 for i in 0..32 {
                                     push(match *method {
-                                        "env" => lum(estimator::env(&env, &sp, pts[i], &mut vis).value),
+                                        "env" => lum(estimator::sampled(&env, &sp, pts[i], &mut vis).value),
                                         "brdf" => lum(estimator::brdf(&env, &sp, pts[i], &mut vis).value),
                                         _ => {
-                                            let [a, c] = estimator::mis(&env, &sp, pts[i], qts[i].as_vec2(), &mut vis);
+                                            let [a, c] =
+                                                estimator::sampled_mis(&env, &sp, pts[i], qts[i].as_vec2(), &mut vis);
                                             lum(a.value + c.value)
                                         }
                                     });

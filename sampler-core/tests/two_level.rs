@@ -234,10 +234,10 @@ fn two_level_is_unbiased_under_a_sun_ten_million_times_the_sky() {
                 for i in 0..n {
                     let u = DVec2::new(rng.next_f64(), rng.next_f64());
                     let v = if mis {
-                        let [a, b] = estimator::two_level_mis(&s, &sp, u, rng.next_f32v(), &mut |_| true);
+                        let [a, b] = estimator::sampled_mis(&s, &sp, u, rng.next_f32v(), &mut |_| true);
                         luminance64(a.value + b.value)
                     } else {
-                        luminance64(estimator::two_level(&s, &sp, u, &mut |_| true).value)
+                        luminance64(estimator::sampled(&s, &sp, u, &mut |_| true).value)
                     };
                     let d = v - mean;
                     mean += d / (i + 1) as f64;
@@ -307,7 +307,7 @@ fn a_brdf_without_a_bound_is_estimated_floored_and_unbiased() {
     let v: Vec<f64> = (0..count)
         .map(|_| {
             let u = DVec2::new(rng.next_f64(), rng.next_f64());
-            luminance64(estimator::two_level(&s, &sp, u, &mut |_| true).value)
+            luminance64(estimator::sampled(&s, &sp, u, &mut |_| true).value)
         })
         .collect();
     let mean = v.iter().sum::<f64>() / count as f64;
