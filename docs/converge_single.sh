@@ -13,8 +13,8 @@ spp="${3:-1048576}"
 shift $(($# < 3 ? $# : 3))
 scenes=("$@")
 if [ ${#scenes[@]} -eq 0 ]; then
-    scenes=(../shared/scenes/s1_forest_spheres.json ../shared/scenes/s2_courtyard_glossy.json
-            ../shared/scenes/s3_sunset_sharp.json docs/scenes/sharp_sun.json)
+    scenes=(docs/scenes/s1_forest_spheres.json docs/scenes/s2_courtyard_glossy.json
+            docs/scenes/s3_sunset_sharp.json docs/scenes/sharp_sun.json)
 fi
 methods=(${METHODS:-env brdf two-stage})
 mkdir -p "$out"

@@ -1,10 +1,12 @@
-//! `cargo bench -p sampler-core`: mapping transforms, per-shading-point product build + warps,
-//! and env-only sampling through the same hierarchy as the yardstick. Numbers go to
-//! docs/perf.md.
+//! `cargo bench -p sampler-core`: mapping transforms, per-shading-point product build + warps
+//! (the quadtree product, and the two-level product beside it), and env-only sampling through
+//! the same hierarchy as the yardstick. The numbers are in docs/perf.md#mapping-transforms,
+//! docs/perf.md#building-a-product-sampler and docs/perf.md#the-two-products.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
+use sampler_core::cone::{Cone, build_cell_cones, cell_count};
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::{sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch};
@@ -12,6 +14,7 @@ use sampler_core::points::sobol02;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::rng::Pcg32;
 use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::two_level::TwoLevelArena;
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -157,9 +160,72 @@ fn shading_points(c: &mut Criterion) {
     eprintln!("arena: ProductArena<256, 2048> = {} bytes", std::mem::size_of::<ProductArena>());
 }
 
+/// Build + 16 warps per shading point, the two-level product at 8×8, 16×16 and 32×32 cells
+/// beside the quadtree product, on the same points (docs/perf.md, "The two products").
+fn two_level_points(c: &mut Criterion) {
+    let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
+        ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
+        ("ggx a=0.01", Box::new(RoughConductor::new(0.01, Vec3::ONE))),
+        ("ggx a=0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
+        ("ggx a=0.3", Box::new(RoughConductor::new(0.3, Vec3::ONE))),
+        ("carpaint", Box::new(CarPaint::default())),
+    ];
+    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    let mut two: Box<TwoLevelArena> = Box::default();
+    let cones: Vec<Vec<Cone>> = [3u32, 4, 5]
+        .iter()
+        .map(|&l| {
+            let mut v = vec![Cone::default(); cell_count(l)];
+            build_cell_cones(&mut v);
+            v
+        })
+        .collect();
+    let mut rng = Pcg32::new(7, 7);
+    let points: Vec<(Frame, Vec3)> = (0..100)
+        .map(|_| {
+            let n = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
+            let f = Frame::from_normal(n);
+            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
+        })
+        .collect();
+    for level in [10u32, 12] {
+        let map = sunny_map(level);
+        let env = EnvHierarchy::new(map.level, &map.pyramid, &map.rgb).unwrap();
+        let res = 1 << level;
+        let mut g = c.benchmark_group(format!("two products {res}x{res}"));
+        for (name, brdf) in &brdfs {
+            let mut i = 0u64;
+            g.bench_function(BenchmarkId::new(*name, "quadtree"), |b| {
+                let mut pts = [DVec2::ZERO; 16];
+                b.iter(|| {
+                    i += 1;
+                    let (frame, wo) = &points[(i % 100) as usize];
+                    let s = arena.build(&env, brdf.as_ref(), frame, *wo, &ProductParams::default(), i);
+                    sobol02(i, 0, &mut pts);
+                    black_box(pts.iter().filter_map(|u| s.sample(*u)).map(|d| d.pdf).sum::<f32>())
+                })
+            });
+            for cones in &cones {
+                let side = 1 << (cones.len().trailing_zeros() / 2);
+                g.bench_function(BenchmarkId::new(*name, format!("two-level {side}x{side}")), |b| {
+                    let mut pts = [DVec2::ZERO; 16];
+                    b.iter(|| {
+                        i += 1;
+                        let (frame, wo) = &points[(i % 100) as usize];
+                        let s = two.build(&env, cones, brdf.as_ref(), frame, *wo).unwrap();
+                        sobol02(i, 0, &mut pts);
+                        black_box(pts.iter().filter_map(|u| s.sample(*u)).map(|d| d.pdf).sum::<f32>())
+                    })
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().measurement_time(Duration::from_secs(2)).warm_up_time(Duration::from_millis(500)).sample_size(30);
-    targets = mapping, shading_points
+    targets = mapping, shading_points, two_level_points
 }
 criterion_main!(benches);

@@ -45,14 +45,14 @@ fn main() {
         report(name, reps, n, |r, a, b, out| {
             let s = arena.build(&env, &brdf, &frame, wo, &params, r);
             for k in 0..a.len() {
-                let [x, y] = estimator::product_mis(&s, &sp, a[k], b[k].as_vec2(), &mut vis);
+                let [x, y] = estimator::sampled_mis(&s, &sp, a[k], b[k].as_vec2(), &mut vis);
                 out.push(lum(x.value + y.value));
             }
         });
     }
     report("mis", reps, n, |_, a, b, out| {
         for k in 0..a.len() {
-            let [x, y] = estimator::mis(&env, &sp, a[k], b[k].as_vec2(), &mut vis);
+            let [x, y] = estimator::sampled_mis(&env, &sp, a[k], b[k].as_vec2(), &mut vis);
             out.push(lum(x.value + y.value));
         }
     });

@@ -63,7 +63,7 @@ fn main() {
                 let mut pts = [DVec2::ZERO; 64];
                 sobol02(seed + 77, 0, &mut pts);
                 for u in pts {
-                    let v = estimator::luminance64(estimator::product(&sampler, &sp, u, &mut |_| true).value);
+                    let v = estimator::luminance64(estimator::sampled(&sampler, &sp, u, &mut |_| true).value);
                     s1 += v;
                     s2 += v * v;
                     cnt += 1.0;

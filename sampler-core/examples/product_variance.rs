@@ -55,14 +55,14 @@ fn main() {
                 let mut sums = [0.0f64; 4];
                 for (u, o) in pts.iter().zip(&oth) {
                     let v = [
-                        estimator::luminance64(estimator::product(&sampler, &sp, *u, &mut |_| true).value),
+                        estimator::luminance64(estimator::sampled(&sampler, &sp, *u, &mut |_| true).value),
                         {
-                            let [a, b] = estimator::product_mis(&sampler, &sp, *u, o.as_vec2(), &mut |_| true);
+                            let [a, b] = estimator::sampled_mis(&sampler, &sp, *u, o.as_vec2(), &mut |_| true);
                             estimator::luminance64(a.value + b.value)
                         },
                         estimator::luminance64(estimator::brdf(&env, &sp, *u, &mut |_| true).value),
                         {
-                            let [a, b] = estimator::mis(&env, &sp, *u, o.as_vec2(), &mut |_| true);
+                            let [a, b] = estimator::sampled_mis(&env, &sp, *u, o.as_vec2(), &mut |_| true);
                             estimator::luminance64(a.value + b.value)
                         },
                     ];

@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::brdf::RoughConductor;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
-use sampler_core::estimator::{Contribution, ShadingPoint, mis_drawn, mis_many, product_mis, product_mis_many};
+use sampler_core::estimator::{Contribution, ShadingPoint, mis_many, sampled_mis, sampled_mis_drawn, sampled_mis_many};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
@@ -78,14 +78,14 @@ fn main() {
             t_sample += t.elapsed().as_secs_f64();
             let t = Instant::now();
             for (u, v) in us.iter().zip(&vs) {
-                let [a, b] = product_mis(&s, &sp, *u, v.as_vec2(), &mut vis);
+                let [a, b] = sampled_mis(&s, &sp, *u, v.as_vec2(), &mut vis);
                 acc += a.value + b.value;
             }
             t_pm += t.elapsed().as_secs_f64();
             // The renderer's paths: a batch at a time.
             let t = Instant::now();
             for (u, b) in us.chunks(64).zip(brdf_points.chunks(64)) {
-                product_mis_many(&s, &sp, u, b, &mut vis, &mut out);
+                sampled_mis_many(&s, &sp, u, b, &mut vis, &mut out);
                 acc += out.iter().map(|[a, b]| a.value + b.value).sum::<DVec3>();
             }
             t_pmb += t.elapsed().as_secs_f64();
@@ -105,7 +105,7 @@ fn main() {
             let t = Instant::now();
             env.sample_many(&us, &mut drawn);
             for (d, v) in drawn.iter().zip(&vs) {
-                let [a, b] = mis_drawn(&env, &sp, *d, v.as_vec2(), &mut vis);
+                let [a, b] = sampled_mis_drawn(&env, &sp, *d, v.as_vec2(), &mut vis);
                 acc += a.value + b.value;
             }
             t_mis += t.elapsed().as_secs_f64();

@@ -11,6 +11,7 @@
 //! RGB radiance for shading is kept at the finest level only, row-major. Lookups are nearest-texel, the same piecewise-constant function the
 //! sampling densities are built from, so radiance cancels exactly in the product estimator.
 
+use crate::direction::DirectionSample;
 use crate::mapping::{
     SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
 };
@@ -66,9 +67,19 @@ pub fn luminance(c: Vec3) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvError {
     /// The finest level is larger than [`MAX_LEVEL`].
-    TooLarge { finest: u32 },
+    TooLarge {
+        /// The finest level asked for.
+        finest: u32,
+    },
     /// A buffer does not have the length its finest level implies.
-    WrongLength { buffer: &'static str, expected: usize, found: usize },
+    WrongLength {
+        /// Which buffer (`"pyramid"` or `"radiance"`).
+        buffer: &'static str,
+        /// The length the finest level implies.
+        expected: usize,
+        /// The length handed in.
+        found: usize,
+    },
     /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
     NotSanitized,
 }
@@ -155,17 +166,6 @@ fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError
         return Err(EnvError::WrongLength { buffer: "pyramid", expected: pyramid_len(finest), found: pyramid });
     }
     Ok(())
-}
-
-/// A direction drawn from the environment alone (density ∝ importance).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EnvSample {
-    /// World-space unit direction towards the environment.
-    pub dir: Vec3,
-    /// Point of the equal-area square it came from.
-    pub uv: Vec2,
-    /// Density with respect to solid angle.
-    pub pdf: f32,
 }
 
 /// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
@@ -427,7 +427,7 @@ impl<'a> EnvHierarchy<'a> {
 
     /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy).
     #[inline]
-    pub fn sample(&self, u: DVec2) -> Option<EnvSample> {
+    pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
         if self.is_black() {
             return None;
         }
@@ -438,9 +438,9 @@ impl<'a> EnvHierarchy<'a> {
 
     /// The sample at point `xi` of finest-level texel (x, y), with its density.
     #[inline]
-    pub(crate) fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> EnvSample {
+    pub(crate) fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> DirectionSample {
         let (uv, pdf) = self.point_in_texel(x, y, xi);
-        EnvSample { dir: self.dir_of(uv), uv, pdf }
+        DirectionSample { dir: self.dir_of(uv), uv, pdf }
     }
 
     /// The point of texel (x, y) at `xi` and the density there (solid angle).

@@ -4,18 +4,23 @@
 //! Visibility is asked only for directions whose unoccluded contribution is non-zero.
 
 use crate::brdf::{Brdf, BrdfSample};
-use crate::env::{EnvHierarchy, EnvSample};
+use crate::direction::{DirectionSample, DirectionSampler};
+use crate::env::EnvHierarchy;
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
-use crate::sampler::{DirectionSample, ProductSampler};
+use crate::sampler::ProductSampler;
 use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 mod batched;
-pub use batched::{BATCH, brdf_many, env_many, mis_many, mis_split, product_mis_many, product_mis_split};
+pub use batched::{
+    BATCH, brdf_many, env_many, mis_many, mis_split, product_mis_split, sampled_many, sampled_mis_many,
+    sampled_mis_split,
+};
 
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {
+    /// True when nothing blocks the environment from the shading point in world direction `dir`.
     fn visible(&mut self, dir: Vec3) -> bool;
 }
 
@@ -29,9 +34,11 @@ impl<F: FnMut(Vec3) -> bool> Visibility for F {
 /// its BRDF.
 #[derive(Clone, Copy)]
 pub struct ShadingPoint<'b, B: Brdf + ?Sized> {
+    /// Shading frame (its normal is the BRDF's +z).
     pub frame: Frame,
     /// World-space unit direction towards the viewer.
     pub wo: Vec3,
+    /// The surface's BRDF, evaluated in `frame`'s local coordinates.
     pub brdf: &'b B,
 }
 
@@ -90,19 +97,20 @@ pub(crate) fn weighted(f: DVec3, pdf: f32, vis: &mut impl Visibility, dir: Vec3)
     if pdf > 0.0 && f.cmpgt(DVec3::ZERO).any() && vis.visible(dir) { f / pdf as f64 } else { DVec3::ZERO }
 }
 
-/// Product importance sampling: one direction from the shading point's [`ProductSampler`].
-pub fn product<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// One direction from any sampler of the environment (env-only, the quadtree or two-level
+/// product, two-stage): f·V/p.
+pub fn sampled<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
     u: DVec2,
     vis: &mut impl Visibility,
 ) -> Contribution {
-    product_drawn(sampler, sp, sampler.sample(u), vis)
+    sampled_drawn(sampler, sp, sampler.sample(u), vis)
 }
 
-/// [`product`] with its sample already drawn (e.g. by [`ProductSampler::sample_many`]).
-pub fn product_drawn<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// [`sampled`] with its sample already drawn (e.g. by [`DirectionSampler::sample_many`]).
+pub fn sampled_drawn<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
     drawn: Option<DirectionSample>,
     vis: &mut impl Visibility,
@@ -114,28 +122,14 @@ pub fn product_drawn<B: Brdf + ?Sized>(
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
-/// Environment-only sampling through the same hierarchy.
-pub fn env<B: Brdf + ?Sized>(
-    env: &EnvHierarchy<'_>,
+/// [`sampled_drawn`] for the quadtree product.
+pub fn product_drawn<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
     sp: &ShadingPoint<'_, B>,
-    u: DVec2,
+    drawn: Option<DirectionSample>,
     vis: &mut impl Visibility,
 ) -> Contribution {
-    env_drawn(env, sp, env.sample(u), vis)
-}
-
-/// [`env()`] with its sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
-pub fn env_drawn<B: Brdf + ?Sized>(
-    env: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: Option<EnvSample>,
-    vis: &mut impl Visibility,
-) -> Contribution {
-    let Some(s) = drawn else {
-        return Contribution::default();
-    };
-    let f = times(env.radiance_at(s.uv), sp.eval(s.dir));
-    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
+    sampled_drawn(sampler, sp, drawn, vis)
 }
 
 /// BRDF-only sampling.
@@ -153,55 +147,29 @@ pub fn brdf<B: Brdf + ?Sized>(
     Contribution { dir, value: weighted(f, s.pdf, vis, dir), pdf: s.pdf, other_pdf: 0.0 }
 }
 
-/// Multiple importance sampling, balance heuristic, one environment and one BRDF sample
-/// (Veach 1997): each sample contributes f·V / (p_env + p_brdf). The sum of the two
-/// contributions is the estimate.
-pub fn mis<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
+/// Multiple importance sampling of any sampler of the environment with BRDF sampling, balance
+/// heuristic, one sample each (Veach 1997): each contributes f·V / (p_sampler + p_brdf), and
+/// the sum of the two is the estimate. With the env-only sampler it is plain MIS; with a
+/// product, the product keeps its edge where lighting varies and BRDF sampling keeps
+/// needle-sharp lobes under smooth lighting as good as they can be.
+pub fn sampled_mis<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
-    u_env: DVec2,
+    u: DVec2,
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    mis_drawn(env_h, sp, env_h.sample(u_env), u_brdf, vis)
+    sampled_mis_drawn(sampler, sp, sampler.sample(u), u_brdf, vis)
 }
 
-/// [`mis`] with its environment sample already drawn (e.g. by [`EnvHierarchy::sample_many`]).
-pub fn mis_drawn<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: Option<EnvSample>,
-    u_brdf: Vec2,
-    vis: &mut impl Visibility,
-) -> [Contribution; 2] {
-    let drawn = drawn.map(|s| (s.dir, s.uv, s.pdf));
-    mis_with_brdf(env_h, sp, drawn, |uv| env_h.pdf_square(uv), u_brdf, vis)
-}
-
-/// MIS of product sampling and BRDF sampling, balance heuristic, one sample each: the product
-/// keeps its edge where lighting varies, and BRDF sampling keeps needle-sharp lobes under
-/// smooth lighting (where f/p_brdf is nearly constant) as good as they can be. The sum of the
-/// two contributions is the estimate.
-pub fn product_mis<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    u_product: DVec2,
-    u_brdf: Vec2,
-    vis: &mut impl Visibility,
-) -> [Contribution; 2] {
-    product_mis_drawn(sampler, sp, sampler.sample(u_product), u_brdf, vis)
-}
-
-/// [`product_mis`] with its product sample already drawn (e.g. by
-/// [`ProductSampler::sample_many`]).
-pub fn product_mis_drawn<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// [`sampled_mis`] with the sampler's direction already drawn.
+pub fn sampled_mis_drawn<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
     drawn: Option<DirectionSample>,
     u_brdf: Vec2,
     vis: &mut impl Visibility,
 ) -> [Contribution; 2] {
-    let drawn = drawn.map(|s| (s.dir, s.uv, s.pdf));
     mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
 }
 
@@ -211,7 +179,7 @@ pub fn product_mis_drawn<B: Brdf + ?Sized>(
 fn mis_with_brdf<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
-    drawn: Option<(Vec3, Vec2, f32)>,
+    drawn: Option<DirectionSample>,
     pdf_square: impl Fn(Vec2) -> f32,
     u_brdf: Vec2,
     vis: &mut impl Visibility,
@@ -229,18 +197,18 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
 fn mis_drawn_half<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
-    drawn: Option<(Vec3, Vec2, f32)>,
+    drawn: Option<DirectionSample>,
     vis: &mut impl Visibility,
 ) -> Contribution {
-    let Some((dir, uv, p)) = drawn else { return Contribution::default() };
-    drawn_half(env_h, (dir, uv, p), sp.eval_pdf(dir), vis)
+    let Some(d) = drawn else { return Contribution::default() };
+    drawn_half(env_h, d, sp.eval_pdf(d.dir), vis)
 }
 
 /// [`mis_drawn_half`] with the BRDF × cos and the BRDF's density at the direction evaluated.
 #[inline]
 pub(crate) fn drawn_half(
     env_h: &EnvHierarchy<'_>,
-    (dir, uv, p): (Vec3, Vec2, f32),
+    DirectionSample { dir, uv, pdf: p }: DirectionSample,
     (b, p_brdf): (Vec3, f32),
     vis: &mut impl Visibility,
 ) -> Contribution {

@@ -5,8 +5,11 @@ use glam::Vec3;
 /// Right-handed orthonormal basis `(s, t, n)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
+    /// First tangent (local +x).
     pub s: Vec3,
+    /// Second tangent (local +y).
     pub t: Vec3,
+    /// Normal (local +z).
     pub n: Vec3,
 }
 

@@ -8,7 +8,7 @@
 //!   root).
 //! * [`ProductSampler::pdf_square_many`]: product densities, four descents by the points' bits.
 
-use crate::env::{EnvHierarchy, EnvSample, level_offset, morton2};
+use crate::env::{EnvHierarchy, level_offset, morton2};
 use crate::mapping::SPHERE_AREA;
 use crate::quadtree::{COORD_BITS, Node, quantize};
 use crate::sampler::{DirectionSample, ProductSampler};
@@ -51,7 +51,7 @@ impl EnvHierarchy<'_> {
     /// arithmetic of the four are independent, so they overlap), branch-free within a level.
     /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
-    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<EnvSample>]) {
+    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
         for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
             let n = us.len().min(os.len());
             let mut lanes = [WarpLane::default(); 4];
@@ -68,7 +68,7 @@ impl EnvHierarchy<'_> {
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
             for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
                 let (uv, pdf) = points[k];
-                *o = lane.alive.then_some(EnvSample { dir: dirs[k], uv, pdf });
+                *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv, pdf });
             }
         }
     }
@@ -330,7 +330,7 @@ mod tests {
         let black = [[0.0f32; 3]; 4];
         let mut p = [0.0f32; 5];
         build_pyramid(1, &black, &mut p).unwrap();
-        let mut out = [Some(EnvSample { dir: Vec3::Z, uv: Vec2::ZERO, pdf: 1.0 }); 5];
+        let mut out = [Some(DirectionSample { dir: Vec3::Z, uv: Vec2::ZERO, pdf: 1.0 }); 5];
         EnvHierarchy::new(1, &p, &black).unwrap().sample_many(&[DVec2::splat(0.5); 5], &mut out);
         assert!(out.iter().all(Option::is_none));
     }

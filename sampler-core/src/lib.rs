@@ -34,6 +34,7 @@
 //! ```
 
 #![no_std]
+#![warn(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 // Loops over the four children of a node read clearer with an index.
 #![allow(clippy::needless_range_loop)]
@@ -43,16 +44,20 @@ extern crate std;
 
 pub mod bilinear;
 pub mod brdf;
+pub mod cone;
+pub mod direction;
 pub mod env;
 pub mod estimator;
 pub mod frame;
 mod lanes;
+pub mod latlong;
 pub mod mapping;
 pub mod points;
 pub mod quadtree;
 pub mod rng;
 pub mod sampler;
 pub mod sampling;
+pub mod two_level;
 pub mod two_stage;
 pub mod warp;
 pub mod wavelet;

@@ -26,8 +26,8 @@ use glam::Vec2;
 use heapless::Vec;
 
 /// Prior count α of the add-α smoothing that gives empty leaves their B̃ (see
-/// `TreeBuilder::node`). Measured on the efficiency set (tests/efficiency.rs): 2 beats 0.1,
-/// 0.25, 0.5, 1 and 4 on every non-needle case.
+/// `TreeBuilder::node`): the best value on every non-needle case of the efficiency set
+/// (tests/efficiency.rs; docs/perf.md#per-sample-variance).
 pub const FILL_PRIOR: f32 = 2.0;
 
 /// Samples in a parent from which an empty child's B̃ also looks at B at its centre.
@@ -48,6 +48,7 @@ pub struct Node {
 }
 
 impl Node {
+    /// True for a leaf (no children).
     #[inline]
     #[must_use]
     pub fn is_leaf(&self) -> bool {
@@ -211,7 +212,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
             // unknown): a sample can sit on the dim side of its leaf, and a B̃ that understates
             // the leaf makes B/B̃ large wherever the light sends the product's samples in it,
-            // while one that overstates it only spends a few samples (docs/perf.md).
+            // while one that overstates it only spends a few samples (docs/perf.md#product-mis-preset).
             if self.probe_leaves {
                 let probe = self.probe(depth, x, y);
                 if probe.is_finite() {
@@ -252,12 +253,12 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         }
         // Empty children. With n samples over k non-empty children, add-α smoothing of the
         // counts gives an empty child (0 + α)/(n/k + α) of a non-empty child's density:
-        // fill = b̄·αk/(n + αk). Two samples in two children: b̄/2 (little evidence; a smooth
+        // fill = b̄·αk/(n + αk). Two samples in two children: 2b̄/3 (little evidence; a smooth
         // BRDF keeps most of it). But counts cannot tell a tail of 1e-2 from one of 1e-5, and
         // the chain of cells above a needle lobe (n = 256, k = 1) would still hand each empty
         // sibling ~1% of the lobe's mass, which a brighter sky there multiplies. So where the
         // counts are strong evidence (n ≥ 4) B itself is probed in the cell (`probe`) and the
-        // smaller of the two is kept — some 30–60 evaluations per shading point.
+        // smaller of the two is kept — a few dozen evaluations per shading point.
         let n = (hi - lo) as f32;
         let count_fill = sum_b * FILL_PRIOR / (n + filled as f32 * FILL_PRIOR);
         for c in 0..4 {

@@ -21,6 +21,7 @@ impl Pcg32 {
         r
     }
 
+    /// The next 32 random bits.
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;

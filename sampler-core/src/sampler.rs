@@ -15,9 +15,8 @@
 //!
 //! Cost: the second moment of f/p grows by at most 1/(1 − ε), so the variance by at most
 //! Var/(1 − ε) + μ²·ε/(1 − ε) — the relative cost is largest where product sampling is already
-//! excellent (small Var against μ²). Measured with a sun (`examples/measure.rs`), per-sample
-//! variance against ε = 0: ε = 0.02 → +3.0% (Lambert), +3.5% (GGX α = 0.1), +6.5% (car paint);
-//! ε = 0.05 → +4.5%, +11%, +16%. The default is ε = 0.02.
+//! excellent (small Var against μ²); docs/perf.md#defensive-mixture has the measured cost.
+//! The default is ε = 0.02.
 
 use crate::bilinear::{self, BilinearCell, Corners, Masses};
 use crate::brdf::{Brdf, BrdfDraw};
@@ -41,9 +40,7 @@ pub struct ProductParams {
     /// Depth cap of the quadtree (≤ 24): coincident samples cannot split forever. Default 14
     /// (cells of 6e-5 of the square, ~2e-4 rad): deeper leaves shrink towards the f32 direction's
     /// resolution, and then the density a BRDF sample's `pdf(ω)` lookup finds is not always the
-    /// product's density at ω — MIS weights stop summing to one. Measured with product-MIS on
-    /// GGX α = 1e-4 at n·v = 1e-3: −0.84% at depth 20 (9σ), −0.43% at 16, −0.04% at 12; the
-    /// stability matrix is at chance level (0.28% beyond 3σ) at 14.
+    /// product's density at ω — MIS weights stop summing to one (docs/perf.md#depth-cap).
     pub max_depth: u32,
     /// Defensive environment-sampling fraction ε ∈ (0, 1].
     pub defensive: f32,
@@ -51,9 +48,9 @@ pub struct ProductParams {
     pub kind: ProductKind,
     /// Probe B at the centre of each leaf that holds samples and keep the larger of that and the
     /// samples' value. Off by default: B̃ from the BRDF samples' own values, as in the paper.
-    /// Hosts turn it on for product-MIS, where it measured 1.03–1.8× lower error on glossy
-    /// surfaces (docs/perf.md); plain product sampling without BRDF-sampling MIS keeps a heavy
-    /// tail on car paint at grazing views either way.
+    /// Hosts turn it on for product-MIS, where it lowers the error on glossy surfaces
+    /// (docs/perf.md#product-mis-preset); plain product sampling without BRDF-sampling MIS
+    /// keeps a heavy tail on car paint at grazing views either way.
     pub probe_leaves: bool,
     /// Split leaves that hold more than this share of the product's mass, B probed at the new
     /// children's centres, until none does (or the depth cap or the arena stops it): B̃ then
@@ -65,11 +62,10 @@ pub struct ProductParams {
     /// continuous across leaves, which the (0,2)-nets reward. Below a leaf the walk through the
     /// environment's levels weighs each cell by L·B̃ at its centre and the final texel is
     /// sampled ∝ B̃ inside. Off by default (the paper's piecewise-constant B̃) and in
-    /// [`ProductParams::for_mis`]: per sample it is far better (`examples/product_variance`,
-    /// GGX α = 0.05 under a smooth sky: plain product 7× and product-MIS 3× lower variance, 18×
-    /// and 6.5× over a 64-point net), but in `ppis` product-MIS it lowered the error 5–20% at
-    /// equal samples for 35–45% more time (cheap rays, one build per pixel). Worth it where
-    /// rays cost more than the ~10 extra environment lookups per sample.
+    /// [`ProductParams::for_mis`]: per sample it is far better (`examples/product_variance`),
+    /// but every sample and every density walks the environment's levels weighing cells by
+    /// B̃, which costs more than it saves where rays are cheap and one build serves a pixel
+    /// (docs/perf.md#product-mis-preset). Worth it where rays cost more than those lookups.
     pub bilinear: bool,
 }
 
@@ -88,12 +84,11 @@ impl Default for ProductParams {
 }
 
 impl ProductParams {
-    /// Settings for a product sampler used in MIS with BRDF sampling (`estimator::product_mis`),
-    /// measured on five scenes at 1024 samples per pixel (docs/perf.md): leaves probed at their
-    /// centres, leaves heavier than one BRDF sample's share (1/K of the mass) refined, and a
-    /// defensive fraction of 0.25 — the BRDF half already covers the lobe, so environment
-    /// samples are what the pair lacks where the light peaks in the lobe's tail (a sun beside a
-    /// sharp lobe: s3's conductor 2.6× lower error than with ε = 0.02 and no refinement).
+    /// Settings for a product sampler used in MIS with BRDF sampling (`estimator::sampled_mis`;
+    /// docs/perf.md#product-mis-preset): leaves probed at their centres, leaves heavier than
+    /// one BRDF sample's share (1/K of the mass) refined, and a defensive fraction of 0.25 —
+    /// the BRDF half already covers the lobe, so environment samples are what the pair lacks
+    /// where the light peaks in the lobe's tail (a sun beside a sharp lobe).
     #[must_use]
     pub fn for_mis(brdf_samples: usize) -> Self {
         Self {
@@ -108,12 +103,11 @@ impl ProductParams {
 
 /// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
 /// Reused from point to point; never allocates. `size_of::<ProductArena<K, NODES>>()` is about
-/// 48·K + 16·NODES bytes (45 112 bytes for the default 256 / 2048: each node's 8 bytes and its
-/// path probability's 8). 256 samples make ~650–760 nodes
-/// on average and at most 1497 in 30 000 measured shading points (GGX α = 1e-3); when NODES is
-/// exhausted, splitting stops and leaves keep the mean of their samples (still exact sampling).
-/// A bilinear B̃ (`ProductParams::bilinear`) also stores four corner values per node and needs
-/// CORNERS ≥ NODES (`ProductArena<256, 2048, 2048>`: +16·NODES bytes, 77 880 in all); with the
+/// 48·K + 16·NODES bytes: each node's 8 bytes and its path probability's 8. The default NODES
+/// holds the largest trees that 256 samples make (docs/perf.md#tree-size-and-memory); when
+/// NODES is exhausted, splitting stops and leaves keep the mean of their samples (still exact
+/// sampling). A bilinear B̃ (`ProductParams::bilinear`) also stores four corner values per node
+/// and needs CORNERS ≥ NODES (+16·NODES bytes); with the
 /// default CORNERS = 0 nobody pays for it and B̃ stays piecewise constant
 /// ([`ProductSampler::is_bilinear`] says which was built).
 pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const CORNERS: usize = 0> {
@@ -277,16 +271,7 @@ pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
     (column / total) * (m[dx + 2 * dy] / column)
 }
 
-/// A direction drawn by a sampler, with its density.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionSample {
-    /// World-space unit direction.
-    pub dir: Vec3,
-    /// Point of the equal-area square (map frame).
-    pub uv: Vec2,
-    /// Density with respect to solid angle (the same value [`ProductSampler::pdf`] gives).
-    pub pdf: f32,
-}
+pub use crate::direction::DirectionSample;
 
 /// The product distribution of one shading point, borrowing its arena.
 #[derive(Clone, Copy, Debug)]

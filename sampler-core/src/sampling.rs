@@ -79,7 +79,8 @@ pub fn reflect(v: Vec3, m: Vec3) -> Vec3 {
 pub const TWO_PI: f32 = 2.0 * PI;
 
 /// (sin 2πu, cos 2πu) for u ∈ [0, 1], by octant reduction and Taylor polynomials on
-/// [−π/4, π/4] (abs. error < 2e-7); about 4× faster than libm's sinf + cosf.
+/// [−π/4, π/4] (abs. error < 2e-7): cheaper than libm's sinf + cosf, and bit for bit
+/// [`sin_cos_2pi_x4`]'s results (tested).
 #[inline]
 #[must_use]
 pub fn sin_cos_2pi(u: f32) -> (f32, f32) {

@@ -140,9 +140,8 @@ impl<'a, 'e, const R: usize> TwoStageSampler<'a, 'e, R> {
         };
         // The corners exactly, not inset: the first split runs through the BRDF's peak, so a
         // corner of each of the first four rectangles lies within a texel of it. Inset corners
-        // missed a needle lobe (α = 0.01) entirely: every rectangle's B̃ came from the tails,
-        // the lobe's rectangle was drawn ~1e-3 as often as it should and mirror pixels read
-        // 30% low at 10⁶ samples (heavy tail).
+        // can miss a needle lobe (α = 0.01) entirely: every rectangle's B̃ then comes from the
+        // tails and the lobe's rectangle is drawn far less often than it should (a heavy tail).
         let v = [at(0.5, 0.5), at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0), at(1.0, 1.0)].map(|p| eval(p).max(0.0));
         let mean = v.iter().sum::<f32>() / 5.0;
         let (lo, hi) = v.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &x| (lo.min(x), hi.max(x)));
@@ -163,6 +162,12 @@ impl<'a, 'e, const R: usize> TwoStageSampler<'a, 'e, R> {
         let stride = self.env.resolution() as usize + 1;
         let at = |x: u32, y: u32| self.sat[y as usize * stride + x as usize];
         (at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0)).max(0.0)
+    }
+
+    /// The environment it samples.
+    #[must_use]
+    pub fn env(&self) -> &EnvHierarchy<'e> {
+        self.env
     }
 
     /// Rectangles in the partition.

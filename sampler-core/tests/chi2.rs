@@ -98,7 +98,7 @@ fn env_sampler_matches_its_pdf() {
             |u| {
                 let mut out = [None];
                 e.sample_many(&[u], &mut out);
-                out[0].map(|s: sampler_core::env::EnvSample| {
+                out[0].map(|s: sampler_core::direction::DirectionSample| {
                     assert_eq!(s.pdf, e.pdf_square(s.uv) / sampler_core::mapping::SPHERE_AREA);
                     s.uv
                 })

@@ -1,5 +1,6 @@
 //! Product sampling must earn its keep. χ² tests prove the warp matches its pdf; they cannot see
-//! a poor B̃ (an early empty-leaf rule gave needle lobes 36× fake mass and still passed them).
+//! a poor B̃ (an empty-leaf rule that hands the empty siblings along a needle lobe's chain the
+//! lobe's mass passes every one of them).
 //! Per-sample variance of the product estimator against env-only and BRDF-only sampling, same
 //! shading points, same number of samples:
 //! * wide and glossy lobes (Lambert, GGX 0.2, car paint): product ≤ 0.5× the better baseline;
@@ -56,7 +57,8 @@ fn product_beats_env_and_brdf_sampling_and_product_mis_beats_product_on_needles(
             let (mut a, mut b) = (Pcg32::new(1, 2), Pcg32::new(3, 4));
             let n = 100_000;
             let (_, v_env) = variance(
-                (0..n).map(|_| lum(estimator::env(&e, &sp, DVec2::new(a.next_f64(), a.next_f64()), &mut vis).value)),
+                (0..n)
+                    .map(|_| lum(estimator::sampled(&e, &sp, DVec2::new(a.next_f64(), a.next_f64()), &mut vis).value)),
             );
             let (_, v_brdf) = variance(
                 (0..n).map(|_| lum(estimator::brdf(&e, &sp, DVec2::new(b.next_f64(), b.next_f64()), &mut vis).value)),
@@ -66,7 +68,7 @@ fn product_beats_env_and_brdf_sampling_and_product_mis_beats_product_on_needles(
                 let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed);
                 let mut pts = [DVec2::ZERO; 16];
                 sobol02(seed + 99, 0, &mut pts);
-                pts.map(|u| lum(estimator::product(&s, &sp, u, &mut vis).value))
+                pts.map(|u| lum(estimator::sampled(&s, &sp, u, &mut vis).value))
             }));
             // MIS spends two samples per estimate: compare its variance per sample.
             let (_, v_pair) = variance((0..n as u64 / 32).flat_map(|seed| {
@@ -77,7 +79,7 @@ fn product_beats_env_and_brdf_sampling_and_product_mis_beats_product_on_needles(
                 sobol02(seed + 8, 0, &mut qts);
                 let mut out = [0.0; 16];
                 for k in 0..16 {
-                    let [a, b] = estimator::product_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
+                    let [a, b] = estimator::sampled_mis(&s, &sp, pts[k], qts[k].as_vec2(), &mut vis);
                     out[k] = lum(a.value + b.value);
                 }
                 out

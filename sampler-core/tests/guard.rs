@@ -62,7 +62,7 @@ fn estimate(params: &ProductParams, env: &TestEnv, frame: &Frame, wo: Vec3) -> (
         let s = arena.build(&e, &brdf, frame, wo, params, seed);
         let mut pts = [DVec2::ZERO; 32];
         sobol02(seed + 1000, 0, &mut pts);
-        let v = pts.iter().map(|p| luminance64(estimator::product(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0;
+        let v = pts.iter().map(|p| luminance64(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0;
         sum += v;
         sum2 += v * v;
     }

@@ -66,6 +66,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
     let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(level)];
     assert!(sampler_core::two_stage::build_sat(&env, &mut sat));
 
+    let mut cones = vec![sampler_core::cone::Cone::default(); 256];
+    assert!(sampler_core::cone::build_cell_cones(&mut cones));
+    let mut two_level: Box<sampler_core::two_level::TwoLevelArena> = Box::default();
     ARMED.with(|a| a.set(true));
     for i in 0..10_000u64 {
         let normal = square_to_sphere(glam::Vec2::new(rng.next_f32(), rng.next_f32()));
@@ -86,22 +89,27 @@ fn ten_thousand_shading_points_allocate_nothing() {
             if let Some(s) = sampler.sample(u) {
                 sink += s.pdf as f64 + sampler.pdf(s.dir) as f64;
             }
-            sink += estimator::product(&sampler, &sp, u, &mut vis).value.x;
-            sink += estimator::env(&env, &sp, u, &mut vis).value.x;
+            sink += estimator::sampled(&sampler, &sp, u, &mut vis).value.x;
+            sink += estimator::sampled(&env, &sp, u, &mut vis).value.x;
             sink += estimator::brdf(&env, &sp, u, &mut vis).value.x;
-            let [a, b] = estimator::mis(&env, &sp, u, u.as_vec2(), &mut vis);
+            let [a, b] = estimator::sampled_mis(&env, &sp, u, u.as_vec2(), &mut vis);
             sink += a.value.x + b.value.x;
-            let [a, b] = estimator::product_mis(&sampler, &sp, u, u.as_vec2(), &mut vis);
+            let [a, b] = estimator::sampled_mis(&sampler, &sp, u, u.as_vec2(), &mut vis);
             sink += a.value.x + b.value.x;
             sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x;
             let two: sampler_core::two_stage::TwoStageSampler<'_, '_> =
                 sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
             sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x;
+            let two = two_level.build(&env, &cones, brdf, &frame, wo).unwrap();
+            sink += two.pdf(wo) as f64;
+            sink += estimator::sampled(&two, &sp, u, &mut vis).value.x;
+            let [a, b] = estimator::sampled_mis(&two, &sp, u, u.as_vec2(), &mut vis);
+            sink += a.value.x + b.value.x;
         }
         // The batched paths the renderer takes.
         let mut pairs = [[estimator::Contribution::default(); 2]; 4];
         let brdf_points = points.map(|p| p.as_vec2());
-        estimator::product_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
+        estimator::sampled_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
         sink += estimator::product_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
         sink += estimator::mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;

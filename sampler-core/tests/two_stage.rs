@@ -112,9 +112,9 @@ fn two_stage_estimator_is_unbiased() {
 #[test]
 fn two_stage_finds_a_needle_lobe_under_a_uniform_sky() {
     // A mirror-like lobe (α = 0.01) under a constant 512² map: the answer is the lobe's
-    // directional albedo. With B̃ probed at inset rectangle corners every probe missed the lobe,
-    // its rectangle was drawn ~1e-3 as often as it should, and the mean read ~30% low after 10⁶
-    // samples (a heavy tail): now the lobe is found and converges like BRDF sampling would.
+    // directional albedo. B̃ probed at inset rectangle corners can miss the lobe entirely, and
+    // then its rectangle is drawn far too rarely and the mean reads low (a heavy tail); probed
+    // at the exact corners, the lobe is found and the mean converges like BRDF sampling's.
     let env = TestEnv::constant(9, 1.0);
     let e = env.view();
     let mut sat = vec![0.0f64; sat_len(e.finest_level())];

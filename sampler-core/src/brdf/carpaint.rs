@@ -4,20 +4,28 @@
 //! (c = 0 is a base and flake lobe with no coat at all, as a UsdPreviewSurface without clearcoat).
 //! This is the paper's hard case: a wide lobe and a needle-sharp one in one BRDF.
 
-use super::microfacet::{Ggx, fresnel_schlick, half_vector};
+use super::microfacet::{Ggx, HalfVectorCone, fresnel_schlick, half_vector};
 use super::{Brdf, BrdfDraw, BrdfSample, pick_lobe};
+use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::{reflect, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
+/// Lambert base + GGX flakes under a GGX clear coat with Schlick Fresnel (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CarPaint {
+    /// Albedo of the Lambertian base.
     pub base: Vec3,
+    /// Reflectance of the metallic-flake lobe.
     pub flake: Vec3,
+    /// Roughness of the flake lobe.
     pub flake_ggx: Ggx,
+    /// Weight c of the clear coat in [0, 1]; 0 removes the coat.
     pub coat: f32,
+    /// Roughness of the clear coat.
     pub coat_ggx: Ggx,
+    /// Schlick F0 of the clear coat (0.04 from [`CarPaint::new`], i.e. η = 1.5).
     pub coat_f0: f32,
 }
 
@@ -30,6 +38,8 @@ impl Default for CarPaint {
 }
 
 impl CarPaint {
+    /// A car paint with base albedo, flake reflectance and roughness, coat weight and coat
+    /// roughness (GGX α, not squared); the coat's F0 is 0.04.
     #[must_use]
     pub fn new(base: Vec3, flake: Vec3, flake_alpha: f32, coat: f32, coat_alpha: f32) -> Self {
         Self { base, flake, flake_ggx: Ggx::new(flake_alpha), coat, coat_ggx: Ggx::new(coat_alpha), coat_f0: 0.04 }
@@ -67,6 +77,41 @@ impl CarPaint {
 }
 
 impl Brdf for CarPaint {
+    /// Each lobe bounded on its own: the coat's Fresnel at the smallest ωo·h of the cone, the
+    /// light entering the base through the coat at most 1 − c·F0.
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        if wo.z <= 0.0 {
+            out.iter_mut().zip(cones).for_each(|(o, _)| *o = 0.0);
+            return true;
+        }
+        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
+        let transmit = (1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z)) * (1.0 - self.coat * self.coat_f0);
+        let coat = self.coat * luminance(Vec3::ONE) * c.g1(wo) / (4.0 * wo.z);
+        let flake = transmit * luminance(self.flake) * f.g1(wo) / (4.0 * wo.z);
+        let base = transmit * luminance(self.base) * FRAC_1_PI;
+        for (o, cone) in out.iter_mut().zip(cones) {
+            let cos_i = cone.max_cos(Vec3::Z);
+            *o = if cos_i > 0.0 {
+                let h = HalfVectorCone::new(wo, cone);
+                let coat =
+                    if self.coat > 0.0 { coat * fresnel_schlick(self.coat_f0, h.cos_oh) * c.d_bound(&h) } else { 0.0 };
+                coat + flake * f.d_bound(&h) + base * cos_i
+            } else {
+                0.0
+            };
+        }
+        true
+    }
+
+    /// Each GGX lobe reflects at most its weight (F ≤ 1, G1(ωi) ≤ 1), the base its albedo.
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        if wo.z <= 0.0 {
+            return Some(0.0);
+        }
+        let transmit = (1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z)) * (1.0 - self.coat * self.coat_f0);
+        Some(self.coat * luminance(Vec3::ONE) + transmit * (luminance(self.flake) + luminance(self.base)))
+    }
+
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;

@@ -1,15 +1,19 @@
 //! GGX rough conductor with Fresnel 1, as Mitsuba 3's `roughconductor` with the separable
 //! Smith shadowing: f = specular · D(h)·G1(ωi)·G1(ωo) / (4 cosθi cosθo).
 
-use super::microfacet::{Ggx, half_vector};
+use super::microfacet::{Ggx, HalfVectorCone, half_vector};
 use super::{Brdf, BrdfDraw, BrdfSample};
+use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::reflect;
 use glam::{Vec2, Vec3};
 
+/// GGX rough conductor with Fresnel 1 (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughConductor {
+    /// The microfacet distribution (its α).
     pub ggx: Ggx,
+    /// Reflectance that scales the lobe.
     pub specular: Vec3,
 }
 
@@ -22,6 +26,24 @@ impl RoughConductor {
 }
 
 impl Brdf for RoughConductor {
+    /// specular · D·G1(ωo)/(4 cosθo) with G1(ωi) ≤ 1 and D bounded over the cone's half vectors.
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        let scale = if wo.z > 0.0 { luminance(self.specular) * self.ggx.g1(wo) / (4.0 * wo.z) } else { 0.0 };
+        for (o, c) in out.iter_mut().zip(cones) {
+            *o = if scale > 0.0 && c.max_cos(Vec3::Z) > 0.0 {
+                scale * self.ggx.d_bound(&HalfVectorCone::new(wo, c))
+            } else {
+                0.0
+            };
+        }
+        true
+    }
+
+    /// With G1(ωi) ≤ 1 the integrand is at most specular × the visible-normal density.
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        Some(if wo.z > 0.0 { luminance(self.specular) } else { 0.0 })
+    }
+
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;

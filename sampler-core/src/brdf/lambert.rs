@@ -1,6 +1,7 @@
 //! Lambertian diffuse reflection.
 
 use super::{Brdf, BrdfDraw, BrdfSample};
+use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use core::f32::consts::FRAC_1_PI;
@@ -9,10 +10,12 @@ use glam::{Vec2, Vec3};
 /// f = albedo / π, sampled ∝ cosθ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambert {
+    /// Reflectance per channel, in [0, 1] for energy conservation.
     pub albedo: Vec3,
 }
 
 impl Lambert {
+    /// A Lambertian BRDF of the given albedo.
     #[must_use]
     pub fn new(albedo: Vec3) -> Self {
         Self { albedo }
@@ -54,5 +57,17 @@ impl Brdf for Lambert {
 
     fn is_diffuse(&self) -> bool {
         true
+    }
+
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        let scale = if wo.z > 0.0 { luminance(self.albedo) * FRAC_1_PI } else { 0.0 };
+        for (o, c) in out.iter_mut().zip(cones) {
+            *o = scale * c.max_cos(Vec3::Z).max(0.0);
+        }
+        true
+    }
+
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        Some(if wo.z > 0.0 { luminance(self.albedo) } else { 0.0 })
     }
 }

@@ -2,8 +2,9 @@
 //! Smith G1, and visible-normal sampling (spherical caps, Dupuy & Benyoub 2023), in local
 //! coordinates (normal = +z). Written to stay accurate for α down to 1e-4.
 
+use crate::cone::Cone;
 use crate::sampling::sin_cos_2pi;
-use core::f32::consts::PI;
+use core::f32::consts::{FRAC_PI_2, PI};
 use glam::{Vec2, Vec3};
 
 /// Smallest roughness accepted (the scene format's clamp).
@@ -23,6 +24,7 @@ impl Ggx {
         Self { alpha }
     }
 
+    /// The (clamped) roughness α.
     #[inline]
     #[must_use]
     pub fn alpha(&self) -> f32 {
@@ -96,6 +98,73 @@ impl Ggx {
             return 0.0;
         }
         self.g1(wo) * self.d(m) / (4.0 * wo.z)
+    }
+}
+
+/// Where the half vectors of a view and a cone of incident directions lie
+/// ([`HalfVectorCone::new`]): what bounds every microfacet lobe over the cone, whatever its α.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfVectorCone {
+    /// A lower bound of sinθh, the half vectors' angle from the normal (0: the normal may be
+    /// among them).
+    pub sin_normal: f32,
+    /// A lower bound of ωo·h, in [0, 1] (Schlick's Fresnel falls as it grows).
+    pub cos_oh: f32,
+}
+
+impl HalfVectorCone {
+    /// Nothing known: any half vector.
+    pub const ANY: Self = Self { sin_normal: 0.0, cos_oh: 0.0 };
+
+    /// Bounds the half vectors h of `wo` and every direction ωi of `cone` (local frame).
+    ///
+    /// h moves at most 1/|ωo + ωi| = 1/(2 cos(θ/2)) radians per radian of ωi, θ the angle
+    /// between ωo and ωi; every ωi of the cone is reached from its axis by an arc of at most
+    /// θc inside it, so h stays within ρ = θc / (2 cos(θmax/2)) of the half vector of the axis.
+    /// With cos ρ ≥ 1 − ρ²/2 and sin ρ ≤ ρ, the angle addition formulas bound the normal's
+    /// nearest approach and the view's farthest without a trigonometric call.
+    #[must_use]
+    pub fn new(wo: Vec3, cone: &Cone) -> Self {
+        let (c_oa, s_oa) = cone.cos_sin_to(wo);
+        if c_oa <= -cone.cos {
+            return Self::ANY;
+        }
+        let cos_widest = c_oa * cone.cos - s_oa * cone.sin;
+        let rho = cone.angle / (2.0 * libm::sqrtf((0.5 * (1.0 + cos_widest)).max(0.0)));
+        if rho.is_nan() || rho >= FRAC_PI_2 {
+            return Self::ANY;
+        }
+        let Some(h) = half_vector(wo, cone.axis) else { return Self::ANY };
+        let cos_rho = 1.0 - 0.5 * rho * rho;
+        let sin_normal = (libm::sqrtf(h.x * h.x + h.y * h.y) * cos_rho - h.z.max(0.0) * rho).max(0.0);
+        let (c_oh, s_oh) = (wo.dot(h), wo.cross(h).length());
+        let cos_oh = if c_oh >= 0.0 { c_oh * cos_rho } else { c_oh } - s_oh * rho;
+        Self { sin_normal, cos_oh: cos_oh.clamp(0.0, 1.0) }
+    }
+}
+
+impl Ggx {
+    /// The largest value D takes anywhere: at the normal for α < 1, at grazing half vectors
+    /// above.
+    #[inline]
+    #[must_use]
+    pub fn d_max(&self) -> f32 {
+        let a2 = self.alpha * self.alpha;
+        if self.alpha < 1.0 { 1.0 / (PI * a2) } else { a2 / PI }
+    }
+
+    /// An upper bound of D over half vectors at least `cone.sin_normal` from the normal: D
+    /// falls with sinθh for α < 1.
+    #[inline]
+    #[must_use]
+    pub fn d_bound(&self, cone: &HalfVectorCone) -> f32 {
+        if self.alpha >= 1.0 {
+            return self.d_max();
+        }
+        let a2 = self.alpha * self.alpha;
+        let s2 = cone.sin_normal * cone.sin_normal;
+        let k = a2 + (1.0 - a2) * s2;
+        a2 / (PI * k * k)
     }
 }
 

@@ -17,6 +17,7 @@ pub use conductor::RoughConductor;
 pub use lambert::Lambert;
 pub use phong::Phong;
 
+use crate::cone::Cone;
 use crate::env::luminance;
 use glam::{Vec2, Vec3};
 
@@ -95,6 +96,24 @@ pub trait Brdf {
     fn is_diffuse(&self) -> bool {
         false
     }
+
+    /// Upper bounds of the luminance of [`Brdf::eval`] over cones of incident directions (local
+    /// frame): `out[k] ≥ luminance(eval(wo, ωi))` for every ωi of `cones[k]` (as many as both
+    /// hold), as tight as is cheap. Returns false when the BRDF has no such bound; the
+    /// two-level product ([`crate::two_level`]) then estimates its weights by evaluation.
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        let _ = (wo, cones, out);
+        false
+    }
+
+    /// An upper bound of the directional reflectance ∫ luminance(eval(wo, ωi)) dωi, or `None`.
+    /// The two-level product caps each cell's B̃ at this over the cell's solid angle: a needle
+    /// lobe's peak is far above its mean over a cell, and uncapped it would draw samples away
+    /// from a sun the lobe's tail reflects.
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        let _ = wo;
+        None
+    }
 }
 
 impl<B: Brdf + ?Sized> Brdf for &B {
@@ -121,6 +140,12 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     }
     fn is_diffuse(&self) -> bool {
         (**self).is_diffuse()
+    }
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        (**self).cone_bounds(wo, cones, out)
+    }
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        (**self).reflectance_bound(wo)
     }
 }
 

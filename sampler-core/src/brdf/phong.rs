@@ -3,6 +3,7 @@
 //! instead of 1 − r·ω, and cos^n as exp(n·log1p(−δ)).
 
 use super::{Brdf, BrdfDraw, BrdfSample, pick_lobe};
+use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::{
     TWO_PI, basis_around, reflect_z, sin_cos_2pi, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf,
@@ -16,8 +17,11 @@ use glam::{Vec2, Vec3};
 /// f = kd/π + ks·(n+2)/(2π)·cos^n α, α the angle between ωi and the mirror of ωo.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Phong {
+    /// Diffuse reflectance.
     pub kd: Vec3,
+    /// Specular reflectance of the lobe.
     pub ks: Vec3,
+    /// Exponent n of the cos^n lobe.
     pub exponent: f32,
 }
 
@@ -151,5 +155,28 @@ impl Brdf for Phong {
 
     fn is_diffuse(&self) -> bool {
         luminance(self.ks) == 0.0
+    }
+
+    /// cosθi and cos α at their largest over the cone.
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+        let (kd, ks) = (luminance(self.kd) * FRAC_1_PI, luminance(self.ks) * ((self.exponent + 2.0) / TWO_PI));
+        let r = reflect_z(wo);
+        for (o, c) in out.iter_mut().zip(cones) {
+            let cos_i = c.max_cos(Vec3::Z);
+            *o = if wo.z > 0.0 && cos_i > 0.0 {
+                let cos_a = c.max_cos(r);
+                let lobe = if cos_a > 0.0 { libm::expf(self.exponent * libm::logf(cos_a)) } else { 0.0 };
+                (kd + ks * lobe) * cos_i
+            } else {
+                0.0
+            };
+        }
+        true
+    }
+
+    /// The lobe (n+2)/(2π)·cosⁿα integrates to (n+2)/(n+1) over its hemisphere; cosθi ≤ 1.
+    fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
+        let spec = luminance(self.ks) * (self.exponent + 2.0) / (self.exponent + 1.0);
+        Some(if wo.z > 0.0 { luminance(self.kd) + spec } else { 0.0 })
     }
 }

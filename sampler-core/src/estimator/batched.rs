@@ -6,51 +6,70 @@
 
 use super::{Contribution, ShadingPoint, Visibility, drawn_half, mis_brdf_half, times, weighted};
 use crate::brdf::{Brdf, BrdfSample};
-use crate::env::{EnvHierarchy, EnvSample};
+use crate::direction::{DirectionSample, DirectionSampler};
+use crate::env::EnvHierarchy;
 use crate::mapping::SPHERE_AREA;
-use crate::sampler::{DirectionSample, ProductSampler};
+use crate::sampler::ProductSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
-/// samples spends 8 pairs; larger batches only zeroed more scratch per call — measured, 6 kB
-/// of contributions per call were a tenth of a 4-sample shading point's time).
+/// samples spends 8 pairs; a larger batch only zeroes more scratch per call, which a shading
+/// point with few samples pays in full: docs/perf.md#batched-and-branch-free-sampling).
 pub const BATCH: usize = 16;
 
-/// A drawn direction: world direction, its point of the square, density (solid angle).
-type Drawn = Option<(Vec3, Vec2, f32)>;
+/// A drawn direction, or none.
+type Drawn = Option<DirectionSample>;
 
-/// [`product_mis`](super::product_mis) for every pair (`out[k]` from `u_product[k]` and
-/// `u_brdf[k]`, as many as all three hold): the product samples drawn by
-/// [`ProductSampler::sample_many`] and the product's density at the BRDF samples by
-/// [`ProductSampler::pdf_square_many`], four tree descents side by side (the same values as one
-/// pair at a time, up to the last bits of a product sample's point).
-pub fn product_mis_many<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// [`sampled_mis`](super::sampled_mis) for every pair (`out[k]` from `u_sampler[k]` and
+/// `u_brdf[k]`, as many as all three hold): the sampler's directions drawn by
+/// [`DirectionSampler::sample_many`] and its densities at the BRDF samples by
+/// [`DirectionSampler::pdf_square_many`] (four tree descents side by side for the quadtree
+/// product: the same values as one pair at a time, up to the last bits of a product sample's
+/// point).
+pub fn sampled_mis_many<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
-    u_product: &[DVec2],
+    u_sampler: &[DVec2],
     u_brdf: &[Vec2],
     vis: &mut impl Visibility,
     out: &mut [[Contribution; 2]],
 ) {
-    let n = u_product.len().min(u_brdf.len()).min(out.len());
+    let n = u_sampler.len().min(u_brdf.len()).min(out.len());
     for start in (0..n).step_by(BATCH) {
         let end = (start + BATCH).min(n);
         let m = end - start;
         let mut directions = [None; BATCH];
-        sampler.draw(&u_product[start..end], &mut directions);
+        sampler.sample_many(&u_sampler[start..end], &mut directions[..m]);
         let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| sampler.pdf_square_many(uv, p);
         let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
         mis_with_brdf_batch(sampler.env(), sp, &directions[..m], u_b, pdf_square_many, vis, o);
     }
 }
 
-/// [`mis_drawn`](super::mis_drawn) for every pair (`out[k]` from `drawn[k]` and `u_brdf[k]`),
-/// e.g. with the env samples of [`EnvHierarchy::sample_many`]: the same values as one pair at
-/// a time.
+/// [`sampled`](super::sampled) for every point of `u` (`out[k]` from `u[k]`): the sampler's
+/// directions drawn a batch at a time and the BRDF evaluated likewise.
+pub fn sampled_many<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
+    sp: &ShadingPoint<'_, B>,
+    u: &[DVec2],
+    vis: &mut impl Visibility,
+    out: &mut [Contribution],
+) {
+    for (us, os) in u.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+        let n = us.len().min(os.len());
+        let mut drawn = [None; BATCH];
+        sampler.sample_many(&us[..n], &mut drawn[..n]);
+        drawn_many(sampler.env(), sp, &drawn[..n], vis, &mut os[..n]);
+    }
+}
+
+/// [`sampled_mis_drawn`](super::sampled_mis_drawn) of the env-only sampler for every pair
+/// (`out[k]` from `drawn[k]` and `u_brdf[k]`), e.g. with the env samples of
+/// [`EnvHierarchy::sample_many`]: the same values as one pair at a time.
 pub fn mis_many<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<EnvSample>],
+    drawn: &[Option<DirectionSample>],
     u_brdf: &[Vec2],
     vis: &mut impl Visibility,
     out: &mut [[Contribution; 2]],
@@ -58,38 +77,42 @@ pub fn mis_many<B: Brdf + ?Sized>(
     let n = drawn.len().min(u_brdf.len()).min(out.len());
     for start in (0..n).step_by(BATCH) {
         let end = (start + BATCH).min(n);
-        let mut directions = [None; BATCH];
-        for (d, s) in directions.iter_mut().zip(&drawn[start..end]) {
-            *d = s.map(|s| (s.dir, s.uv, s.pdf));
-        }
-        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_pdf_squares(env_h, uv, p);
+        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_h.pdf_square_many(uv, p);
         let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
-        mis_with_brdf_batch(env_h, sp, &directions[..end - start], u_b, pdf_square_many, vis, o);
+        mis_with_brdf_batch(env_h, sp, &drawn[start..end], u_b, pdf_square_many, vis, o);
     }
 }
 
-/// [`env_drawn`](super::env_drawn) for every drawn env sample (`out[k]` from `drawn[k]`), the
-/// BRDF evaluated a batch at a time ([`Brdf::eval_pdf_many`]): the same values, bit for bit.
+/// [`sampled_drawn`](super::sampled_drawn) of the env-only sampler for every drawn sample
+/// (`out[k]` from `drawn[k]`), the BRDF evaluated a batch at a time ([`Brdf::eval_pdf_many`]):
+/// the same values, bit for bit.
 pub fn env_many<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<EnvSample>],
+    drawn: &[Option<DirectionSample>],
     vis: &mut impl Visibility,
     out: &mut [Contribution],
 ) {
     for (ds, os) in drawn.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
-        let n = ds.len().min(os.len());
-        let mut directions = [None; BATCH];
-        for (d, s) in directions.iter_mut().zip(&ds[..n]) {
-            *d = s.map(|s| (s.dir, s.uv, s.pdf));
-        }
-        let evaluated = evaluate_drawn(sp, &directions[..n]);
-        for ((o, d), (b, _)) in os.iter_mut().zip(&directions[..n]).zip(evaluated) {
-            *o = d.map_or(Contribution::default(), |(dir, uv, p)| {
-                let f = times(env_h.radiance_at(uv), b);
-                Contribution { dir, value: weighted(f, p, vis, dir), pdf: p, other_pdf: 0.0 }
-            });
-        }
+        drawn_many(env_h, sp, ds, vis, os);
+    }
+}
+
+/// f·V/p of up to [`BATCH`] drawn directions into `out`, the BRDF evaluated at once.
+fn drawn_many<B: Brdf + ?Sized>(
+    env_h: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    drawn: &[Drawn],
+    vis: &mut impl Visibility,
+    out: &mut [Contribution],
+) {
+    let n = drawn.len().min(out.len()).min(BATCH);
+    let evaluated = evaluate_drawn(sp, &drawn[..n]);
+    for ((o, d), (b, _)) in out.iter_mut().zip(&drawn[..n]).zip(evaluated) {
+        *o = d.map_or(Contribution::default(), |d| {
+            let f = times(env_h.radiance_at(d.uv), b);
+            Contribution { dir: d.dir, value: weighted(f, d.pdf, vis, d.dir), pdf: d.pdf, other_pdf: 0.0 }
+        });
     }
 }
 
@@ -146,7 +169,7 @@ fn evaluate_drawn<B: Brdf + ?Sized>(sp: &ShadingPoint<'_, B>, drawn: &[Drawn]) -
     let n = drawn.len().min(BATCH);
     let mut local = [Vec3::Z; BATCH];
     for (l, d) in local.iter_mut().zip(&drawn[..n]) {
-        *l = d.map_or(Vec3::Z, |(dir, _, _)| sp.frame.to_local(dir));
+        *l = d.map_or(Vec3::Z, |d| sp.frame.to_local(d.dir));
     }
     let mut evaluated = [(Vec3::ZERO, 0.0); BATCH];
     sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[..n], &mut evaluated[..n]);
@@ -190,8 +213,8 @@ fn brdf_draws<B: Brdf + ?Sized>(
 /// their count. Unbiased for any split: each technique's density covers what it samples, and
 /// together they cover every direction where L·B > 0 (the product through its defensive part).
 /// Where a wide lobe meets extended light, product samples are worth more than BRDF samples,
-/// and a split towards them lowers the error (docs/perf.md); with shares (½, ½) and as many
-/// points of each it is [`product_mis_many`]'s estimate.
+/// and a split towards them lowers the error (docs/perf.md#budget-splits); with shares (½, ½) and as many
+/// points of each it is [`sampled_mis_many`]'s estimate.
 pub fn product_mis_split<B: Brdf + ?Sized>(
     sampler: &ProductSampler<'_, '_>,
     sp: &ShadingPoint<'_, B>,
@@ -200,14 +223,14 @@ pub fn product_mis_split<B: Brdf + ?Sized>(
     shares: (f32, f32),
     vis: &mut impl Visibility,
 ) -> DVec3 {
-    split_with_brdf(sampler, sp, u_product, u_brdf, shares, vis)
+    sampled_mis_split(sampler, sp, u_product, u_brdf, shares, vis)
 }
 
 /// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
 /// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
 /// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
 /// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
-/// than an env sample (docs/perf.md).
+/// than an env sample (docs/perf.md#budget-splits).
 pub fn mis_split<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
@@ -216,57 +239,15 @@ pub fn mis_split<B: Brdf + ?Sized>(
     shares: (f32, f32),
     vis: &mut impl Visibility,
 ) -> DVec3 {
-    split_with_brdf(env_h, sp, u_env, u_brdf, shares, vis)
+    sampled_mis_split(env_h, sp, u_env, u_brdf, shares, vis)
 }
 
-/// The technique an MIS split draws beside BRDF sampling: product or env-only sampling.
-trait FirstTechnique {
-    fn env_hierarchy(&self) -> &EnvHierarchy<'_>;
-    /// Directions for the points of `u` (into `out`, as many as both hold).
-    fn draw(&self, u: &[DVec2], out: &mut [Drawn]);
-    /// The technique's density per unit square area at each point of `uv` (into `p`).
-    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]);
-}
-
-impl FirstTechnique for ProductSampler<'_, '_> {
-    fn env_hierarchy(&self) -> &EnvHierarchy<'_> {
-        self.env()
-    }
-    fn draw(&self, u: &[DVec2], out: &mut [Drawn]) {
-        let mut drawn = [None; BATCH];
-        let n = u.len().min(out.len()).min(BATCH);
-        self.sample_many(&u[..n], &mut drawn[..n]);
-        for (o, s) in out.iter_mut().zip(&drawn[..n]) {
-            *o = s.map(|s: DirectionSample| (s.dir, s.uv, s.pdf));
-        }
-    }
-    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]) {
-        self.pdf_square_many(uv, p);
-    }
-}
-
-impl FirstTechnique for EnvHierarchy<'_> {
-    fn env_hierarchy(&self) -> &EnvHierarchy<'_> {
-        self
-    }
-    fn draw(&self, u: &[DVec2], out: &mut [Drawn]) {
-        let mut drawn = [None; BATCH];
-        let n = u.len().min(out.len()).min(BATCH);
-        self.sample_many(&u[..n], &mut drawn[..n]);
-        for (o, s) in out.iter_mut().zip(&drawn[..n]) {
-            *o = s.map(|s: EnvSample| (s.dir, s.uv, s.pdf));
-        }
-    }
-    fn pdf_squares(&self, uv: &[Vec2], p: &mut [f32]) {
-        env_pdf_squares(self, uv, p);
-    }
-}
-
-/// The sum of f·V / (c_d·p_first + c_b·p_brdf) over the points of both techniques: all of the
-/// first technique's samples, then the BRDF's, one by one (the same order and rounding however
-/// the points are batched).
-fn split_with_brdf<B: Brdf + ?Sized>(
-    first: &impl FirstTechnique,
+/// Any sampler of the environment and BRDF sampling in MIS with the budget split unevenly, as
+/// [`product_mis_split`] describes: the sum of f·V / (c_d·p_first + c_b·p_brdf) over the points
+/// of both techniques — all of the first technique's samples, then the BRDF's, one by one (the
+/// same order and rounding however the points are batched).
+pub fn sampled_mis_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    first: &S,
     sp: &ShadingPoint<'_, B>,
     u_first: &[DVec2],
     u_brdf: &[Vec2],
@@ -274,21 +255,16 @@ fn split_with_brdf<B: Brdf + ?Sized>(
     vis: &mut impl Visibility,
 ) -> DVec3 {
     let mut sum = DVec3::ZERO;
-    let env_h = first.env_hierarchy();
+    let env_h = first.env();
     for u in u_first.chunks(BATCH) {
         let mut drawn = [None; BATCH];
-        first.draw(u, &mut drawn);
+        first.sample_many(u, &mut drawn[..u.len()]);
         add_drawn(env_h, sp, &drawn[..u.len()], shares, vis, &mut sum);
     }
     for u in u_brdf.chunks(BATCH) {
-        add_brdf(env_h, sp, u, |uv, p| first.pdf_squares(uv, p), shares, vis, &mut sum);
+        add_brdf(env_h, sp, u, |uv, p| first.pdf_square_many(uv, p), shares, vis, &mut sum);
     }
     sum
-}
-
-/// The environment's density per unit square area at each point of `uv` (into `p`).
-fn env_pdf_squares(env_h: &EnvHierarchy<'_>, uv: &[Vec2], p: &mut [f32]) {
-    p.iter_mut().zip(uv).for_each(|(p, uv)| *p = env_h.pdf_square(*uv));
 }
 
 /// Adds f·V / (c_d·p_drawn + c_b·p_brdf) of up to [`BATCH`] directions drawn by the first
@@ -303,7 +279,7 @@ fn add_drawn<B: Brdf + ?Sized>(
 ) {
     let evaluated = evaluate_drawn(sp, drawn);
     for (d, (b, p_brdf)) in drawn.iter().zip(evaluated) {
-        if let Some((dir, uv, p)) = *d {
+        if let Some(DirectionSample { dir, uv, pdf: p }) = *d {
             *sum += weighted(times(env_h.radiance_at(uv), b), c_d * p + c_b * p_brdf, vis, dir);
         }
     }
