@@ -69,7 +69,7 @@ fn main() {
                 *b = v.as_vec2();
             }
             let t = Instant::now();
-            let s = arena.build(&env, &brdf, frame, *wo, &params, i as u64);
+            let s = arena.build(&env, &brdf, frame, *wo, &params, i as u64).unwrap();
             t_build += t.elapsed().as_secs_f64();
             let t = Instant::now();
             for u in &us {

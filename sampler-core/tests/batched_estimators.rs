@@ -66,7 +66,7 @@ fn batched_mis_is_pair_by_pair_mis() {
                 assert_eq!(bits(&singles[k]), bits(&one), "brdf, brdf {i}, sample {k}");
             }
             // Product and BRDF.
-            let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
+            let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5).unwrap();
             let mut drawn = [None; 101];
             s.sample_many(&u, &mut drawn);
             estimator::sampled_mis_many(&s, &sp, &u, &brdf_points, &mut vis, &mut out);

@@ -150,7 +150,7 @@ fn run(estimator: &str) {
                 let params = ProductParams { kind, ..ProductParams::default() };
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let mut pts = [DVec2::ZERO; 32];
                         sobol02(seed ^ 0xabc, 0, &mut pts);
                         pts.iter().map(|p| lum(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0
@@ -222,7 +222,7 @@ fn run(estimator: &str) {
                 };
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts);
                         sobol02(seed ^ 0x123, 0, &mut qts);
@@ -250,7 +250,7 @@ fn run(estimator: &str) {
                 let params = ProductParams::for_mis(256);
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts[..n_p]);
                         sobol02(seed ^ 0x123, 0, &mut qts[..n_b]);

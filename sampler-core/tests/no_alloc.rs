@@ -80,7 +80,7 @@ fn ten_thousand_shading_points_allocate_nothing() {
             2 => ProductParams { bilinear: true, ..ProductParams::for_mis(256) },
             _ => ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() },
         };
-        let sampler = arena.build(&env, brdf, &frame, wo, &params, i);
+        let sampler = arena.build(&env, brdf, &frame, wo, &params, i).unwrap();
         let mut points = [DVec2::ZERO; 4];
         sobol02(i, 0, &mut points);
         let sp = ShadingPoint { frame, wo, brdf };
