@@ -5,9 +5,9 @@
 //!     cargo run --release -p host-std --example bvh_compare -- [SCENE] [--width W]
 //!
 //! Spheres are left out (obvhs builds over triangles); rectangles count as two triangles.
-use host_std::bvh::Bvh;
-use host_std::camera::Camera;
 use host_std::scene::{Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
+use host_std::trace::camera::Camera;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use sampler_core::glam::{Vec3, Vec3A};
@@ -31,14 +31,85 @@ fn triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
     out
 }
 
+/// Rays through every pixel centre.
+fn camera_rays(camera: &Camera) -> Vec<(Vec3, Vec3)> {
+    let mut cam = Vec::new();
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            cam.push((camera.origin, camera.direction(x as f32 + 0.5, y as f32 + 0.5)));
+        }
+    }
+    cam
+}
+
+/// Shadow rays from each camera ray's hit towards a fixed set of directions over the sphere.
+fn shadow_rays(cam: &[(Vec3, Vec3)], hits: &[Option<f32>]) -> Vec<(Vec3, Vec3)> {
+    let dirs: Vec<Vec3> = (0..16)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f32 + 0.5) / 16.0;
+            let phi = k as f32 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            Vec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect();
+    // Four of the sixteen directions per hit, rotating with the pixel.
+    let mut shadow = Vec::new();
+    for (i, ((o, d), t)) in cam.iter().zip(hits).enumerate() {
+        if let Some(t) = t {
+            let p = *o + *d * *t;
+            let eps = 1e-4 * (1.0 + p.abs().max_element());
+            for k in 0..4 {
+                let w = dirs[(i + 4 * k) % dirs.len()];
+                shadow.push((p + w * eps, w));
+            }
+        }
+    }
+    shadow
+}
+
+/// obvhs's closest hit along each ray.
+fn obvhs_closest(bvh: &obvhs::cwbvh::CwBvh, tris: &[Triangle], rays: &[(Vec3, Vec3)]) -> Vec<Option<f32>> {
+    rays.iter()
+        .map(|&(o, d)| {
+            let mut hit = RayHit::none();
+            let ray = Ray::new_inf(o.into(), d.into());
+            bvh.ray_traverse(ray, &mut hit, |r, id| tris[bvh.primitive_indices[id] as usize].intersect(r))
+                .then_some(hit.t)
+        })
+        .collect()
+}
+
+/// How many of the rays obvhs finds occluded.
+fn obvhs_occluded(bvh: &obvhs::cwbvh::CwBvh, tris: &[Triangle], rays: &[(Vec3, Vec3)]) -> usize {
+    rays.iter()
+        .filter(|&&(o, d)| {
+            !bvh.ray_traverse_miss(Ray::new_inf(o.into(), d.into()), |r, id| {
+                tris[bvh.primitive_indices[id] as usize].intersect(r)
+            })
+        })
+        .count()
+}
+
+/// How many closest hits agree (both miss, or hit at the same distance within 1e-4 relative).
+fn agreeing(ours: &[Option<f32>], theirs: &[Option<f32>]) -> usize {
+    ours.iter()
+        .zip(theirs)
+        .filter(|(a, b)| match (a, b) {
+            (Some(a), Some(b)) => (a - b).abs() <= 1e-4 * a.max(1.0),
+            (None, None) => true,
+            _ => false,
+        })
+        .count()
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let width: u32 = args.iter().position(|a| a == "--width").map_or(512, |i| args[i + 1].parse().unwrap());
     let path = args.iter().find(|a| !a.starts_with("--") && a.parse::<u32>().is_err());
     let mut scene = match path {
-        None => host_std::default_scene::scene(),
-        Some(p) if p.ends_with(".json") => host_std::scene_json::load(p.as_ref()).unwrap(),
-        Some(p) => host_std::usd_scene::load(p.as_ref(), &Default::default()).unwrap().scene,
+        None => host_std::scene::builtin::scene(),
+        Some(p) if p.ends_with(".json") => host_std::scene::json::load(p.as_ref()).unwrap(),
+        Some(p) => host_std::scene::usd::load(p.as_ref(), &Default::default()).unwrap().scene,
     };
     let tris = triangles(&scene);
     let aspect = scene.camera.width as f32 / scene.camera.height as f32;
@@ -70,71 +141,22 @@ fn main() {
 
     // Camera rays through pixel centres; shadow rays from each hit towards a fixed set of
     // directions over the sphere.
-    let camera = Camera::new(&scene.camera);
-    let mut cam = Vec::new();
-    for y in 0..camera.height {
-        for x in 0..camera.width {
-            cam.push((camera.origin, camera.direction(x as f32 + 0.5, y as f32 + 0.5)));
-        }
-    }
+    let cam = camera_rays(&Camera::new(&scene.camera));
     let t0 = Instant::now();
     let ours_hits: Vec<Option<f32>> =
         cam.iter().map(|&(o, d)| ours.intersect(o, d, 0.0, f32::INFINITY).map(|h| h.t)).collect();
     let ours_cam = t0.elapsed();
     let t0 = Instant::now();
-    let theirs_hits: Vec<Option<f32>> = cam
-        .iter()
-        .map(|&(o, d)| {
-            let mut hit = RayHit::none();
-            let ray = Ray::new_inf(o.into(), d.into());
-            theirs
-                .ray_traverse(ray, &mut hit, |r, id| theirs_tris[theirs.primitive_indices[id] as usize].intersect(r))
-                .then_some(hit.t)
-        })
-        .collect();
+    let theirs_hits = obvhs_closest(&theirs, &theirs_tris, &cam);
     let theirs_cam = t0.elapsed();
-    let agree = ours_hits
-        .iter()
-        .zip(&theirs_hits)
-        .filter(|(a, b)| match (a, b) {
-            (Some(a), Some(b)) => (a - b).abs() <= 1e-4 * a.max(1.0),
-            (None, None) => true,
-            _ => false,
-        })
-        .count();
+    let agree = agreeing(&ours_hits, &theirs_hits);
 
-    let dirs: Vec<Vec3> = (0..16)
-        .map(|k| {
-            let z = 1.0 - 2.0 * (k as f32 + 0.5) / 16.0;
-            let phi = k as f32 * 2.399_963;
-            let r = (1.0 - z * z).sqrt();
-            Vec3::new(r * phi.cos(), z, r * phi.sin())
-        })
-        .collect();
-    // Four of the sixteen directions per hit, rotating with the pixel.
-    let mut shadow = Vec::new();
-    for (i, ((o, d), t)) in cam.iter().zip(&ours_hits).enumerate() {
-        if let Some(t) = t {
-            let p = *o + *d * *t;
-            let eps = 1e-4 * (1.0 + p.abs().max_element());
-            for k in 0..4 {
-                let w = dirs[(i + 4 * k) % dirs.len()];
-                shadow.push((p + w * eps, w));
-            }
-        }
-    }
+    let shadow = shadow_rays(&cam, &ours_hits);
     let t0 = Instant::now();
     let ours_occ = shadow.iter().filter(|&&(o, d)| ours.occluded(o, d, 0.0, f32::INFINITY)).count();
     let ours_shadow = t0.elapsed();
     let t0 = Instant::now();
-    let theirs_occ = shadow
-        .iter()
-        .filter(|&&(o, d)| {
-            !theirs.ray_traverse_miss(Ray::new_inf(o.into(), d.into()), |r, id| {
-                theirs_tris[theirs.primitive_indices[id] as usize].intersect(r)
-            })
-        })
-        .count();
+    let theirs_occ = obvhs_occluded(&theirs, &theirs_tris, &shadow);
     let theirs_shadow = t0.elapsed();
 
     let mrays = |n: usize, t: Duration| n as f64 / t.as_secs_f64() / 1e6;

@@ -4,10 +4,17 @@
 
 use std::path::{Path, PathBuf};
 
+/// Why an output file cannot be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
+    /// The file cannot be written.
     #[error("{path}: cannot write: {message}")]
-    Write { path: PathBuf, message: String },
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 fn temp_path(path: &Path) -> PathBuf {

@@ -3,7 +3,7 @@
 //! allocation made while decoding exceeds what the file could hold (decoded RGB of 1000× the
 //! file's size or 64 MB, the loader's own bound, plus the decoders' fixed buffers).
 
-use host_std::env_io::load_bytes;
+use host_std::light::image_file::load_bytes;
 use proptest::prelude::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -3,12 +3,13 @@
 //! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
 //! matte studio where it measures twice as good as the rules' MIS.
 
-use host_std::bvh::Bvh;
-use host_std::environment::{EnvSource, Environment, Placement};
-use host_std::integrator::Method;
-use host_std::pilot;
-use host_std::render::{Settings, render};
+use host_std::light::environment::{EnvSource, Environment, Placement};
+use host_std::plan::Method;
+use host_std::plan::pilot;
+use host_std::plan::{Settings, render};
+use host_std::render::strategy::Strategy;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::{Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
 
@@ -74,7 +75,7 @@ fn a_matte_sphere_under_the_sun_is_not_brdf_sampled() {
     // pixels would not see the rare cosine samples that hit the sun, and would score BRDF
     // sampling by the sky alone. Under a constant dome it is a candidate; under the sun not.
     let matte = Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5)));
-    let brdf = pilot::PLANS.iter().position(|p| p.0 == Method::Brdf).expect("BRDF sampling is a plan");
+    let brdf = pilot::PLANS.iter().position(|p| p.strategy == Strategy::Brdf).expect("BRDF sampling is a plan");
     let sun = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
     let dome = Environment::build(&EnvSource::Constant { level: 3 }, Placement::default()).unwrap();
     assert!(!pilot::eligible(brdf, &matte, sun.hierarchy().peak(5)), "not a candidate under the sun");
@@ -90,10 +91,10 @@ fn a_matte_studio_can_be_env_sampled() {
     // (0.02) lit by 24 soft boxes, discs of 3–6° of radiance 20–200 above the horizon.
     // Cosine-weighted BRDF samples seldom find them and MIS spends a quarter of its samples
     // that way; the rule's plan is MIS 3:1 and the pilot replaces it where it measures env
-    // sampling more than twice as good (the real studio at 256², 1024 spp: 2.3× at equal
-    // time, docs/perf.md session 8).
+    // sampling more than twice as good (as on the real studio; docs/perf.md, "Error against
+    // time (`ppis report`)").
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes");
-    let mut scene = host_std::scene_json::load(&dir.join("studio.json")).unwrap();
+    let mut scene = host_std::scene::json::load(&dir.join("studio.json")).unwrap();
     scene.camera.width = 96;
     scene.camera.height = 96;
     scene.materials.truncate(1);

@@ -1,12 +1,12 @@
 //! End-to-end properties of the tracer: the image does not depend on the thread count, every
 //! method converges to the analytic white-furnace answer, and nothing non-finite comes out.
 
-use host_std::bvh::Bvh;
-use host_std::default_scene;
-use host_std::environment::{EnvSource, Environment, Placement};
-use host_std::integrator::Method;
-use host_std::render::{Settings, render};
+use host_std::light::environment::{EnvSource, Environment, Placement};
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
+use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
@@ -23,7 +23,7 @@ fn render_with_threads(scene: &Scene, env: &Environment, s: &Settings, threads: 
 
 #[test]
 fn the_image_is_bit_identical_at_any_thread_count() {
-    let mut scene = default_scene::scene();
+    let mut scene = builtin::scene();
     scene.camera.width = 64;
     scene.camera.height = 36;
     let env = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
@@ -81,7 +81,7 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
 #[test]
 fn unshadowed_renders_trace_no_shadow_rays_and_are_brighter() {
     // The default scene's spheres shadow the ground: without visibility every pixel gains.
-    let mut scene = default_scene::scene();
+    let mut scene = builtin::scene();
     scene.camera.width = 48;
     scene.camera.height = 27;
     let env = Environment::build(&EnvSource::Sky { level: 7 }, Placement::default()).unwrap();

@@ -3,12 +3,12 @@
 //! for what a scene uses.
 #![cfg(feature = "usd")]
 
-use host_std::bvh::Bvh;
-use host_std::camera::Camera;
-use host_std::environment::Environment;
-use host_std::integrator::Method;
-use host_std::render::{Settings, render};
-use host_std::usd_scene;
+use host_std::light::environment::Environment;
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
+use host_std::scene::usd;
+use host_std::trace::bvh::Bvh;
+use host_std::trace::camera::Camera;
 use sampler_core::glam::{Mat3, Vec3};
 use std::f32::consts::PI;
 use std::path::PathBuf;
@@ -81,7 +81,7 @@ fn dome_light_orientation_matches_the_convention() {
     ];
     let mut predicted = Vec::new();
     for (file, z_up, pole_to_z) in cases {
-        let mut c = usd_scene::load(&fixture(file), &Default::default()).unwrap();
+        let mut c = usd::load(&fixture(file), &Default::default()).unwrap();
         assert!(c.notes.is_empty(), "{file}: {:?}", c.notes);
         c.scene.camera.width = 96;
         c.scene.camera.height = 72;
@@ -113,7 +113,7 @@ fn dome_light_orientation_matches_the_convention() {
 
 #[test]
 fn a_scene_without_a_dome_builds_no_environment() {
-    let c = usd_scene::load(&fixture("materials.usda"), &Default::default()).unwrap();
+    let c = usd::load(&fixture("materials.usda"), &Default::default()).unwrap();
     assert!(c.usd.dome.is_none());
     assert!(c.scene.env.is_none(), "no DomeLight, so no env hierarchy is built");
     // Its camera frames the scene's bounds.
@@ -125,7 +125,7 @@ fn usd_errors_name_the_file_and_do_not_panic() {
     let tmp = tempfile::Builder::new().prefix("ppis-usd-").tempdir().unwrap();
     let dir = tmp.path();
     let missing = dir.join("missing.usda");
-    let e = usd_scene::load(&missing, &Default::default()).err().unwrap().to_string();
+    let e = usd::load(&missing, &Default::default()).err().unwrap().to_string();
     assert!(e.contains("missing.usda") && e.contains("not found"), "{e}");
     for (name, bytes) in [
         ("garbage.usda", b"#usda 1.0\ndef Xform \"A\" {\n  double3 xformOp:translate = (1, 2\n".to_vec()),
@@ -135,12 +135,12 @@ fn usd_errors_name_the_file_and_do_not_panic() {
     ] {
         let p = dir.join(name);
         std::fs::write(&p, bytes).unwrap();
-        let e = usd_scene::load(&p, &Default::default()).err().map(|e| e.to_string());
+        let e = usd::load(&p, &Default::default()).err().map(|e| e.to_string());
         let e = e.unwrap_or_else(|| panic!("{name} was accepted"));
         assert!(e.contains(name), "{name}: {e}");
     }
-    let options = usd_scene::Options { camera: Some("/Root/NoSuchCam".into()), ..Default::default() };
-    let e = usd_scene::load(&fixture("dome_y.usda"), &options).err().unwrap().to_string();
+    let options = usd::Options { camera: Some("/Root/NoSuchCam".into()), ..Default::default() };
+    let e = usd::load(&fixture("dome_y.usda"), &options).err().unwrap().to_string();
     assert!(e.contains("/Root/NoSuchCam"), "{e}");
 }
 
@@ -148,7 +148,7 @@ fn usd_errors_name_the_file_and_do_not_panic() {
 fn textures_are_looked_up_at_each_hit() {
     // A quad with a 2×2 texture (red, green above blue, white; clamped), texture coordinates
     // from the primvar the material names (`uv`), under a constant white dome.
-    let mut c = usd_scene::load(&fixture("uv_quad.usda"), &Default::default()).unwrap();
+    let mut c = usd::load(&fixture("uv_quad.usda"), &Default::default()).unwrap();
     assert!(c.notes.is_empty(), "{:?}", c.notes);
     c.scene.camera.width = 40;
     c.scene.camera.height = 30;

@@ -5,13 +5,13 @@
 //! UsdRenderSettings pick the image size and the camera.
 #![cfg(feature = "usd")]
 
-use host_std::bvh::Bvh;
-use host_std::camera::Camera;
-use host_std::environment::Environment;
-use host_std::integrator::Method;
-use host_std::render::{Settings, render};
+use host_std::light::environment::Environment;
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
 use host_std::scene::{Bsdf, Scene, Shape};
-use host_std::{scene_json, usd_scene};
+use host_std::scene::{json, usd};
+use host_std::trace::bvh::Bvh;
+use host_std::trace::camera::Camera;
 use sampler_core::brdf::RoughConductor;
 use std::path::PathBuf;
 
@@ -86,12 +86,12 @@ fn tolerance(se: f64, value: f64) -> f64 {
 
 #[test]
 fn usd_twins_render_like_their_json_original() {
-    let json = scene_json::load(&fixture("twins.json")).unwrap();
+    let json = json::load(&fixture("twins.json")).unwrap();
     let (a, b) = (render_scene(&json, 1), render_scene(&json, 3));
     let reference = sphere_means(&json, &a);
     let errors = sphere_errors(&json, &a, &b);
     for file in ["twins.usda", "twins.usdc"] {
-        let c = usd_scene::load(&fixture(file), &Default::default()).unwrap();
+        let c = usd::load(&fixture(file), &Default::default()).unwrap();
         assert!(c.notes.is_empty(), "{file}: {:?}", c.notes);
         // The render settings' resolution and camera (not the first camera in namespace order).
         assert_eq!((c.scene.camera.width, c.scene.camera.height), (96, 64), "{file}");
@@ -116,7 +116,7 @@ fn usd_twins_render_like_their_json_original() {
 fn a_conductor_of_roughness_as_alpha_would_fail_the_twin_test() {
     // The control: the metal sphere's α set to its USD roughness (0.3) instead of 0.3² moves
     // its mean far beyond the twin test's tolerance.
-    let json = scene_json::load(&fixture("twins.json")).unwrap();
+    let json = json::load(&fixture("twins.json")).unwrap();
     let mut wrong = json.clone();
     let metal = wrong.objects[1].material;
     let Bsdf::Conductor(c) = wrong.materials[metal].bsdf else { panic!("sphere 1 is the conductor") };
@@ -132,8 +132,8 @@ fn a_conductor_of_roughness_as_alpha_would_fail_the_twin_test() {
 
 #[test]
 fn width_and_height_override_the_render_settings() {
-    let options = usd_scene::Options { width: Some(48), ..Default::default() };
-    let c = usd_scene::load(&fixture("twins.usda"), &options).unwrap();
+    let options = usd::Options { width: Some(48), ..Default::default() };
+    let c = usd::load(&fixture("twins.usda"), &options).unwrap();
     assert_eq!((c.scene.camera.width, c.scene.camera.height), (48, 64));
     // expandAperture: the 3:2 aperture grows vertically to fill the 3:4 image, so the
     // horizontal field of view stays the authored one.

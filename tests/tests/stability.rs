@@ -5,11 +5,11 @@ mod common;
 
 use common::{env_from, materials, sphere_scene};
 use glam::Vec3;
-use host_std::bvh::Bvh;
-use host_std::environment::Environment;
-use host_std::integrator::Method;
-use host_std::render::{Rendered, Settings, render};
+use host_std::light::environment::Environment;
+use host_std::plan::Method;
+use host_std::plan::{Rendered, Settings, render};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
 
 fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_samples: usize) -> Rendered {

@@ -11,11 +11,11 @@ mod common;
 
 use common::{env_from, materials, sphere_scene};
 use glam::Vec3;
-use host_std::bvh::Bvh;
-use host_std::environment::Environment;
-use host_std::integrator::Method;
-use host_std::render::{Settings, render};
+use host_std::light::environment::Environment;
+use host_std::plan::Method;
+use host_std::plan::{Settings, render};
 use host_std::scene::{Bsdf, Scene};
+use host_std::trace::bvh::Bvh;
 use rayon::prelude::*;
 use std::fmt::Write;
 

@@ -2,7 +2,7 @@
 //! user's would be, and the suite's materials.
 
 use glam::Vec3;
-use host_std::environment::{EnvSource, Environment, Placement};
+use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 

@@ -1,14 +1,17 @@
 //! `ppis report`: every method at every sample count against a reference — error against
 //! render time as CSV, plot and equal-time tables.
 
-use super::{MAX_SPP, SamplingArgs, SceneArgs, load_scene, parse_method, warn_notes};
+use crate::args::{DEFAULT_SHADING_POINTS, MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::load::{load_scene, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use host_std::bvh::Bvh;
-use host_std::environment::Environment;
-use host_std::integrator::Method;
-use host_std::output;
-use host_std::render::{self, Settings};
+use host_std::light::environment::Environment;
+use host_std::plan::Method;
+use host_std::plan::{self, Settings};
+use host_std::scene::Scene;
+use host_std::trace::bvh::Bvh;
+use host_std::{output, report};
+use sampler_core::env::EnvHierarchy;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -44,7 +47,7 @@ pub(crate) struct ReportArgs {
     #[arg(long)]
     bracket: bool,
     /// Time every render this many times in all (in rounds over all renders) and keep the
-    /// fastest: on a noisy machine single timings move by tens of per cent.
+    /// fastest: single timings vary with what else the machine is doing.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
     #[command(flatten)]
@@ -61,7 +64,6 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         None if args.methods.contains(&Method::Product) => Method::Product,
         None => args.methods[0],
     };
-    use host_std::report;
     let loaded = load_scene(&args.scene, args.sampling.size())?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
@@ -70,7 +72,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     // Everything that reads input comes first: bad input leaves no output folder behind.
     let given = match &args.reference {
         Some(path) => {
-            let image = host_std::env_io::load(path)?;
+            let image = host_std::light::image_file::load(path)?;
             if (image.width, image.height) != (w, h) {
                 bail!("{}: the reference is {}×{}, the render {}×{}", path.display(), image.width, image.height, w, h);
             }
@@ -92,7 +94,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let base = Settings {
         method: Method::Product,
         spp: 1,
-        shading_points: args.sampling.shading_points.unwrap_or(crate::DEFAULT_SHADING_POINTS) as usize,
+        shading_points: args.sampling.shading_points.unwrap_or(DEFAULT_SHADING_POINTS) as usize,
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: false,
@@ -100,27 +102,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     };
     let (reference, note) = match given {
         Some(given) => given,
-        None => {
-            let spp = args.reference_spp as usize;
-            let settings = Settings {
-                method: args.reference_method,
-                spp,
-                shading_points: report::shading_points_per_pixel(spp, 16, args.samples_per_point.map(|v| v as usize)),
-                seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
-                progress: true,
-                ..base
-            };
-            eprintln!("ppis: rendering the reference ({}, {spp} spp)", args.reference_method);
-            let image = pool.install(|| render::render(&scene, &bvh, hierarchy.as_ref(), &settings));
-            output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
-            (
-                image.pixels,
-                format!(
-                    "{} at {spp} spp (reference.exr, {:.1} s), independent seed",
-                    args.reference_method, image.render_seconds
-                ),
-            )
-        }
+        None => render_reference(&args, &pool, &scene, &bvh, hierarchy.as_ref(), &base)?,
     };
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
     let bracket = args.bracket.then_some(base_method);
@@ -151,16 +133,61 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             },
         )
     });
-    output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(&measurements))?;
+    write_outputs(&args, &scene.name, &measurements, base_method, threads, &note)?;
+    Ok(())
+}
+
+/// Renders the reference (`--reference-method` at `--reference-spp`, an independent seed),
+/// writes it as reference.exr, and returns it with the report's note about it.
+fn render_reference(
+    args: &ReportArgs,
+    pool: &rayon::ThreadPool,
+    scene: &Scene,
+    bvh: &Bvh,
+    hierarchy: Option<&EnvHierarchy<'_>>,
+    base: &Settings,
+) -> Result<(Vec<[f32; 3]>, String)> {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let spp = args.reference_spp as usize;
+    let settings = Settings {
+        method: args.reference_method,
+        spp,
+        shading_points: report::shading_points_per_pixel(spp, 16, args.samples_per_point.map(|v| v as usize)),
+        seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
+        progress: true,
+        ..*base
+    };
+    eprintln!("ppis: rendering the reference ({}, {spp} spp)", args.reference_method);
+    let image = pool.install(|| plan::render(scene, bvh, hierarchy, &settings));
+    output::write_exr(&args.out.join("reference.exr"), w, h, &image.pixels)?;
+    Ok((
+        image.pixels,
+        format!(
+            "{} at {spp} spp (reference.exr, {:.1} s), independent seed",
+            args.reference_method, image.render_seconds
+        ),
+    ))
+}
+
+/// Writes the CSV, report.md and the plot into `--out`.
+fn write_outputs(
+    args: &ReportArgs,
+    scene: &str,
+    measurements: &[report::Measurement],
+    base_method: Method,
+    threads: usize,
+    note: &str,
+) -> Result<()> {
+    output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(measurements))?;
     output::write_text(
         &args.out.join("report.md"),
-        &report::markdown(&scene.name, &measurements, base_method, threads, &timing_note(&note, args.repeat)),
+        &report::markdown(scene, measurements, base_method, threads, &timing_note(note, args.repeat)),
     )?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
         &args.out.join("error_vs_time.png"),
-        &format!("{}: relMSE against render time ({threads} threads)", scene.name),
-        &measurements,
+        &format!("{scene}: relMSE against render time ({threads} threads)"),
+        measurements,
     )
     .map_err(|e| anyhow::anyhow!("{}: cannot draw the plot: {e}", args.out.display()))?;
     eprintln!(

@@ -2,7 +2,7 @@
 //! Lambert, glossy GGX, very sharp GGX, car paint — on a grey ground plane under the built-in
 //! sky with its sun.
 
-use crate::environment::{EnvSource, Placement};
+use crate::light::environment::{EnvSource, Placement};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
@@ -10,6 +10,7 @@ use sampler_core::glam::Vec3;
 /// Equal-area resolution of the built-in sky: 1024² keeps the 0.53° sun at ~6 texels.
 pub const SKY_LEVEL: u32 = 10;
 
+/// The built-in scene.
 pub fn scene() -> Scene {
     let material = |bsdf| Material::new(bsdf, false);
     let materials = vec![

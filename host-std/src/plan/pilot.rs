@@ -1,69 +1,75 @@
-//! `auto`'s choice of method per material, checked on the scene: a pilot render of a few of
+//! `auto`'s choice of strategy per material, checked on the scene: a pilot render of a few of
 //! each material's pixels with every candidate plan, twice with independent samples, at the
 //! render's own spp and shading points, scored by variance × cost — the variance from the
 //! pixel pairs' squared differences (relMSE's normalisation), the cost a fixed per-sample
-//! weight per plan measured once (`PLANS`), not the pilot's clock, so that the choice, and the
-//! image, depend only on the scene, the settings and the seed. The pilot's samples are
-//! independent of the render's (their own seeds), so choosing from them keeps every pixel's
-//! estimate unbiased.
+//! weight per plan ([`PLANS`]), not the pilot's clock, so that the choice, and the image,
+//! depend only on the scene, the settings and the seed. The pilot's samples are independent of
+//! the render's (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
 //!
-//! The pilot overrides the rule-based plan (`Method::for_material`, measured on five scenes)
-//! only when another plan scores [`OVERRIDE_MARGIN`]× better: a variance estimate from tens
-//! of pixel pairs is dominated by its few brightest pixels and is good to tens of per cent
-//! at best (seeds 0–2 on s2: product-MIS 3:1 against MIS on the α = 0.1 sphere scored 54 /
-//! 45, 13 / 25 and 15 / 22), while an env map whose light is unlike those five scenes' makes
-//! a plan win by several times (studio's diffuse walls: env sampling 3.7× ahead of the rule's
-//! MIS 3:1).
+//! The pilot overrides the rules' plan ([`auto_strategy`](crate::plan::rules::auto_strategy))
+//! only when another plan scores [`OVERRIDE_MARGIN`]× better: a variance estimate from tens of
+//! pixel pairs is dominated by its few brightest pixels and is good to tens of per cent at
+//! best, while an env map whose light is unlike the scenes the rules were set on makes a plan
+//! win by several times.
 //!
 //! A pilot cannot see rare large samples it did not draw: BRDF sampling under a sun looks quiet
 //! in a pilot that never hit the sun, and then leaves fireflies across the image. So only plans
 //! whose sample weights are bounded for the material and lighting compete ([`eligible`]): the
 //! MIS plans always (each sample is weighted against a technique that covers the light), env
 //! sampling where B·cos is bounded (its weight is B·cos × the map's total power), BRDF sampling
-//! where the lighting is (its weight is L × B·cos/p). And each MIS method competes with the
+//! where the lighting is (its weight is L × B·cos/p). And each MIS strategy competes with the
 //! rules' split only: the splits differ by less than the pilot can tell apart
 //! ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the others.
 
-use crate::bvh::Bvh;
-use crate::camera::Camera;
-use crate::integrator::{Method, SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
-use crate::render::{MaterialPlan, Scratch, Settings, pixel};
-use crate::scene::{Bsdf, Scene};
+use crate::plan::method::strategy_name;
+use crate::plan::rules::{SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
+use crate::render::pixel::{Scratch, pixel};
+use crate::render::strategy::{MaterialPlan, Strategy};
+use crate::render::{Context, Options};
+use crate::scene::Bsdf;
 use rayon::prelude::*;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::points::permutation_element;
 use sampler_core::rng::hash_combine;
 
-/// The candidates: method, share of the first technique (see `MaterialPlan::split`), and the
-/// time per visibility sample relative to MIS's pairs (`ppis render --method M --spp 1024
-/// --shading-points 64 --threads 1`, 128², mean over the default scene, s1, s2, s3 and studio
-/// of the faster of two runs: env 1.09–1.30, BRDF 0.67–0.77, product-MIS 1.45–1.84; the 3:1
-/// splits from those per-sample costs and the measured 1.15× of product-MIS at 3:1;
-/// docs/perf.md, session 9).
-pub const PLANS: [(Method, f64, f64); 6] = [
-    (Method::Env, 0.5, 1.15),
-    (Method::Brdf, 0.5, 0.72),
-    (Method::Mis, 0.5, 1.0),
-    (Method::Mis, 0.75, 1.04),
-    (Method::ProductMis, 0.5, 1.68),
-    (Method::ProductMis, 0.75, 1.93),
+/// A plan the pilot may choose, with its cost.
+#[derive(Clone, Copy, Debug)]
+pub struct Candidate {
+    /// The strategy.
+    pub strategy: Strategy,
+    /// Time per visibility sample relative to MIS's pairs, measured once over the benchmark
+    /// scenes (docs/perf.md, "Equal time against Mitsuba 3").
+    pub cost: f64,
+}
+
+/// The candidates.
+pub const PLANS: [Candidate; 6] = [
+    Candidate { strategy: Strategy::Env, cost: 1.15 },
+    Candidate { strategy: Strategy::Brdf, cost: 0.72 },
+    Candidate { strategy: Strategy::Mis { env_share: 0.5 }, cost: 1.0 },
+    Candidate { strategy: Strategy::Mis { env_share: 0.75 }, cost: 1.04 },
+    Candidate { strategy: Strategy::ProductMis { product_share: 0.5 }, cost: 1.68 },
+    Candidate { strategy: Strategy::ProductMis { product_share: 0.75 }, cost: 1.93 },
 ];
 
 /// How much better than the rule's plan another must score to replace it.
 pub const OVERRIDE_MARGIN: f64 = 2.0;
 
 /// Share of the render's work (in MIS pixels, the candidates weighted by their cost) the pilot
-/// aims to spend, both repetitions of every candidate, and the most it may spend: with fewer
-/// than [`MIN_PIXELS`] per material within that, the rules decide alone. (At 4% of the pixels
-/// and every split a candidate, the default scene, whose plans the pilot keeps, measured 15%
-/// behind MIS at equal time: its error falls faster than 1/t there.)
-const PILOT_SHARE: f64 = 0.02;
-const MAX_PILOT_SHARE: f64 = 0.05;
+/// aims to spend, both repetitions of every candidate. A larger pilot costs more than its
+/// better choices gain where the rules' plan stands.
+pub const PILOT_SHARE: f64 = 0.02;
 
-/// Pilot pixels per material: fewer and the scores are noise (8 pixels on a 48² studio: the
-/// diffuse floor's plan changed with every seed), more and the pilot costs too much.
-const MIN_PIXELS: usize = 32;
-const MAX_PIXELS: usize = 64;
+/// The most the pilot may spend: with fewer than [`MIN_PIXELS`] per material within that, the
+/// rules decide alone.
+pub const MAX_PILOT_SHARE: f64 = 0.05;
+
+/// Pilot pixels per material, at least: fewer and the scores are noise (the plan changes with
+/// the seed).
+pub const MIN_PIXELS: usize = 32;
+
+/// Pilot pixels per material, at most: more and the pilot costs too much.
+pub const MAX_PIXELS: usize = 64;
 
 /// Largest BRDF × cos peak (per steradian) for which env-only sampling may compete: GGX α ≥
 /// 0.14, Phong n ≤ 98 (Lambert: 1/π).
@@ -75,15 +81,17 @@ const MAX_SCANNED: usize = 1 << 14;
 /// What the pilot measured for one material.
 #[derive(Clone, Debug)]
 pub struct PilotResult {
+    /// The material.
     pub material: usize,
     /// Pilot pixels (each rendered twice per candidate).
     pub pixels: usize,
-    /// Per candidate of [`PLANS`]: relative variance × cost (`None`: not trusted — its pilot
-    /// mean disagrees with the others', the sign of rare large samples it missed).
+    /// Per candidate of [`PLANS`]: relative variance × cost (`None`: not measured or not
+    /// trusted — its pilot mean disagrees with the others', the sign of rare large samples it
+    /// missed).
     pub scores: Vec<Option<f64>>,
     /// The index into [`PLANS`] chosen.
     pub chosen: usize,
-    /// The rule's plan (`Method::for_material`), if it is one of [`PLANS`].
+    /// The rules' plan, if it is one of [`PLANS`].
     pub rule: Option<usize>,
 }
 
@@ -91,9 +99,8 @@ pub struct PilotResult {
 /// (`EnvHierarchy::peak(5)`): see the module's note.
 #[must_use]
 pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
-    let (method, split, _) = PLANS[c];
-    match method {
-        Method::Env => {
+    match PLANS[c].strategy {
+        Strategy::Env => {
             let peak = match bsdf {
                 Bsdf::Diffuse(_) => std::f32::consts::FRAC_1_PI,
                 Bsdf::Conductor(g) => 1.0 / (std::f32::consts::PI * g.ggx.alpha() * g.ggx.alpha()),
@@ -102,36 +109,62 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
             };
             peak <= ENV_ONLY_LOBE_PEAK
         }
-        Method::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
-        Method::Mis => split == auto_env_share(bsdf, env_peak),
-        Method::ProductMis => split == product_share(bsdf, env_peak),
-        _ => false,
+        Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
+        Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak),
+        Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
+        Strategy::Product | Strategy::Wavelet | Strategy::Ris | Strategy::TwoStage => false,
     }
 }
 
-/// Runs the pilot and returns the plans (one per material; `defaults` where a material has too
-/// few pixels to measure) and what was measured.
-#[allow(clippy::too_many_arguments)]
+/// One material's pilot: its candidates' pixel pairs, per candidate (index into [`PLANS`]).
+type Measured = Vec<(usize, Vec<[[f64; 3]; 2]>)>;
+
+/// Runs the pilot on the render `ctx` (whose plans are the rules') and returns the plans (one
+/// per material; the rules' where a material has too few pixels to measure) and what was
+/// measured.
 pub(crate) fn choose(
-    scene: &Scene,
-    bvh: &Bvh,
+    ctx: &Context<'_, '_>,
     env: &EnvHierarchy<'_>,
-    camera: &Camera,
-    settings: &Settings,
-    defaults: &[MaterialPlan],
     env_peak: f32,
 ) -> (Vec<MaterialPlan>, Vec<PilotResult>) {
+    let defaults = ctx.plans;
+    let Some((found, tasks)) = pilot_tasks(ctx, env_peak) else { return (defaults.to_vec(), Vec::new()) };
+    let mut measured: Vec<Measured> = vec![Vec::new(); found.len()];
+    for ((m, c), v) in tasks.iter().zip(measure(ctx, env, &found, &tasks)) {
+        measured[*m].push((*c, v));
+    }
+    let mut plans = defaults.to_vec();
+    let mut results = Vec::new();
+    for (m, pixels) in found.iter().enumerate() {
+        if measured[m].is_empty() {
+            continue;
+        }
+        let pairs: Vec<(usize, &[[[f64; 3]; 2]])> = measured[m].iter().map(|(c, v)| (*c, v.as_slice())).collect();
+        let scores = score(&pairs, pixels.len());
+        let rule = PLANS.iter().position(|p| p.strategy == defaults[m].strategy);
+        let Some(chosen) = decide(&scores, rule) else { continue };
+        plans[m] = MaterialPlan { strategy: PLANS[chosen].strategy, ..defaults[m] };
+        results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
+    }
+    (plans, results)
+}
+
+/// Each material's pilot pixels, and every (material, candidate) to measure; `None` when the
+/// pilot would cost more than [`MAX_PILOT_SHARE`] of the render.
+#[allow(clippy::type_complexity)]
+fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, usize)>>, Vec<(usize, usize)>)> {
+    let camera = ctx.camera;
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let materials = scene.materials.len();
+    let materials = ctx.scene.materials.len();
     // Each material's pixels, in a fixed pseudo-random order over the image.
     let mut found: Vec<Vec<(usize, usize)>> = vec![Vec::new(); materials];
     let n = w * h;
-    let order_seed = hash_combine(settings.seed, 0x9170) as u32;
+    let order_seed = hash_combine(ctx.options.seed, 0x9170) as u32;
     for k in 0..n.min(MAX_SCANNED) {
         let i = permutation_element(k as u32, n as u32, order_seed) as usize;
         let (x, y) = (i % w, i / w);
         let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
-        if let Some(hit) = bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY) {
+        if let Some(hit) = ctx.bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY) {
             found[hit.material as usize].push((x, y));
         }
     }
@@ -140,35 +173,45 @@ pub(crate) fn choose(
     let tasks: Vec<(usize, usize)> = (0..materials)
         .filter(|&m| found[m].len() >= MIN_PIXELS)
         .flat_map(|m| {
-            (0..PLANS.len()).filter(move |&c| eligible(c, &scene.materials[m].bsdf, env_peak)).map(move |c| (m, c))
+            let bsdf = &ctx.scene.materials[m].bsdf;
+            (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))
         })
         .collect();
-    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].2).sum();
+    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost).sum();
     let per_material = ((PILOT_SHARE * n as f64 / cost_per_pixel.max(1.0)) as usize).clamp(MIN_PIXELS, MAX_PIXELS);
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
-        return (defaults.to_vec(), Vec::new());
+        return None;
     }
     for f in &mut found {
         f.truncate(per_material);
     }
-    // Every task renders its pixels twice, in parallel; the values come back in a fixed order
-    // whatever the thread count (truncating kept every measured material at ≥ MIN_PIXELS).
-    // One job per (task, pixel), so that the threads share the work evenly.
+    Some((found, tasks))
+}
+
+/// Renders every task's pixels twice, in parallel, and returns per task its pixel pairs, in a
+/// fixed order whatever the thread count (truncating kept every measured material at ≥
+/// [`MIN_PIXELS`]). One job per (task, pixel), so that the threads share the work evenly.
+fn measure(
+    ctx: &Context<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    found: &[Vec<(usize, usize)>],
+    tasks: &[(usize, usize)],
+) -> Vec<Vec<[[f64; 3]; 2]>> {
     let jobs: Vec<(usize, (usize, usize))> =
         tasks.iter().enumerate().flat_map(|(t, &(m, _))| found[m].iter().map(move |&p| (t, p))).collect();
     let rendered: Vec<[[f64; 3]; 2]> = jobs
         .par_iter()
         .map(|&(t, (x, y))| {
             let (m, c) = tasks[t];
-            let mut plans: Vec<MaterialPlan> = defaults.to_vec();
-            let (method, split, _) = PLANS[c];
-            plans[m] = MaterialPlan { method, split, ..defaults[m] };
+            let mut plans: Vec<MaterialPlan> = ctx.plans.to_vec();
+            plans[m] = MaterialPlan { strategy: PLANS[c].strategy, ..ctx.plans[m] };
             [0u64, 1].map(|rep| {
-                let s = Settings { seed: hash_combine(settings.seed, 0x9170_0000 + rep), ..*settings };
+                let options = Options { seed: hash_combine(ctx.options.seed, 0x9170_0000 + rep), ..*ctx.options };
+                let job = Context { env: Some(env), options: &options, plans: &plans, ..*ctx };
                 // A fresh scratch: no product sampler carried over from another pixel or
                 // repetition (that would correlate the pair).
-                let mut scratch = Scratch::new(materials, s.shading_points);
-                pixel(scene, bvh, Some(env), None, camera, &s, &plans, x, y, &mut scratch).map(f64::from)
+                let mut scratch = Scratch::new(plans.len(), options.shading_points);
+                pixel(&job, x, y, &mut scratch).map(f64::from)
             })
         })
         .collect();
@@ -176,22 +219,7 @@ pub(crate) fn choose(
     for ((t, _), v) in jobs.iter().zip(rendered) {
         values[*t].push(v);
     }
-    let mut plans = defaults.to_vec();
-    let mut results = Vec::new();
-    for (m, pixels) in found.iter().enumerate() {
-        let measured: Vec<(usize, &[[[f64; 3]; 2]])> =
-            tasks.iter().zip(&values).filter(|(t, _)| t.0 == m).map(|(t, v)| (t.1, v.as_slice())).collect();
-        if measured.is_empty() {
-            continue;
-        }
-        let scores = score(&measured, pixels.len());
-        let rule = PLANS.iter().position(|p| p.0 == defaults[m].method && p.1 == defaults[m].split);
-        let Some(chosen) = decide(&scores, rule) else { continue };
-        let (method, split, _) = PLANS[chosen];
-        plans[m] = MaterialPlan { method, split, ..defaults[m] };
-        results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
-    }
-    (plans, results)
+    values
 }
 
 /// The rule's plan unless another scores [`OVERRIDE_MARGIN`]× better (or the rule's was not
@@ -229,7 +257,7 @@ fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize) -> Vec<Option<f6
     let median = sorted[sorted.len() / 2];
     let mut scores = vec![None; PLANS.len()];
     for ((v, &total), &(c, _)) in values.iter().zip(&totals).zip(measured) {
-        let cost = PLANS[c].2;
+        let cost = PLANS[c].cost;
         scores[c] = {
             let (mut rel, mut spread) = (0.0, 0.0);
             for (pair, r) in v.iter().zip(&reference) {
@@ -253,12 +281,7 @@ fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize) -> Vec<Option<f6
 /// ("mis 3:1" — three env samples to one BRDF sample; "product-mis 3:1").
 #[must_use]
 pub fn plan_name(candidate: usize) -> String {
-    let (method, split, _) = PLANS[candidate];
-    if split == 0.5 {
-        method.name().to_string()
-    } else {
-        format!("{} {}:{}", method.name(), (split * 4.0).round(), ((1.0 - split) * 4.0).round())
-    }
+    strategy_name(PLANS[candidate].strategy)
 }
 
 #[cfg(test)]
@@ -296,7 +319,7 @@ mod tests {
         // A value's variance d²/2 over relMSE's r² + 0.01, r the mean of all candidates, times
         // the plan's cost.
         let r = (5.0 + 0.02) / 6.0;
-        let expected = 0.1f64.powi(2) / 2.0 / (r * r + 0.01) * PLANS[3].2;
+        let expected = 0.1f64.powi(2) / 2.0 / (r * r + 0.01) * PLANS[3].cost;
         assert!((s[3] / expected - 1.0).abs() < 1e-12, "{} vs {expected}", s[3]);
     }
 

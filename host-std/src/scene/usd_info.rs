@@ -66,7 +66,10 @@ pub fn print_import(u: &host_usd::UsdScene) {
             s.camera.as_ref().map_or(String::new(), |c| format!(", camera {c}"))
         ),
         None => {
-            println!("  render settings: none ({} wide, the camera's aperture aspect)", crate::usd_scene::DEFAULT_WIDTH)
+            println!(
+                "  render settings: none ({} wide, the camera's aperture aspect)",
+                crate::scene::usd::DEFAULT_WIDTH
+            )
         }
     }
 }

@@ -17,8 +17,11 @@ pub struct Sky {
     pub sun_radius: f32,
     /// Radiance of the sun disk.
     pub sun_radiance: Vec3,
+    /// Sky radiance at the zenith.
     pub zenith: Vec3,
+    /// Sky radiance at the horizon.
     pub horizon: Vec3,
+    /// Radiance of the ground below the horizon.
     pub ground: Vec3,
 }
 

@@ -4,16 +4,41 @@
 use sampler_core::glam::Vec3;
 use std::path::{Path, PathBuf};
 
+/// Why a mesh cannot be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The file cannot be read.
     #[error("{path}: cannot read the mesh: {error}")]
-    Io { path: PathBuf, error: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        error: std::io::Error,
+    },
+    /// The file is not valid in its format.
     #[error("{path}: not a readable {format} mesh: {message}")]
-    Decode { path: PathBuf, format: &'static str, message: String },
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// The format it was read as.
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file's extension names no format this build reads.
     #[error("{path}: unsupported mesh format (expected .obj or .ply)")]
-    Unsupported { path: PathBuf },
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file is well-formed but describes something invalid.
     #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 /// Positions and triangles of a mesh file.
@@ -54,5 +79,9 @@ fn load_obj(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), Mes
 }
 
 fn load_ply(path: &Path, bytes: &[u8]) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), MeshError> {
-    crate::ply::parse(bytes).map_err(|message| MeshError::Decode { path: path.to_owned(), format: "PLY", message })
+    crate::scene::ply::parse(bytes).map_err(|message| MeshError::Decode {
+        path: path.to_owned(),
+        format: "PLY",
+        message,
+    })
 }

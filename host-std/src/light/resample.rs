@@ -7,7 +7,7 @@
 //! square lives in the same local frame: texel (x, y) is the direction `square_to_sphere` gives
 //! for its points, x along u, y along v of the square.
 
-use crate::env_io::RgbImage;
+use crate::light::image_file::RgbImage;
 use rayon::prelude::*;
 use sampler_core::glam::{Vec2, Vec3};
 use sampler_core::mapping::square_to_sphere;
@@ -27,8 +27,9 @@ pub fn direction_to_latlong_uv(d: Vec3) -> (f64, f64) {
 }
 
 /// atan2(y, x) within 2 ulp of libm's (Cephes' rational atan on [0, 0.66], the rest by
-/// tan(π/4 + a) = (1 + t)/(1 − t) and symmetry); exact on the axes and diagonals. glibc's
-/// correctly rounded atan2 was 39% of resampling a 4096×2048 map; this is 1.6× faster.
+/// tan(π/4 + a) = (1 + t)/(1 − t) and symmetry); exact on the axes and diagonals. Resampling
+/// calls it for every point of every texel, where a correctly rounded atan2 is a large share of
+/// the time.
 #[inline]
 pub fn atan2(y: f64, x: f64) -> f64 {
     const P: [f64; 5] = [
@@ -121,11 +122,11 @@ const BAND_ROWS: usize = 16;
 /// Resamples a lat-long image into a `2^level` equal-area square, conserving energy.
 ///
 /// A bright source (the sun) can carry most of a map's energy on a few pixels that cover a few
-/// texels; any point-sampled *gather* quantises their coverage (a 1-pixel sun measured −2.5% of
+/// texels; any point-sampled *gather* quantises their coverage (a 1-pixel sun loses percents of
 /// the map's energy). So each source pixel is split at T = 64 × the map's mean luminance:
 /// * the part up to T is gathered: every texel is the mean of `ss × ss` stratified points, and
-///   of 4 × 4 where those and the texel's corners disagree by more than 25% (16 × 16 at 10%
-///   cost 11× the time on the forest map for an energy error of 6e-6 instead of 6e-5);
+///   of 4 × 4 where those and the texel's corners disagree by more than 25% (a finer gather
+///   costs many times the time for an energy error that is already small);
 /// * the excess above T, present on at most 1/64 of the sphere, is splatted: 8 × 8 points per
 ///   pixel, uniform in solid angle, each carrying 1/64 of the pixel's excess energy into the
 ///   texel it lands in — energy conserved exactly, whatever the coverage.
@@ -159,7 +160,7 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     };
     let mut out = vec![[0.0f32; 3]; n * n];
     // Bands of rows, each with its (rows + 1) × (n + 1) texel corners looked up once and shared
-    // by the four texels that meet there (four lookups per texel before).
+    // by the four texels that meet there (instead of four lookups per texel).
     let band = BAND_ROWS.min(n);
     out.par_chunks_mut(n * band).enumerate().for_each(|(b, rows)| {
         let y0 = b * band;
@@ -179,7 +180,14 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
             *texel = mean.map(|a| a as f32);
         }
     });
-    // Splat the excess of the bright pixels.
+    splat_excess(image, n, &clamped, &mut out);
+    out
+}
+
+/// Adds the radiance that `clamped` cut from the source's bright pixels to the equal-area map
+/// `out` (n × n), each pixel's excess spread over 8 × 8 directions uniform in its solid angle:
+/// the map keeps the source's energy without the clamp's outliers in single texels' averages.
+fn splat_excess(image: &RgbImage, n: usize, clamped: &impl Fn([f32; 3]) -> [f32; 3], out: &mut [[f32; 3]]) {
     const SPLAT: usize = 8;
     let texel_solid_angle = 4.0 * PI / (n * n) as f64;
     let (w, h) = (image.width, image.height);
@@ -221,7 +229,6 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
             }
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -1,24 +1,44 @@
-//! The JSON scene format of `../shared/docs/scene-format.md` (copied in docs/scene-format.md):
+//! The JSON scene format of docs/scene-format.md:
 //! camera, environment, spheres, rectangles and meshes with diffuse, rough-conductor, Phong and
 //! car-paint materials. Unknown fields are errors: a misspelt key must not silently render
 //! something else.
 
-use crate::environment::{EnvSource, Placement};
-use crate::mesh;
+use crate::light::environment::{EnvSource, Placement};
+use crate::scene::mesh;
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Mat4, Vec3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// Why a JSON scene cannot be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The file cannot be read.
     #[error("{path}: cannot read the scene: {error}")]
-    Io { path: PathBuf, error: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        error: std::io::Error,
+    },
+    /// The file is not valid scene JSON.
     #[error("{path}: invalid scene JSON: {message}")]
-    Json { path: PathBuf, message: String },
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file is well-formed but describes something invalid.
     #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A mesh the scene names cannot be loaded.
     #[error(transparent)]
     Mesh(#[from] mesh::MeshError),
 }

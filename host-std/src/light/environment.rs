@@ -1,9 +1,9 @@
 //! The scene's environment light, owned by the host: the equal-area RGB map and its importance
 //! pyramid, built once; `sampler-core` borrows both through an `EnvHierarchy`.
 
-use crate::env_io::{self, LoadError, RgbImage};
-use crate::resample;
-use crate::sky::Sky;
+use crate::light::image_file::{self, LoadError, RgbImage};
+use crate::light::resample;
+use crate::light::sky::Sky;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::glam::Mat3;
 use std::path::{Path, PathBuf};
@@ -13,15 +13,28 @@ use std::time::Instant;
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvSource {
     /// The built-in procedural sky at `2^level`.
-    Sky { level: u32 },
+    Sky {
+        /// Equal-area resolution: 2^level texels square.
+        level: u32,
+    },
     /// An image file: lat-long (2:1) or an equal-area square.
     File(PathBuf),
     /// An image already in memory (e.g. read from inside a usdz package), named for messages;
     /// `latlong` reads it as lat-long whatever its shape (a USD dome texture is lat-long even
     /// when square).
-    Bytes { name: PathBuf, bytes: std::sync::Arc<Vec<u8>>, latlong: bool },
+    Bytes {
+        /// The name messages give it.
+        name: PathBuf,
+        /// The encoded image.
+        bytes: std::sync::Arc<Vec<u8>>,
+        /// Read as lat-long whatever its shape.
+        latlong: bool,
+    },
     /// The same radiance from every direction (a DomeLight without a texture).
-    Constant { level: u32 },
+    Constant {
+        /// Equal-area resolution: 2^level texels square.
+        level: u32,
+    },
 }
 
 /// How an environment is placed: radiance scale and tint, and rotation: d_world =
@@ -29,9 +42,13 @@ pub enum EnvSource {
 /// factor; a USD DomeLight's frame is `rotation`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
+    /// Radiance scale.
     pub scale: f32,
+    /// Radiance tint per channel.
     pub tint: [f32; 3],
+    /// Rotation about +Y in degrees, applied after `rotation`.
     pub rotate_y_deg: f32,
+    /// The map's frame in the world.
     pub rotation: Mat3,
 }
 
@@ -44,15 +61,23 @@ impl Default for Placement {
 /// Facts about a built environment, for the summary and the stats file.
 #[derive(Clone, Debug, Default)]
 pub struct EnvStats {
+    /// Where the map came from, for messages.
     pub source: String,
+    /// The source image's width and height.
     pub source_size: (usize, usize),
+    /// Equal-area resolution: 2^level texels square.
     pub level: u32,
+    /// Source texels that were NaN, infinite or negative and were set to 0.
     pub sanitized: usize,
-    /// Mean radiance over the sphere: of the source, and of the equal-area map.
+    /// Mean radiance over the sphere of the source.
     pub source_mean: [f64; 3],
+    /// Mean radiance over the sphere of the equal-area map.
     pub map_mean: [f64; 3],
+    /// Seconds reading the source.
     pub load_seconds: f64,
+    /// Seconds resampling and building the pyramid.
     pub build_seconds: f64,
+    /// Bytes of the map and its pyramid.
     pub bytes: usize,
 }
 
@@ -61,19 +86,35 @@ type EqualArea = (Vec<[f32; 3]>, u32, [f64; 3]);
 
 /// An environment map ready for sampling.
 pub struct Environment {
+    /// Equal-area resolution: 2^level texels square.
     pub level: u32,
+    /// The equal-area map's linear RGB texels, row by row.
     pub rgb: Vec<[f32; 3]>,
+    /// The importance pyramid over the map's luminance (sampler-core's layout).
     pub pyramid: Vec<f32>,
+    /// Directions of the map's frame into the world's.
     pub map_to_world: Mat3,
+    /// What building it found and took.
     pub stats: EnvStats,
 }
 
+/// Why an environment cannot be built.
 #[derive(Debug, thiserror::Error)]
 pub enum EnvError {
+    /// The image cannot be loaded.
     #[error(transparent)]
     Load(#[from] LoadError),
+    /// The image's shape is neither lat-long nor equal-area.
     #[error("{path}: a {width}×{height} image is neither a 2:1 lat-long map nor a square power-of-two equal-area map")]
-    Layout { path: PathBuf, width: usize, height: usize },
+    Layout {
+        /// The file.
+        path: PathBuf,
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// sampler-core rejects the map.
     #[error("{0}")]
     Core(#[from] sampler_core::env::EnvError),
 }
@@ -104,8 +145,8 @@ impl Environment {
             }
             EnvSource::File(_) | EnvSource::Bytes { .. } => {
                 let (path, image, latlong) = match source {
-                    EnvSource::File(path) => (path, env_io::load(path)?, false),
-                    EnvSource::Bytes { name, bytes, latlong } => (name, env_io::load_bytes(name, bytes)?, *latlong),
+                    EnvSource::File(path) => (path, image_file::load(path)?, false),
+                    EnvSource::Bytes { name, bytes, latlong } => (name, image_file::load_bytes(name, bytes)?, *latlong),
                     _ => unreachable!("matched above"),
                 };
                 let load_seconds = t0.elapsed().as_secs_f64();

@@ -1,43 +1,60 @@
-//! The renderer's scene: camera, shapes with materials, and an optional environment light.
-//! Filled by the embedded default scene, the JSON reader, and (later) the USD importer.
+//! The scene model: camera, shapes with materials, and an optional environment light, as every
+//! loader fills it (the built-in scene, the JSON reader, the USD importer).
 
-use crate::environment::{EnvSource, Placement};
+use crate::light::environment::{EnvSource, Placement};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Vec2, Vec3};
 
 /// A pinhole camera, the scene format's exact convention (see `camera.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraSpec {
+    /// Eye position.
     pub origin: Vec3,
+    /// The point looked at.
     pub target: Vec3,
+    /// Up direction (need not be orthogonal to the view).
     pub up: Vec3,
+    /// Vertical field of view in degrees.
     pub fov_y_deg: f32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Pixel width over pixel height (1 for square pixels).
     pub pixel_aspect: f32,
+    /// Distance below which primary hits are ignored.
     pub near_clip: f32,
 }
 
 /// Geometry of one shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
+    /// A sphere.
     Sphere {
+        /// Centre.
         center: Vec3,
+        /// Radius.
         radius: f32,
     },
     /// The points p0 + s·e1 + t·e2, s, t ∈ [0, 1]; front normal normalize(e1 × e2).
     Rectangle {
+        /// A corner.
         p0: Vec3,
+        /// The first edge from `p0`.
         e1: Vec3,
+        /// The second edge from `p0`.
         e2: Vec3,
     },
     /// Triangles (counter-clockwise front faces); optional per-corner shading normals
     /// (empty: face normals) and texture coordinates (empty: none).
     Mesh {
+        /// Vertex positions.
         positions: Vec<Vec3>,
+        /// Vertex indices per triangle.
         triangles: Vec<[u32; 3]>,
+        /// Per triangle, its corners' shading normals (empty: face normals).
         normals: Vec<[Vec3; 3]>,
+        /// Per triangle, its corners' texture coordinates (empty: none).
         uvs: Vec<[Vec2; 3]>,
     },
 }
@@ -46,13 +63,16 @@ pub enum Shape {
 /// surface with textures (then `bsdf` is its value at the textures' means).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// The BRDF (where textured, its value at the textures' means).
     pub bsdf: Bsdf,
     /// Seen from the back, a one-sided surface reflects nothing.
     pub twosided: bool,
+    /// Textures varying the BRDF over the surface.
     pub texture: Option<TextureHandle>,
 }
 
 impl Material {
+    /// An untextured material.
     pub fn new(bsdf: Bsdf, twosided: bool) -> Self {
         Self { bsdf, twosided, texture: None }
     }
@@ -77,13 +97,18 @@ impl PartialEq for TextureHandle {
 /// The built-in BRDFs, by value (enum dispatch; each is a few floats).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Bsdf {
+    /// Lambertian diffuse.
     Diffuse(Lambert),
+    /// GGX rough conductor.
     Conductor(RoughConductor),
+    /// Modified Phong.
     Phong(Phong),
+    /// Car paint: a clear coat over flakes over a diffuse base.
     CarPaint(CarPaint),
 }
 
 impl Bsdf {
+    /// The BRDF behind the enum, for the core's estimators.
     pub fn as_brdf(&self) -> &dyn Brdf {
         match self {
             Bsdf::Diffuse(b) => b,
@@ -130,17 +155,24 @@ impl Bsdf {
 /// One shape and the index of its material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
+    /// Its geometry.
     pub shape: Shape,
+    /// Index into the scene's materials.
     pub material: usize,
 }
 
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
+    /// For messages and reports.
     pub name: String,
+    /// The camera.
     pub camera: CameraSpec,
+    /// Every shape.
     pub objects: Vec<Object>,
+    /// The materials objects index.
     pub materials: Vec<Material>,
+    /// The environment light, if any.
     pub env: Option<(EnvSource, Placement)>,
     /// Camera rays that miss return 0 instead of the environment.
     pub hide_emitters: bool,

@@ -3,10 +3,10 @@
 //! roughness) are decoded and looked up at each hit's texture coordinates; every skip is
 //! reported.
 
-use crate::env_io;
-use crate::environment::{EnvSource, Placement};
+use crate::light::environment::{EnvSource, Placement};
+use crate::light::image_file;
+use crate::scene::texture::{ImageTexture, Wrap};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
-use crate::texture::{ImageTexture, Wrap};
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::{Mat3, Vec2, Vec3};
@@ -19,7 +19,9 @@ pub const DEFAULT_WIDTH: u32 = 640;
 
 /// A converted scene and the notes to show the user (skips, texture reductions).
 pub struct Converted {
+    /// The renderer's scene.
     pub scene: Scene,
+    /// What the import left out or reduced, one line each.
     pub notes: Vec<String>,
     /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
     pub usd: UsdScene,
@@ -32,8 +34,9 @@ pub struct Options {
     pub camera: Option<String>,
     /// The RenderSettings prim (default: the layer's `renderSettingsPrimPath`).
     pub render_settings: Option<String>,
-    /// Image width and height, overriding the render settings' resolution.
+    /// Image width, overriding the render settings' resolution.
     pub width: Option<u32>,
+    /// Image height, overriding the render settings' resolution.
     pub height: Option<u32>,
 }
 
@@ -93,7 +96,7 @@ impl Map {
             "sRGB" => Some(true),
             _ => None,
         };
-        let image = env_io::load_bytes_as(&name, bytes, srgb).map_err(|e| e.to_string())?;
+        let image = image_file::load_bytes_as(&name, bytes, srgb).map_err(|e| e.to_string())?;
         let channel = match src.channel.as_str() {
             "r" => Channel::One(0),
             "g" => Channel::One(1),
@@ -126,7 +129,7 @@ impl Map {
 
     /// The input's mean over the texture (for surfaces without texture coordinates).
     fn mean(&self) -> [f32; 3] {
-        let mean = crate::resample::equal_area_mean(&self.texture.image.texels);
+        let mean = crate::light::resample::equal_area_mean(&self.texture.image.texels);
         self.value(mean.map(|m| m as f32))
     }
 }

@@ -7,29 +7,81 @@ use std::path::{Path, PathBuf};
 /// A loaded image: linear RGB, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RgbImage {
+    /// Width in texels.
     pub width: usize,
+    /// Height in texels.
     pub height: usize,
+    /// Linear RGB, row by row.
     pub texels: Vec<[f32; 3]>,
     /// Texels that held NaN, ±Inf or negative values and were set to 0.
     pub sanitized: usize,
 }
 
+/// Why an image cannot be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
+    /// The file cannot be read.
     #[error("{path}: cannot read the file: {error}")]
-    Io { path: PathBuf, error: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        error: std::io::Error,
+    },
+    /// The file is not valid in its format.
     #[error("{path}: not a readable {format} image: {message}")]
-    Decode { path: PathBuf, format: &'static str, message: String },
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// The format it was read as.
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The image has no pixels.
     #[error("{path}: the image is empty (zero width or height)")]
-    Empty { path: PathBuf },
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file's extension names no format this build reads.
     #[error("{path}: unsupported image format (expected .exr, .hdr, .png, .jpg, .jpeg or .tga)")]
-    Unsupported { path: PathBuf },
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The format's cargo feature was left out of this build.
     #[error("{path}: support for {format} images was left out of this build (cargo feature `{feature}`)")]
-    FeatureDisabled { path: PathBuf, format: &'static str, feature: &'static str },
+    FeatureDisabled {
+        /// The file.
+        path: PathBuf,
+        /// The format it was read as.
+        format: &'static str,
+        /// The cargo feature.
+        feature: &'static str,
+    },
+    /// The image is larger than the renderer accepts.
     #[error("{path}: the image is {width}×{height}, larger than the 32768×16384 this renderer accepts")]
-    TooLarge { path: PathBuf, width: usize, height: usize },
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// The header's size cannot fit in the file.
     #[error("{path}: the header claims {width}×{height} pixels, more than a file of {bytes} bytes can hold")]
-    Implausible { path: PathBuf, width: usize, height: usize, bytes: usize },
+    Implausible {
+        /// The file.
+        path: PathBuf,
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+        /// The file's size in bytes.
+        bytes: usize,
+    },
 }
 
 const MAX_WIDTH: usize = 32_768;

@@ -6,20 +6,26 @@
 use crate::scene::CameraSpec;
 use sampler_core::glam::Vec3;
 
+/// A camera ready to make primary rays.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
+    /// Eye position: where primary rays start.
     pub origin: Vec3,
     forward: Vec3,
     right: Vec3,
     up: Vec3,
     tan_half: f32,
     aspect: f32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Distance below which primary hits are ignored.
     pub near_clip: f32,
 }
 
 impl Camera {
+    /// The camera of `spec`.
     pub fn new(spec: &CameraSpec) -> Self {
         let forward = (spec.target - spec.origin).normalize();
         let right = forward.cross(spec.up).normalize();

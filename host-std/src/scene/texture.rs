@@ -1,15 +1,19 @@
 //! Image textures for materials: bilinear lookups with USD's texture-coordinate convention
 //! (st = (0, 0) is the image's lower-left corner) and wrap modes.
 
-use crate::env_io::RgbImage;
+use crate::light::image_file::RgbImage;
 use sampler_core::glam::Vec2;
 
 /// How coordinates outside [0, 1] read the image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Wrap {
+    /// Repeats the image.
     Repeat,
+    /// Reads the nearest edge texel.
     Clamp,
+    /// Repeats the image mirrored every other time.
     Mirror,
+    /// Reads black.
     Black,
 }
 
@@ -48,7 +52,9 @@ impl Wrap {
 /// A decoded texture (linear RGB).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageTexture {
+    /// The texels.
     pub image: RgbImage,
+    /// How s and t outside [0, 1] read the image.
     pub wrap: [Wrap; 2],
 }
 

@@ -1,0 +1,92 @@
+//! The arguments `render`, `info` and `report` share: the scene to load and how to sample it.
+
+use clap::Args;
+use host_std::plan::Method;
+use host_std::scene::Scene;
+use std::path::PathBuf;
+
+/// Largest visibility-sample count per pixel accepted (2^26: converging single techniques on
+/// sharp highlights takes millions; pixel counters are u64, per-point indices u32).
+pub(crate) const MAX_SPP: i64 = 1 << 26;
+
+#[derive(Args)]
+pub(crate) struct SceneArgs {
+    /// Scene file: .json (docs/scene-format.md) or USD (.usda, .usdc, .usdz, .usd). Without
+    /// it: the embedded default scene.
+    pub(crate) scene: Option<PathBuf>,
+    /// USD: the camera prim to render through (default: the render settings' camera, else
+    /// the stage's first camera).
+    #[arg(long)]
+    pub(crate) camera: Option<String>,
+    /// USD: the RenderSettings prim whose resolution and camera apply (default: the layer's
+    /// renderSettingsPrimPath, else the stage's only RenderSettings prim).
+    #[arg(long, value_name = "PRIM")]
+    pub(crate) render_settings: Option<String>,
+    /// Environment map replacing the scene's (lat-long .exr/.hdr/.png/.jpg, or a square
+    /// equal-area map).
+    #[arg(long)]
+    pub(crate) env: Option<PathBuf>,
+    /// Radiance scale of the environment (with --env; otherwise the scene's).
+    #[arg(long)]
+    pub(crate) env_scale: Option<f32>,
+    /// Rotation of the environment about +Y in degrees (d_world = R_y·d_local).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) env_rotate_y: Option<f32>,
+}
+
+/// Primary rays per pixel when `--shading-points` is not given (reduced to a divisor of spp).
+pub(crate) const DEFAULT_SHADING_POINTS: u32 = 4;
+
+/// How a render samples, shared by `render` and `report`.
+#[derive(Args)]
+pub(crate) struct SamplingArgs {
+    /// Primary rays (shading points) per pixel, each spending spp/P visibility samples
+    /// [default: 4, or the largest divisor of --spp below it]. `render`: a P given must divide
+    /// --spp; `report`: reduced to a divisor of each spp.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub(crate) shading_points: Option<u32>,
+    /// BRDF samples per product sampler (the paper's K).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub(crate) brdf_samples: u32,
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Worker threads, for the BVH and environment builds and the render (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub(crate) threads: Option<u32>,
+    /// Image width, overriding the scene's camera.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub(crate) width: Option<u32>,
+    /// Image height, overriding the scene's camera.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub(crate) height: Option<u32>,
+    /// No shadow rays: every light direction counts as visible (for analysis: the error of
+    /// sampling light × BRDF without the error visibility adds).
+    #[arg(long)]
+    pub(crate) unshadowed: bool,
+}
+
+impl SamplingArgs {
+    /// --width and --height, as given.
+    pub(crate) fn size(&self) -> (Option<u32>, Option<u32>) {
+        (self.width, self.height)
+    }
+
+    /// Applies --width/--height to the scene's camera.
+    pub(crate) fn resize(&self, scene: &mut Scene) {
+        if let Some(w) = self.width {
+            scene.camera.width = w;
+        }
+        if let Some(h) = self.height {
+            scene.camera.height = h;
+        }
+    }
+
+    /// Worker threads: --threads, or every core.
+    pub(crate) fn threads(&self) -> usize {
+        self.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize)
+    }
+}
+
+pub(crate) fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}

@@ -1,0 +1,126 @@
+//! `ppis info`: what a scene holds and what a render of it would build, or USD conformance
+//! against Pixar's answers.
+
+use crate::args::SceneArgs;
+use crate::load::load_scene;
+use anyhow::Result;
+#[cfg(not(feature = "usd"))]
+use anyhow::bail;
+use clap::Args;
+use host_std::light::environment::EnvSource;
+use host_std::plan::Method;
+use host_std::plan::pilot::{self, MAX_PILOT_SHARE, MAX_PIXELS, MIN_PIXELS, OVERRIDE_MARGIN, PILOT_SHARE, PLANS};
+use host_std::plan::rules::{
+    AUTO_DIFFUSE_ENV_SHARE, PRODUCT_ALPHA, PRODUCT_ALPHA_EXTENDED, SMOOTH_LIGHTING_PEAK, SUN_PEAK, WIDE_LOBE,
+    WIDE_LOBE_PRODUCT_SHARE,
+};
+use host_std::scene::Scene;
+use host_std::trace::bvh::Bvh;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub(crate) struct InfoArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// USD conformance: check every USD file under DIR that has a `<name>.expected.json`
+    /// (Pixar's answers: world matrices, bound materials, metadata) and import it.
+    #[arg(long, value_name = "DIR")]
+    expected: Option<PathBuf>,
+}
+
+pub(crate) fn info_command(args: InfoArgs) -> Result<()> {
+    if let Some(dir) = &args.expected {
+        return conformance(dir);
+    }
+    let loaded = load_scene(&args.scene, (None, None))?;
+    #[cfg(feature = "usd")]
+    if let Some(usd) = &loaded.usd {
+        host_std::scene::usd_info::print_import(usd);
+    }
+    if !loaded.notes.is_empty() {
+        println!("not rendered as authored ({}):", loaded.notes.len());
+        for n in &loaded.notes {
+            println!("  {n}");
+        }
+    }
+    let scene = loaded.scene;
+    print_scene(&scene);
+    println!(
+        "a render builds: {} BVH primitives{}; {}",
+        Bvh::build(&scene).primitive_count(),
+        if scene.env.is_some() { ", the env hierarchy" } else { "" },
+        sampling_summary()
+    );
+    Ok(())
+}
+
+/// The scene's camera, objects, materials and environment.
+fn print_scene(scene: &Scene) {
+    let c = &scene.camera;
+    println!("scene {}", scene.name);
+    println!(
+        "camera: {}×{}, fov {}°, from {:?} to {:?}",
+        c.width,
+        c.height,
+        c.fov_y_deg,
+        c.origin.to_array(),
+        c.target.to_array()
+    );
+    println!("objects: {} ({} triangles)", scene.objects.len(), scene.triangle_count());
+    for (i, m) in scene.materials.iter().enumerate() {
+        println!("  material {i}: {}{}", m.bsdf.kind(), if m.twosided { ", two-sided" } else { "" });
+    }
+    match &scene.env {
+        None => println!("environment: none — a render builds no env hierarchy and is black except for hits"),
+        Some((EnvSource::Sky { level }, _)) => {
+            println!("environment: built-in sky, equal-area {}² (pyramid {} MB)", 1u32 << level, pyramid_mb(*level))
+        }
+        Some((EnvSource::Bytes { name, .. }, p)) => println!(
+            "environment: {} (tint {:?}), resampled to a power-of-two equal-area square",
+            name.display(),
+            p.tint
+        ),
+        Some((EnvSource::Constant { .. }, p)) => println!("environment: constant radiance {:?}", p.tint),
+        Some((EnvSource::File(path), p)) => println!(
+            "environment: {} (scale {}, rotate_y {}°), resampled to a power-of-two equal-area square",
+            path.display(),
+            p.scale,
+            p.rotate_y_deg
+        ),
+    }
+}
+
+/// What the methods build and how `auto` decides, from the constants that decide it.
+fn sampling_summary() -> String {
+    let mut candidates: Vec<&str> = Vec::new();
+    for c in &PLANS {
+        let name = Method::of(c.strategy).name();
+        if !candidates.contains(&name) {
+            candidates.push(name);
+        }
+    }
+    let last = candidates.pop().unwrap_or_default();
+    format!(
+        "product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {WIDE_LOBE_PRODUCT_SHARE} of its samples from the product on GGX conductors with α ≥ {WIDE_LOBE} when the map's peak is under {SUN_PEAK}, half elsewhere); auto = product-mis on GGX conductors with α in {PRODUCT_ALPHA:?} ({PRODUCT_ALPHA_EXTENDED:?} when the map's peak is under {SUN_PEAK}: no sun), mis on the other materials ({AUTO_DIFFUSE_ENV_SHARE} of it env samples on diffuse surfaces when the peak is under {SUN_PEAK}), or BRDF sampling when the lighting is smooth (peak < {SMOOTH_LIGHTING_PEAK}) — then checked per material by a pilot render of {MIN_PIXELS}–{MAX_PIXELS} of its pixels with the candidate plans {} and {last} (those whose sample weights are bounded there, the two MIS methods at the rules' splits; of {} plans in all: {}), which replaces the rule's plan where another measures {OVERRIDE_MARGIN}× better at equal cost (about {}% of the render, at most {}%: with fewer than {MIN_PIXELS} pixels per material within that, the rules decide alone)",
+        candidates.join(", "),
+        PLANS.len(),
+        (0..PLANS.len()).map(pilot::plan_name).collect::<Vec<_>>().join(", "),
+        PILOT_SHARE * 100.0,
+        MAX_PILOT_SHARE * 100.0,
+    )
+}
+
+/// Megabytes of the built-in sky's map and importance pyramid at `level`.
+fn pyramid_mb(level: u32) -> f64 {
+    (sampler_core::env::pyramid_len(level) * 4 + (1usize << (2 * level)) * 12) as f64 / 1e6
+}
+
+#[cfg(feature = "usd")]
+fn conformance(dir: &Path) -> Result<()> {
+    host_std::scene::usd_info::conformance(dir)
+}
+
+#[cfg(not(feature = "usd"))]
+fn conformance(_dir: &Path) -> Result<()> {
+    bail!("--expected: this ppis was built without USD support (cargo feature `usd`)")
+}

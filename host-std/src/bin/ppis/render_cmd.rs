@@ -1,0 +1,166 @@
+//! `ppis render`: one scene, one method, to a linear EXR, an sRGB PNG and optionally the
+//! stats JSON.
+
+use crate::args::{DEFAULT_SHADING_POINTS, MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::load::{load_scene, warn_notes};
+use crate::stats::Stats;
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use host_std::light::environment::Environment;
+use host_std::plan::{self, Method, Rendered, Settings, pilot};
+use host_std::scene::Scene;
+use host_std::trace::bvh::Bvh;
+use host_std::{output, report};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto. The default,
+    /// product-MIS, is product sampling beside BRDF sampling: faster than `product` alone at
+    /// equal error and far less noisy (docs/perf.md).
+    #[arg(long, default_value = "product-mis", value_parser = parse_method)]
+    pub(crate) method: Method,
+    /// Visibility samples (shadow rays) per pixel.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
+    pub(crate) spp: u32,
+    #[command(flatten)]
+    pub(crate) sampling: SamplingArgs,
+    /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+    /// Write timings and counts as JSON.
+    #[arg(long)]
+    stats_json: Option<PathBuf>,
+}
+
+/// A scene ready to render: loaded, its environment and BVH built, and how long that took.
+pub(crate) struct Prepared {
+    pub(crate) scene: Scene,
+    pub(crate) environment: Option<Environment>,
+    pub(crate) bvh: Bvh,
+    /// Seconds loading the scene (the environment's own load time is in its stats).
+    pub(crate) load_seconds: f64,
+    pub(crate) bvh_seconds: f64,
+}
+
+pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
+    let shading_points = match args.sampling.shading_points {
+        Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
+        Some(p) => p,
+        None => report::shading_points_for(args.spp as usize, DEFAULT_SHADING_POINTS as usize) as u32,
+    };
+    let (exr_path, png_path) = output_paths(&args)?;
+    let threads = args.sampling.threads();
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
+    let prepared = prepare(&args, &pool)?;
+    let settings = Settings {
+        method: args.method,
+        spp: args.spp as usize,
+        shading_points: shading_points as usize,
+        brdf_samples: args.sampling.brdf_samples as usize,
+        seed: args.sampling.seed,
+        progress: true,
+        shadows: !args.sampling.unshadowed,
+    };
+    let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
+    let image = pool.install(|| plan::render(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings));
+
+    output::write_exr(&exr_path, image.width, image.height, &image.pixels)?;
+    output::write_png(&png_path, image.width, image.height, &image.pixels)?;
+    if let Some(path) = &args.stats_json {
+        let stats = Stats::new(&args, &prepared, hierarchy.as_ref(), &image, shading_points, threads);
+        output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
+    }
+    let t = image.render_seconds.max(1e-9);
+    eprintln!(
+        "ppis: {}×{} {} spp ({} shading points/pixel), method {}, {} threads: {:.2} s, {:.2} M samples/s, {:.0} k shading points/s; wrote {} and {}",
+        image.width,
+        image.height,
+        args.spp,
+        shading_points,
+        args.method,
+        threads,
+        image.render_seconds,
+        image.shadow_rays as f64 / t * 1e-6,
+        image.shading_points as f64 / t * 1e-3,
+        exr_path.display(),
+        png_path.display()
+    );
+    report_pilot(&prepared.scene, &image);
+    if image.non_finite > 0 {
+        eprintln!("ppis: warning: {} pixels were not finite and were written as 0", image.non_finite);
+    }
+    Ok(())
+}
+
+/// The EXR and PNG to write, checked before any work.
+fn output_paths(args: &RenderArgs) -> Result<(PathBuf, PathBuf)> {
+    let exr_path = args.output.clone().unwrap_or_else(|| PathBuf::from("render.exr"));
+    let is_exr = exr_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        // `-o out.png` would otherwise write the EXR there and then the PNG over it.
+        bail!(
+            "{}: the output is an OpenEXR file and must end in .exr (the PNG is written beside it)",
+            exr_path.display()
+        );
+    }
+    let png_path = exr_path.with_extension("png");
+    check_writable(&exr_path)?;
+    if let Some(stats) = &args.stats_json {
+        check_writable(stats)?;
+    }
+    Ok((exr_path, png_path))
+}
+
+/// Loads the scene and builds (only what this render uses) on the pool's threads.
+fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
+    let t_load = Instant::now();
+    let loaded = load_scene(&args.scene, args.sampling.size())?;
+    warn_notes(&loaded.scene, &loaded.notes);
+    let mut scene = loaded.scene;
+    args.sampling.resize(&mut scene);
+    let load_seconds = t_load.elapsed().as_secs_f64();
+    let environment = match &scene.env {
+        Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
+        None => None,
+    };
+    let t_bvh = Instant::now();
+    let bvh = pool.install(|| Bvh::build(&scene));
+    let bvh_seconds = t_bvh.elapsed().as_secs_f64();
+    if let Some(env) = &environment
+        && env.stats.sanitized > 0
+    {
+        eprintln!(
+            "ppis: warning: {}: {} texels were NaN, infinite or negative and were set to 0",
+            env.stats.source, env.stats.sanitized
+        );
+    }
+    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds })
+}
+
+/// One line per material `auto`'s pilot measured.
+fn report_pilot(scene: &Scene, image: &Rendered) {
+    for r in &image.pilot {
+        eprintln!(
+            "ppis: auto: {} → {}{} (pilot: {} pixels, {:.2} s in all)",
+            scene.materials[r.material].bsdf.label(),
+            pilot::plan_name(r.chosen),
+            if Some(r.chosen) == r.rule { "" } else { ", measured ahead of the rule's plan" },
+            r.pixels,
+            image.pilot_seconds
+        );
+    }
+}
+
+/// Fails early (before any work) when the output folder does not exist.
+fn check_writable(path: &Path) -> Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!("{}: the output folder does not exist", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,122 @@
+//! The stats JSON of `ppis render --stats-json`: timings, counts and what was built. The file
+//! lists its keys sorted, so the fields are declared in alphabetical order; scripts (docs/,
+//! host-usd/bench/) read them by name.
+
+use crate::render_cmd::{Prepared, RenderArgs};
+use host_std::plan::{Rendered, pilot};
+use sampler_core::env::EnvHierarchy;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One render's stats.
+#[derive(Serialize)]
+pub(crate) struct Stats {
+    /// `auto`: per material its pilot's plan and scores (empty otherwise).
+    auto_plans: Vec<AutoPlan>,
+    brdf_samples: u32,
+    bvh_seconds: f64,
+    camera_rays: u64,
+    env_build_seconds: f64,
+    env_bytes: Option<usize>,
+    env_level: Option<u32>,
+    env_map_mean_rgb: Option<[f64; 3]>,
+    /// The equal-area map's mean radiance against the source's: the largest relative error
+    /// over the channels.
+    env_mean_relative_error: Option<f64>,
+    /// `EnvHierarchy::peak(5)`, widened to f64 as the file has it.
+    env_peak: Option<f64>,
+    env_sanitized_texels: Option<usize>,
+    env_source_mean_rgb: Option<[f64; 3]>,
+    height: usize,
+    /// The scene's and the environment's.
+    load_seconds: f64,
+    method: &'static str,
+    non_finite_pixels: u64,
+    pilot_seconds: f64,
+    /// The environment's build and the BVH's.
+    preprocess_seconds: f64,
+    primitives: usize,
+    render_seconds: f64,
+    scene: String,
+    seed: u64,
+    shading_points: u64,
+    shading_points_per_pixel: u32,
+    shadow_rays: u64,
+    spp: u32,
+    threads: usize,
+    unshadowed: bool,
+    width: usize,
+}
+
+/// What `auto`'s pilot measured for one material.
+#[derive(Serialize)]
+struct AutoPlan {
+    material: String,
+    pilot_pixels: usize,
+    plan: String,
+    rule_plan: Option<String>,
+    /// Per candidate plan by name, its score (`null`: not measured or not trusted).
+    scores: BTreeMap<String, Option<f64>>,
+}
+
+impl Stats {
+    /// The stats of `image`, rendered from `prepared` as `args` asked.
+    pub(crate) fn new(
+        args: &RenderArgs,
+        prepared: &Prepared,
+        hierarchy: Option<&EnvHierarchy<'_>>,
+        image: &Rendered,
+        shading_points: u32,
+        threads: usize,
+    ) -> Self {
+        let env = prepared.environment.as_ref();
+        let env_load = env.map_or(0.0, |e| e.stats.load_seconds);
+        let env_build = env.map_or(0.0, |e| e.stats.build_seconds);
+        let scene = &prepared.scene;
+        Stats {
+            auto_plans: image
+                .pilot
+                .iter()
+                .map(|r| AutoPlan {
+                    material: scene.materials[r.material].bsdf.label(),
+                    pilot_pixels: r.pixels,
+                    plan: pilot::plan_name(r.chosen),
+                    rule_plan: r.rule.map(pilot::plan_name),
+                    scores: (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), r.scores[c])).collect(),
+                })
+                .collect(),
+            brdf_samples: args.sampling.brdf_samples,
+            bvh_seconds: prepared.bvh_seconds,
+            camera_rays: image.camera_rays,
+            env_build_seconds: env_build,
+            env_bytes: env.map(|e| e.stats.bytes),
+            env_level: env.map(|e| e.level),
+            env_map_mean_rgb: env.map(|e| e.stats.map_mean),
+            env_mean_relative_error: env.map(|e| {
+                (0..3)
+                    .map(|c| (e.stats.map_mean[c] / e.stats.source_mean[c].max(1e-300) - 1.0).abs())
+                    .fold(0.0, f64::max)
+            }),
+            env_peak: hierarchy.map(|h| f64::from(h.peak(5))),
+            env_sanitized_texels: env.map(|e| e.stats.sanitized),
+            env_source_mean_rgb: env.map(|e| e.stats.source_mean),
+            height: image.height,
+            load_seconds: prepared.load_seconds + env_load,
+            method: args.method.name(),
+            non_finite_pixels: image.non_finite,
+            pilot_seconds: image.pilot_seconds,
+            preprocess_seconds: env_build + prepared.bvh_seconds,
+            primitives: prepared.bvh.primitive_count(),
+            render_seconds: image.render_seconds,
+            scene: scene.name.clone(),
+            seed: args.sampling.seed,
+            shading_points: image.shading_points,
+            shading_points_per_pixel: shading_points,
+            shadow_rays: image.shadow_rays,
+            spp: args.spp,
+            threads,
+            unshadowed: args.sampling.unshadowed,
+            width: image.width,
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! Light sources. The environment: image files read into RGB texels, lat-long maps resampled to
+//! the equal-area square, the built-in sky, and the built map with its importance pyramid that
+//! `sampler-core` samples. The bottom layer: it depends on nothing else in the crate.
+
+pub mod environment;
+pub mod image_file;
+pub mod resample;
+pub mod sky;

@@ -1,0 +1,133 @@
+//! The methods a render is asked for by name (`--method`), and what each one samples a
+//! material with.
+
+use crate::plan::rules;
+use crate::render::strategy::Strategy;
+use crate::scene::Bsdf;
+use std::fmt;
+use std::str::FromStr;
+
+/// How the light is sampled: a fixed strategy for every material, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Product importance sampling, quadtree product (the paper).
+    Product,
+    /// Product importance sampling, Haar wavelet product.
+    Wavelet,
+    /// Environment-only importance sampling through the same hierarchy.
+    Env,
+    /// BRDF importance sampling.
+    Brdf,
+    /// MIS (balance heuristic) of env and BRDF sampling, as Mitsuba's `direct` integrator.
+    Mis,
+    /// MIS of product and BRDF sampling.
+    ProductMis,
+    /// Resampled importance sampling: env/BRDF candidates, one shadow ray.
+    Ris,
+    /// Two-stage importance sampling (Cline et al. 2006).
+    TwoStage,
+    /// Per material, the strategy of `auto`'s rules ([`rules::auto_strategy`]), checked by a
+    /// pilot render of the material's pixels that replaces it where another measures
+    /// [`OVERRIDE_MARGIN`](crate::plan::pilot::OVERRIDE_MARGIN)× as good (`plan::pilot`).
+    Auto,
+}
+
+impl Method {
+    /// Every method, in the order `--help` lists them.
+    pub const ALL: [Method; 9] = [
+        Method::Product,
+        Method::Wavelet,
+        Method::Env,
+        Method::Brdf,
+        Method::Mis,
+        Method::ProductMis,
+        Method::Ris,
+        Method::TwoStage,
+        Method::Auto,
+    ];
+
+    /// The name `--method` takes.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Product => "product",
+            Method::Wavelet => "wavelet",
+            Method::Env => "env",
+            Method::Brdf => "brdf",
+            Method::Mis => "mis",
+            Method::ProductMis => "product-mis",
+            Method::Ris => "ris",
+            Method::TwoStage => "two-stage",
+            Method::Auto => "auto",
+        }
+    }
+
+    /// What this method samples a material of `bsdf` with under a map of peak `env_peak`
+    /// (`EnvHierarchy::peak(5)`; `f32::MAX` where not measured). Product-MIS takes its split
+    /// from the rules ([`rules::product_share`]); `mis` stays Mitsuba's pairs.
+    #[must_use]
+    pub fn strategy(self, bsdf: &Bsdf, env_peak: f32) -> Strategy {
+        match self {
+            Method::Product => Strategy::Product,
+            Method::Wavelet => Strategy::Wavelet,
+            Method::Env => Strategy::Env,
+            Method::Brdf => Strategy::Brdf,
+            Method::Mis => Strategy::Mis { env_share: 0.5 },
+            Method::ProductMis => Strategy::ProductMis { product_share: rules::product_share(bsdf, env_peak) },
+            Method::Ris => Strategy::Ris,
+            Method::TwoStage => Strategy::TwoStage,
+            Method::Auto => rules::auto_strategy(bsdf, env_peak),
+        }
+    }
+
+    /// The fixed method that samples with `strategy` (its split aside).
+    #[must_use]
+    pub fn of(strategy: Strategy) -> Method {
+        match strategy {
+            Strategy::Product => Method::Product,
+            Strategy::Wavelet => Method::Wavelet,
+            Strategy::Env => Method::Env,
+            Strategy::Brdf => Method::Brdf,
+            Strategy::Mis { .. } => Method::Mis,
+            Strategy::ProductMis { .. } => Method::ProductMis,
+            Strategy::Ris => Method::Ris,
+            Strategy::TwoStage => Method::TwoStage,
+        }
+    }
+
+    /// Whether a render with this method reads the map's peak (`auto`'s rules and
+    /// product-MIS's split do).
+    #[must_use]
+    pub fn reads_env_peak(self) -> bool {
+        matches!(self, Method::Auto | Method::ProductMis)
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown method \"{s}\" (expected one of: {})", names.join(", "))
+        })
+    }
+}
+
+/// A strategy's name: its method's, and its split where it is not half and half ("mis 3:1" —
+/// three env samples to one BRDF sample; "product-mis 3:1").
+#[must_use]
+pub fn strategy_name(strategy: Strategy) -> String {
+    let name = Method::of(strategy).name();
+    match strategy {
+        Strategy::Mis { env_share: split } | Strategy::ProductMis { product_share: split } if split != 0.5 => {
+            format!("{name} {}:{}", (split * 4.0).round(), ((1.0 - split) * 4.0).round())
+        }
+        _ => name.to_string(),
+    }
+}

@@ -1,0 +1,122 @@
+//! Planning a render: the methods (`--method`), `auto`'s rules and its pilot, and [`render`],
+//! which resolves the method per material, runs the pilot where `auto` asks for one, and
+//! renders. Calls down into `render`, never the reverse.
+
+pub mod method;
+pub mod pilot;
+pub mod rules;
+
+pub use method::Method;
+
+use crate::render::strategy::MaterialPlan;
+use crate::render::tiles::render_tiles;
+use crate::render::{Context, Options, summed_area_table};
+use crate::scene::Scene;
+use crate::trace::bvh::Bvh;
+use crate::trace::camera::Camera;
+use pilot::PilotResult;
+use sampler_core::env::EnvHierarchy;
+use std::time::Instant;
+
+/// What to render and how.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// How the light is sampled.
+    pub method: Method,
+    /// Visibility samples per pixel.
+    pub spp: usize,
+    /// Primary rays (shading points) per pixel; divides `spp`.
+    pub shading_points: usize,
+    /// BRDF samples that build each product sampler.
+    pub brdf_samples: usize,
+    /// The seed every pixel's sequences derive from.
+    pub seed: u64,
+    /// Show a progress bar on stderr (after the first second).
+    pub progress: bool,
+    /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
+    /// to tell the error that visibility adds from the error of sampling light × BRDF).
+    pub shadows: bool,
+}
+
+impl Settings {
+    /// How pixels are sampled, the method aside.
+    #[must_use]
+    pub fn options(&self) -> Options {
+        Options {
+            spp: self.spp,
+            shading_points: self.shading_points,
+            brdf_samples: self.brdf_samples,
+            seed: self.seed,
+            progress: self.progress,
+            shadows: self.shadows,
+        }
+    }
+}
+
+/// A rendered image and what it took.
+pub struct Rendered {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Linear RGB, rows top to bottom.
+    pub pixels: Vec<[f32; 3]>,
+    /// Wall clock of the render, `auto`'s pilot included.
+    pub render_seconds: f64,
+    /// Shading points shaded.
+    pub shading_points: u64,
+    /// Shadow rays traced.
+    pub shadow_rays: u64,
+    /// Primary rays traced.
+    pub camera_rays: u64,
+    /// Pixel values that came out NaN or infinite and were set to 0 (should stay 0).
+    pub non_finite: u64,
+    /// `auto`: what its pilot measured per material (empty for the other methods).
+    pub pilot: Vec<PilotResult>,
+    /// `auto`: seconds of the pilot, included in `render_seconds`.
+    pub pilot_seconds: f64,
+}
+
+/// Renders the scene. `env` is `None` when the scene has no environment light.
+pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Rendered {
+    // `auto` and product-MIS resolve per material once, knowing how peaked the lighting is.
+    let env_peak = match env {
+        Some(e) if settings.method.reads_env_peak() => e.peak(5),
+        _ => f32::MAX,
+    };
+    let plans: Vec<MaterialPlan> = scene
+        .materials
+        .iter()
+        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf))
+        .collect();
+    // The summed-area table exists only for the strategy that reads it.
+    let sat = env.and_then(|e| summed_area_table(e, &plans));
+    let camera = Camera::new(&scene.camera);
+    let options = settings.options();
+    let ctx = Context { scene, bvh, env, sat: sat.as_deref(), camera: &camera, options: &options, plans: &plans };
+    // Timed from here: `auto`'s pilot is part of its cost.
+    let start = Instant::now();
+    let (chosen, pilot) = match (settings.method, env) {
+        (Method::Auto, Some(e)) => {
+            let (chosen, measured) = pilot::choose(&ctx, e, env_peak);
+            (Some(chosen), measured)
+        }
+        _ => (None, Vec::new()),
+    };
+    let pilot_seconds = start.elapsed().as_secs_f64();
+    let image = render_tiles(&Context { plans: chosen.as_deref().unwrap_or(&plans), ..ctx }, start);
+    let render_seconds = start.elapsed().as_secs_f64();
+    let c = image.counters;
+    Rendered {
+        width: image.width,
+        height: image.height,
+        pixels: image.pixels,
+        render_seconds,
+        shading_points: c.shading_points,
+        shadow_rays: c.shadow_rays,
+        camera_rays: c.camera_rays,
+        non_finite: c.non_finite,
+        pilot,
+        pilot_seconds,
+    }
+}

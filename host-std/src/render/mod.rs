@@ -1,0 +1,92 @@
+//! Rendering an image whose materials are already planned: rayon over 16×16 tiles
+//! ([`tiles`]), each pixel through the pipeline of [`pixel`] (camera ray, intersection,
+//! shading point, light samples, the pixel's mean), samplers built and kept by
+//! [`sampler_cache`], light sampled by [`shade`] as each material's [`strategy`] says.
+//! Depends on `light`, `scene` and `trace`; `plan` decides the strategies and calls in here.
+//!
+//! Every pixel is seeded from (seed, pixel index), so the image depends only on the scene, the
+//! options, the plans and the seed, never on the thread count or on which thread rendered
+//! which tile. Each pixel gets P shading points (primary rays jittered uniformly inside the
+//! pixel: a box filter) and each shading point spp/P visibility samples.
+
+pub mod pixel;
+pub mod sampler_cache;
+pub mod shade;
+pub mod strategy;
+pub mod tiles;
+
+use crate::scene::Scene;
+use crate::trace::bvh::Bvh;
+use crate::trace::camera::Camera;
+use sampler_core::env::EnvHierarchy;
+use std::ops::AddAssign;
+use strategy::MaterialPlan;
+
+/// How pixels are sampled: the budget, the seed and what is traced.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Visibility samples per pixel.
+    pub spp: usize,
+    /// Primary rays (shading points) per pixel; divides `spp`.
+    pub shading_points: usize,
+    /// BRDF samples that build each product sampler.
+    pub brdf_samples: usize,
+    /// The seed every pixel's sequences derive from.
+    pub seed: u64,
+    /// Show a progress bar on stderr (after the first second).
+    pub progress: bool,
+    /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
+    /// to tell the error that visibility adds from the error of sampling light × BRDF).
+    pub shadows: bool,
+}
+
+/// What every pixel of a render reads.
+#[derive(Clone, Copy)]
+pub struct Context<'a, 'e> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its BVH.
+    pub bvh: &'a Bvh,
+    /// The environment light, if the scene has one.
+    pub env: Option<&'a EnvHierarchy<'e>>,
+    /// The summed-area table of `env`, built when a material is sampled two-stage.
+    pub sat: Option<&'a [f64]>,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// How pixels are sampled.
+    pub options: &'a Options,
+    /// Per material, how it is shaded.
+    pub plans: &'a [MaterialPlan],
+}
+
+/// What a render (or a pixel) did, counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Shading points shaded (primary hits on a surface that reflects light to the viewer).
+    pub shading_points: u64,
+    /// Shadow rays traced.
+    pub shadow_rays: u64,
+    /// Primary rays traced.
+    pub camera_rays: u64,
+    /// Pixel values that came out NaN or infinite and were set to 0.
+    pub non_finite: u64,
+}
+
+impl AddAssign for Counters {
+    fn add_assign(&mut self, other: Self) {
+        self.shading_points += other.shading_points;
+        self.shadow_rays += other.shadow_rays;
+        self.camera_rays += other.camera_rays;
+        self.non_finite += other.non_finite;
+    }
+}
+
+/// The summed-area table two-stage sampling reads, built when a plan needs it.
+#[must_use]
+pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<f64>> {
+    plans.iter().any(|p| p.strategy == strategy::Strategy::TwoStage).then(|| {
+        let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(env.finest_level())];
+        sampler_core::two_stage::build_sat(env, &mut sat);
+        sat
+    })
+}

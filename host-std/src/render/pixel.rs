@@ -1,0 +1,209 @@
+//! One pixel, in named steps: for each of its shading points a camera ray
+//! ([`camera_ray`]), its intersection with the scene, the shading point there
+//! ([`surface`]); then the light sampled at every shading point ([`sample_light`]), and the
+//! pixel's mean ([`accumulate`]).
+
+use crate::render::sampler_cache::{Lead, SamplerCache};
+use crate::render::shade::{self, CountingVisibility, Run};
+use crate::render::strategy::Strategy;
+use crate::render::{Context, Counters};
+use crate::scene::{Bsdf, Scene};
+use crate::trace::bvh;
+use crate::trace::camera::Camera;
+use sampler_core::brdf::Brdf;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::ShadingPoint;
+use sampler_core::frame::Frame;
+use sampler_core::glam::{DVec2, DVec3, Vec3};
+use sampler_core::points::{permutation_element, sobol02};
+use sampler_core::rng::hash_combine;
+
+/// Shading points traced together: their hits are grouped by material before shading.
+const GROUP: usize = 64;
+
+/// A primary ray's hit, ready to shade.
+pub(crate) struct Hit {
+    /// The shading frame.
+    pub frame: Frame,
+    /// Towards the viewer.
+    pub wo: Vec3,
+    /// The BRDF at this hit when its material is textured; otherwise the material's.
+    pub bsdf: Option<Bsdf>,
+    /// Where shadow rays start: the hit, offset along the geometric normal.
+    pub origin: Vec3,
+    /// The hit's material.
+    pub material: usize,
+    /// The shading point's index in the pixel.
+    pub index: usize,
+}
+
+/// A tile's scratch memory, reused from pixel to pixel.
+pub struct Scratch {
+    /// The samplers built and kept.
+    cache: SamplerCache,
+    /// The pixel's primary hits.
+    hits: Vec<Hit>,
+    /// What the tile's pixels did so far.
+    pub counters: Counters,
+}
+
+impl Scratch {
+    /// Scratch for a scene of `materials` materials and pixels of `shading_points` points.
+    #[must_use]
+    pub fn new(materials: usize, shading_points: usize) -> Self {
+        Self {
+            cache: SamplerCache::new(materials),
+            hits: Vec::with_capacity(shading_points.clamp(1, GROUP)),
+            counters: Counters::default(),
+        }
+    }
+}
+
+/// The seeds of one pixel.
+#[derive(Clone, Copy)]
+struct Seeds {
+    /// The pixel's: its film positions, and the samplers' builds.
+    pixel: u64,
+    /// Its light-sample sequences, shared by its shading points (each takes its own run of
+    /// them, see [`shade::Run`]).
+    light: u64,
+}
+
+/// One pixel: the mean over its shading points (product-MIS samplers shared per pixel and
+/// material, and reused by the tile's next pixels while their shading points stay within
+/// the material's reuse angle; every other sampler built per shading point).
+pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -> [f32; 3] {
+    let pixel = hash_combine(ctx.options.seed, (y * ctx.camera.width as usize + x) as u64);
+    let seeds = Seeds { pixel, light: hash_combine(pixel, 0x11647) };
+    let p = ctx.options.shading_points.max(1);
+    let mut film = [DVec2::ZERO; GROUP];
+    // Accumulated in f64: single samples of a 1e30 map can exceed the f32 range.
+    let mut sum = DVec3::ZERO;
+    let mut done = 0;
+    while done < p {
+        let m = (p - done).min(GROUP);
+        sobol02(seeds.pixel, done as u32, &mut film[..m]);
+        scratch.hits.clear();
+        for (k, f) in film[..m].iter().enumerate() {
+            let dir = camera_ray(ctx.camera, x, y, *f, &mut scratch.counters);
+            let Some(hit) = ctx.bvh.intersect(ctx.camera.origin, dir, ctx.camera.near_clip, f32::INFINITY) else {
+                if let Some(radiance) = background(ctx, dir) {
+                    sum += radiance;
+                }
+                continue;
+            };
+            if let Some(h) = surface(ctx, dir, &hit, done + k) {
+                scratch.hits.push(h);
+            }
+        }
+        if let Some(env) = ctx.env {
+            sample_light(ctx, env, seeds, scratch, &mut sum);
+        }
+        done += m;
+    }
+    accumulate(sum, p, &mut scratch.counters)
+}
+
+/// The primary ray through film position `f` of pixel (x, y).
+fn camera_ray(camera: &Camera, x: usize, y: usize, f: DVec2, counters: &mut Counters) -> Vec3 {
+    counters.camera_rays += 1;
+    camera.direction(x as f32 + f.x as f32, y as f32 + f.y as f32)
+}
+
+/// What a primary ray that leaves the scene sees: the environment, unless the scene hides it.
+fn background(ctx: &Context<'_, '_>, dir: Vec3) -> Option<DVec3> {
+    match (ctx.env, ctx.scene.hide_emitters) {
+        (Some(e), false) => Some(e.radiance(dir).as_dvec3()),
+        _ => None,
+    }
+}
+
+/// The shading point of a primary hit, `None` where nothing is reflected to the viewer (the
+/// back of a one-sided surface, or no light to reflect).
+fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, index: usize) -> Option<Hit> {
+    let material = &ctx.scene.materials[hit.material as usize];
+    let wo = -dir;
+    let (mut n, mut ns) = (hit.normal, hit.shading_normal);
+    if n.dot(wo) < 0.0 {
+        // Seen from the back, a one-sided surface reflects nothing.
+        if !material.twosided {
+            return None;
+        }
+        (n, ns) = (-n, -ns);
+    }
+    // The shading frame follows the interpolated normal, kept on the viewer's side of the
+    // surface.
+    if ns.dot(n) <= 0.0 {
+        ns = n;
+    }
+    ctx.env?;
+    let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
+    Some(Hit {
+        frame: Frame::from_normal(ns),
+        wo,
+        bsdf: match (&material.texture, hit.uv) {
+            (Some(t), Some(uv)) => Some(t.0.bsdf_at(uv)),
+            _ => None,
+        },
+        origin: hit.point + n * eps,
+        material: hit.material as usize,
+        index,
+    })
+}
+
+/// Samples the light at every shading point of the group in `scratch`, adding to `sum`: one
+/// sampler per shading point, or for product-MIS one per material, built at its first point.
+fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scratch: &mut Scratch, sum: &mut DVec3) {
+    let Scratch { cache, hits, counters } = scratch;
+    let p = ctx.options.shading_points.max(1);
+    let budget = (ctx.options.spp / p).max(1);
+    let shadows = ctx.options.shadows;
+    for first in 0..hits.len() {
+        let lead = &hits[first];
+        let group = lead.material;
+        let shared = matches!(ctx.plans[group].strategy, Strategy::ProductMis { .. });
+        if shared && hits[..first].iter().any(|h| h.material == group) {
+            // Shaded with the group's first point.
+            continue;
+        }
+        let lead_sp = shading_point(ctx.scene, lead);
+        let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
+        let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });
+        let members =
+            hits[first..].iter().enumerate().filter(|(k, h)| if shared { h.material == group } else { *k == 0 });
+        for (_, h) in members {
+            counters.shading_points += 1;
+            let origin = h.origin;
+            let mut vis = CountingVisibility {
+                test: |d: Vec3| !shadows || !ctx.bvh.occluded(origin, d, 0.0, f32::INFINITY),
+                rays: 0,
+            };
+            let block = permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize;
+            let run = Run { seed: seeds.light, block };
+            *sum += shade::shade(&sampling, env, &shading_point(ctx.scene, h), budget, run, &mut vis);
+            // Only rays traced count.
+            counters.shadow_rays += if shadows { vis.rays } else { 0 };
+        }
+    }
+}
+
+/// The pixel's value: the mean of its shading points, or 0 (counted) where the mean exceeds
+/// the f32 range of the output or is NaN.
+fn accumulate(sum: DVec3, shading_points: usize, counters: &mut Counters) -> [f32; 3] {
+    let mean = (sum / shading_points as f64).as_vec3();
+    if mean.is_finite() {
+        mean.to_array()
+    } else {
+        counters.non_finite += 1;
+        [0.0; 3]
+    }
+}
+
+/// The hit's shading point: its own BRDF if its material is textured, the material's otherwise.
+fn shading_point<'a>(scene: &'a Scene, h: &'a Hit) -> ShadingPoint<'a, dyn Brdf + 'a> {
+    let brdf = match &h.bsdf {
+        Some(b) => b.as_brdf(),
+        None => scene.materials[h.material].bsdf.as_brdf(),
+    };
+    ShadingPoint { frame: h.frame, wo: h.wo, brdf }
+}

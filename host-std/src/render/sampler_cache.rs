@@ -1,0 +1,163 @@
+//! The samplers a tile builds and keeps: the arena of the product sampler built per shading
+//! point, and per material the product-MIS sampler built last, reused by the tile's next pixels
+//! while their shading points stay within the material's reuse angle.
+//!
+//! Product-MIS shares one sampler per pixel and material, built from the group's first shading
+//! point: MIS with BRDF sampling covers where another point's lobe leaves the shared B̃. Plain
+//! product, wavelet and two-stage build per shading point: shared, they grow fireflies near
+//! silhouettes and on sharp lobes, where only the defensive mixture covers the mismatch. How
+//! much sharing saves is measured in docs/perf.md ("Equal time against Mitsuba 3").
+
+use crate::render::Context;
+use crate::render::pixel::Hit;
+use crate::render::shade::Sampling;
+use crate::render::strategy::{MaterialPlan, Strategy};
+use crate::scene::Bsdf;
+use sampler_core::brdf::Brdf;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::ShadingPoint;
+use sampler_core::glam::Vec3;
+use sampler_core::quadtree::ProductKind;
+use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
+use sampler_core::two_stage::TwoStageSampler;
+
+/// Share of a material's lobe width within which the tile's next pixels reuse a product-MIS
+/// sampler (normals and mirror directions both that close to the one it was built at). A
+/// smaller share rebuilds more often for no less error; a larger one raises the error on
+/// glossy surfaces (docs/perf.md, "Equal time against Mitsuba 3").
+pub const REUSE_SHARE: f32 = 0.5;
+
+/// Widest lobe (radians) the reuse angle follows; diffuse surfaces reuse within
+/// [`REUSE_SHARE`] of it.
+const WIDEST_REUSED_LOBE: f32 = 0.4;
+
+/// Cosine of the largest angle at which a product-MIS sampler built at one shading point is
+/// reused at another of the same material: [`REUSE_SHARE`] of its sharpest lobe's width, and at
+/// most of [`WIDEST_REUSED_LOBE`] (diffuse). Sharing stays unbiased whatever the angle (MIS
+/// with BRDF sampling and the defensive part cover every direction); the angle trades build
+/// time for variance.
+#[must_use]
+pub fn reuse_cosine(bsdf: &Bsdf) -> f32 {
+    (REUSE_SHARE * bsdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
+}
+
+/// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
+/// direction of the shading point it was built at.
+struct SharedSampler {
+    arena: Box<ProductArena>,
+    normal: Vec3,
+    mirror: Vec3,
+}
+
+/// The shading point a sampler is built at: its hit, its shading point and the seed of the
+/// build's BRDF samples.
+pub(crate) struct Lead<'a> {
+    /// The primary hit.
+    pub hit: &'a Hit,
+    /// Its shading point.
+    pub sp: &'a ShadingPoint<'a, dyn Brdf + 'a>,
+    /// The seed of the build's BRDF samples.
+    pub seed: u64,
+}
+
+/// A tile's samplers, reused from pixel to pixel.
+pub(crate) struct SamplerCache {
+    /// For the product samplers built per shading point.
+    arena: Option<Box<ProductArena>>,
+    /// Per material, the product-MIS sampler built last and where.
+    shared: Vec<Option<SharedSampler>>,
+}
+
+impl SamplerCache {
+    /// An empty cache for a scene of `materials` materials.
+    pub fn new(materials: usize) -> Self {
+        Self { arena: None, shared: (0..materials).map(|_| None).collect() }
+    }
+
+    /// The sampling of `lead`'s material at its shading point, with the sampler it needs built
+    /// (or, for product-MIS, reused when built near enough).
+    pub fn sampling<'s, 'e>(
+        &'s mut self,
+        ctx: &Context<'s, 'e>,
+        env: &'s EnvHierarchy<'e>,
+        lead: &Lead<'_>,
+    ) -> Sampling<'s, 'e> {
+        let plan = &ctx.plans[lead.hit.material];
+        let sp = lead.sp;
+        match plan.strategy {
+            Strategy::Env => Sampling::Env,
+            Strategy::Brdf => Sampling::Brdf,
+            Strategy::Mis { env_share } => Sampling::Mis { env_share },
+            Strategy::Ris => Sampling::Ris,
+            Strategy::Product => Sampling::Product(self.product(ctx, env, ProductKind::Quadtree, lead)),
+            Strategy::Wavelet => Sampling::Product(self.product(ctx, env, ProductKind::Wavelet, lead)),
+            Strategy::ProductMis { product_share } => {
+                Sampling::ProductMis { sampler: self.shared_product(ctx, env, plan, lead), product_share }
+            }
+            Strategy::TwoStage => {
+                let sat = ctx.sat.expect("the summed-area table is built when a material is sampled two-stage");
+                Sampling::TwoStage(TwoStageSampler::new(env, sat, sp.brdf, &sp.frame, sp.wo))
+            }
+        }
+    }
+
+    /// A product sampler of the paper's estimator, built for `lead` alone.
+    fn product<'s, 'e>(
+        &'s mut self,
+        ctx: &Context<'s, 'e>,
+        env: &'s EnvHierarchy<'e>,
+        kind: ProductKind,
+        lead: &Lead<'_>,
+    ) -> ProductSampler<'s, 'e> {
+        let params = ProductParams { brdf_samples: ctx.options.brdf_samples, kind, ..ProductParams::default() };
+        let arena = self.arena.get_or_insert_with(|| Box::new(ProductArena::new()));
+        let sp = lead.sp;
+        arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed)
+    }
+
+    /// The product-MIS sampler of `lead`'s material: the kept one if it was built within the
+    /// material's reuse angle (and the material is not textured), otherwise built anew and kept.
+    fn shared_product<'s, 'e>(
+        &'s mut self,
+        ctx: &Context<'s, 'e>,
+        env: &'s EnvHierarchy<'e>,
+        plan: &MaterialPlan,
+        lead: &Lead<'_>,
+    ) -> ProductSampler<'s, 'e> {
+        let (hit, sp) = (lead.hit, lead.sp);
+        let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
+        let cos = plan.reuse_cosine;
+        let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
+        let slot = &mut self.shared[hit.material];
+        if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
+            let c = slot.get_or_insert_with(|| SharedSampler { arena: Box::new(ProductArena::new()), normal, mirror });
+            let params = ProductParams::for_mis(ctx.options.brdf_samples);
+            c.arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed);
+            (c.normal, c.mirror) = (normal, mirror);
+        }
+        let slot: &'s Option<SharedSampler> = slot;
+        slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above")
+    }
+}
+
+/// The mirror direction of `wo` about `n`.
+fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    2.0 * wo.dot(n) * n - wo
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sampler_core::brdf::{Lambert, RoughConductor};
+
+    #[test]
+    fn samplers_are_reused_within_half_the_sharpest_lobe() {
+        let close = |bsdf: &Bsdf, angle: f32| (reuse_cosine(bsdf) - angle.cos()).abs() < 1e-6;
+        assert!(close(&Bsdf::Conductor(RoughConductor::new(0.05, Vec3::ONE)), 0.025));
+        assert!(close(&Bsdf::Diffuse(Lambert::new(Vec3::ONE)), 0.2));
+        let paint = sampler_core::brdf::CarPaint::default();
+        assert!(close(&Bsdf::CarPaint(paint), 0.5 * paint.coat_ggx.alpha()));
+        let no_coat = sampler_core::brdf::CarPaint { coat: 0.0, ..paint };
+        assert!(close(&Bsdf::CarPaint(no_coat), 0.5 * paint.flake_ggx.alpha()));
+    }
+}

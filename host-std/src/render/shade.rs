@@ -1,0 +1,293 @@
+//! Direct illumination from the environment at one shading point, by each strategy, with the
+//! same budget: `budget` visibility samples (shadow rays) per shading point. MIS in pairs spends
+//! them one per technique, so it takes ⌊budget/2⌋ pairs (at least one).
+
+use sampler_core::brdf::Brdf;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::{self, BATCH, Contribution, ShadingPoint, Visibility};
+use sampler_core::glam::{DVec2, DVec3, Vec2, Vec3};
+use sampler_core::points::sobol02;
+use sampler_core::rng::hash_combine;
+use sampler_core::sampler::ProductSampler;
+use sampler_core::two_stage::TwoStageSampler;
+
+/// Candidates per RIS estimate (each costs an env or BRDF sample and an evaluation, no ray).
+pub const RIS_CANDIDATES: usize = 8;
+
+/// Counts the shadow rays a visibility closure traces.
+pub struct CountingVisibility<F: FnMut(Vec3) -> bool> {
+    /// Whether the light is visible in a direction.
+    pub test: F,
+    /// Directions tested so far.
+    pub rays: u64,
+}
+
+impl<F: FnMut(Vec3) -> bool> Visibility for CountingVisibility<F> {
+    fn visible(&mut self, dir: Vec3) -> bool {
+        self.rays += 1;
+        (self.test)(dir)
+    }
+}
+
+/// What a shading point samples the light with: its strategy, holding the sampler the strategy
+/// needs, built. A product sampler or two-stage partition may have been built for another
+/// shading point of the same pixel and material (still unbiased: it is a valid density that is
+/// positive wherever L > 0).
+// The two-stage partition makes one variant large; a `Sampling` lives on the stack for one
+// group of shading points, and boxing it would allocate per shading point.
+#[allow(clippy::large_enum_variant)]
+pub enum Sampling<'s, 'e> {
+    /// Env samples only.
+    Env,
+    /// BRDF samples only.
+    Brdf,
+    /// MIS of env and BRDF samples (see [`Strategy::Mis`](crate::render::strategy::Strategy::Mis)).
+    Mis {
+        /// Share of the budget spent on env samples; ½ spends it in pairs.
+        env_share: f64,
+    },
+    /// Resampled importance sampling.
+    Ris,
+    /// Product samples (quadtree or wavelet product), the paper's estimator.
+    Product(ProductSampler<'s, 'e>),
+    /// MIS of product and BRDF samples.
+    ProductMis {
+        /// The product sampler, possibly shared with other shading points.
+        sampler: ProductSampler<'s, 'e>,
+        /// Share of the budget spent on product samples.
+        product_share: f64,
+    },
+    /// Two-stage importance sampling through its partition.
+    TwoStage(TwoStageSampler<'s, 'e>),
+}
+
+/// Where a shading point's samples come from: the pixel's light-sample seed, and the block of
+/// the pixel's sequences this shading point takes (the pixel's shading points together draw one
+/// (0,2)-net per technique, stratified over the whole pixel, not per point).
+#[derive(Clone, Copy, Debug)]
+pub struct Run {
+    /// The seed of the pixel's light-sample sequences.
+    pub seed: u64,
+    /// This shading point's block of them.
+    pub block: usize,
+}
+
+/// Mean radiance reflected towards `sp.wo` by direct environment light, from `budget`
+/// visibility samples drawn as `sampling` says. The MIS strategies with a split spend their
+/// share of the budget on their first technique (product or env samples) and the rest on BRDF
+/// samples (at least one of each).
+pub fn shade<B: Brdf + ?Sized>(
+    sampling: &Sampling<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    budget: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let budget = budget.max(1);
+    match sampling {
+        Sampling::ProductMis { sampler, product_share } => {
+            shade_split(First::Product(sampler), sp, budget, *product_share, run, vis)
+        }
+        Sampling::Mis { env_share } if *env_share != 0.5 => {
+            shade_split(First::Env(env), sp, budget, *env_share, run, vis)
+        }
+        Sampling::Mis { .. } => mis_pairs(env, sp, (budget / 2).max(1), run, vis),
+        Sampling::Env => env_only(env, sp, budget, run, vis),
+        Sampling::Brdf => brdf_only(env, sp, budget, run, vis),
+        Sampling::Ris => ris(env, sp, budget, run, vis),
+        Sampling::Product(sampler) => product(sampler, sp, budget, run, vis),
+        Sampling::TwoStage(sampler) => two_stage(sampler, env, sp, budget, run, vis),
+    }
+}
+
+/// The mean of `n` samples of one technique: `batch` gets each batch of this shading point's
+/// run of the pixel's (0,2)-sequence, the run's first index and the batch's offset in it, and
+/// adds the batch's values to the sum in order. Batches are a power of two long, which keeps
+/// each one a (0,2)-net.
+fn batched(n: usize, run: Run, mut batch: impl FnMut(&[DVec2], u32, usize, &mut DVec3)) -> DVec3 {
+    let first = (run.block * n) as u32;
+    let mut points = [DVec2::ZERO; BATCH];
+    let mut sum = DVec3::ZERO;
+    let mut done = 0;
+    while done < n {
+        let m = (n - done).min(BATCH);
+        sobol02(hash_combine(run.seed, 1), first + done as u32, &mut points[..m]);
+        batch(&points[..m], first, done, &mut sum);
+        done += m;
+    }
+    sum / n as f64
+}
+
+/// `points` as the f32 points the BRDF samplers take.
+fn brdf_points(points: &[DVec2]) -> [Vec2; BATCH] {
+    let mut out = [Vec2::ZERO; BATCH];
+    for (b, p) in out.iter_mut().zip(points) {
+        *b = p.as_vec2();
+    }
+    out
+}
+
+/// MIS of env and BRDF samples in `n` pairs; the batch's env samples are drawn together (their
+/// descents overlap).
+fn mis_pairs<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut others = [DVec2::ZERO; BATCH];
+    let mut drawn = [None; BATCH];
+    let mut pairs = [[Contribution::default(); 2]; BATCH];
+    batched(n, run, |points, first, done, sum| {
+        let m = points.len();
+        sobol02(hash_combine(run.seed, 2), first + done as u32, &mut others[..m]);
+        env.sample_many(points, &mut drawn[..m]);
+        let brdf = brdf_points(&others[..m]);
+        estimator::mis_many(env, sp, &drawn[..m], &brdf[..m], vis, &mut pairs[..m]);
+        for pair in &pairs[..m] {
+            *sum += pair[0].value + pair[1].value;
+        }
+    })
+}
+
+/// Env samples only, each batch drawn together.
+fn env_only<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut drawn = [None; BATCH];
+    let mut singles = [Contribution::default(); BATCH];
+    batched(n, run, |points, _, _, sum| {
+        let m = points.len();
+        env.sample_many(points, &mut drawn[..m]);
+        estimator::env_many(env, sp, &drawn[..m], vis, &mut singles[..m]);
+        for s in &singles[..m] {
+            *sum += s.value;
+        }
+    })
+}
+
+/// BRDF samples only.
+fn brdf_only<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut singles = [Contribution::default(); BATCH];
+    batched(n, run, |points, _, _, sum| {
+        let m = points.len();
+        let brdf = brdf_points(points);
+        estimator::brdf_many(env, sp, &brdf[..m], vis, &mut singles[..m]);
+        for s in &singles[..m] {
+            *sum += s.value;
+        }
+    })
+}
+
+/// Resampled importance sampling: per sample, [`RIS_CANDIDATES`] candidates from their own
+/// sequence, one chosen by the sample's point.
+fn ris<B: Brdf + ?Sized>(
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    batched(n, run, |points, first, done, sum| {
+        for (k, u) in points.iter().enumerate() {
+            let mut candidates = [DVec2::ZERO; RIS_CANDIDATES];
+            sobol02(hash_combine(run.seed, 3 + first as u64 + (done + k) as u64), 0, &mut candidates);
+            *sum += estimator::ris(env, sp, &candidates, u.x, vis).value;
+        }
+    })
+}
+
+/// Product samples, each batch drawn together.
+fn product<B: Brdf + ?Sized>(
+    sampler: &ProductSampler<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut drawn = [None; BATCH];
+    batched(n, run, |points, _, _, sum| {
+        let m = points.len();
+        sampler.sample_many(points, &mut drawn[..m]);
+        for d in &drawn[..m] {
+            *sum += estimator::product_drawn(sampler, sp, *d, vis).value;
+        }
+    })
+}
+
+/// Two-stage samples through the partition.
+fn two_stage<B: Brdf + ?Sized>(
+    sampler: &TwoStageSampler<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    batched(n, run, |points, _, _, sum| {
+        for u in points {
+            *sum += estimator::two_stage(sampler, env, sp, *u, vis).value;
+        }
+    })
+}
+
+/// The technique an MIS split draws beside BRDF sampling.
+enum First<'s, 'e> {
+    Product(&'s ProductSampler<'s, 'e>),
+    Env(&'s EnvHierarchy<'e>),
+}
+
+/// MIS at one shading point with the budget split: ⌊share·budget⌉ samples of `first` and the
+/// rest BRDF samples (at least one of each; a budget of one still takes one of each), each
+/// technique's points this shading point's run of the pixel's (0,2)-sequence for it.
+fn shade_split<B: Brdf + ?Sized>(
+    first: First<'_, '_>,
+    sp: &ShadingPoint<'_, B>,
+    budget: usize,
+    share: f64,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let Run { seed, block } = run;
+    let (n_p, n_b) = if budget < 2 {
+        (1, 1)
+    } else {
+        let n_p = ((share * budget as f64).round() as usize).clamp(1, budget - 1);
+        (n_p, budget - n_p)
+    };
+    let total = (n_p + n_b) as f64;
+    let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
+    let mut sum = DVec3::ZERO;
+    let (mut done_p, mut done_b) = (0, 0);
+    let mut first_points = [DVec2::ZERO; BATCH];
+    let mut brdf_points = [DVec2::ZERO; BATCH];
+    let mut brdf_points_f32 = [Vec2::ZERO; BATCH];
+    // Batches of each technique's points (a power of two keeps each batch a net).
+    while done_p < n_p || done_b < n_b {
+        let (m_p, m_b) = ((n_p - done_p).min(BATCH), (n_b - done_b).min(BATCH));
+        sobol02(hash_combine(seed, 1), (block * n_p + done_p) as u32, &mut first_points[..m_p]);
+        sobol02(hash_combine(seed, 2), (block * n_b + done_b) as u32, &mut brdf_points[..m_b]);
+        for (b, o) in brdf_points_f32.iter_mut().zip(&brdf_points[..m_b]) {
+            *b = o.as_vec2();
+        }
+        let (u_p, u_b) = (&first_points[..m_p], &brdf_points_f32[..m_b]);
+        sum += match first {
+            First::Product(sampler) => estimator::product_mis_split(sampler, sp, u_p, u_b, shares, vis),
+            First::Env(env) => estimator::mis_split(env, sp, u_p, u_b, shares, vis),
+        };
+        (done_p, done_b) = (done_p + m_p, done_b + m_b);
+    }
+    sum / total
+}

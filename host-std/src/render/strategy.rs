@@ -1,0 +1,57 @@
+//! What a material's shading points sample the light with, resolved before the render (by
+//! `plan`): the strategy, with the share of the budget a two-technique strategy spends on its
+//! first technique.
+
+use crate::render::sampler_cache::reuse_cosine;
+use crate::scene::Bsdf;
+
+/// How a material's shading points sample the light. Every method but `auto` is one of these
+/// for every material; `auto` picks one per material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Strategy {
+    /// Product importance sampling, quadtree product (the paper).
+    Product,
+    /// Product importance sampling, Haar wavelet product.
+    Wavelet,
+    /// Environment-only importance sampling through the same hierarchy.
+    Env,
+    /// BRDF importance sampling.
+    Brdf,
+    /// MIS (balance heuristic) of env and BRDF sampling. At an `env_share` of ½ the budget is
+    /// spent in pairs, one sample per technique, as Mitsuba's `direct` integrator; otherwise
+    /// `env_share` of it on env samples and the rest on BRDF samples.
+    Mis {
+        /// Share of the budget spent on env samples.
+        env_share: f64,
+    },
+    /// MIS of product and BRDF sampling, with a product sampler shared per pixel and material
+    /// and reused by the tile's next pixels.
+    ProductMis {
+        /// Share of the budget spent on product samples.
+        product_share: f64,
+    },
+    /// Resampled importance sampling: [`RIS_CANDIDATES`](crate::render::shade::RIS_CANDIDATES)
+    /// env/BRDF candidates, one shadow ray.
+    Ris,
+    /// Two-stage importance sampling (Cline et al. 2006, reconstructed in sampler-core's
+    /// `two_stage.rs`): a BRDF-driven partition weighted through a summed-area table.
+    TwoStage,
+}
+
+/// How a material is shaded, resolved once per render.
+#[derive(Clone, Copy, Debug)]
+pub struct MaterialPlan {
+    /// What its shading points sample the light with.
+    pub strategy: Strategy,
+    /// Cosine of the angle within which a product-MIS sampler is reused (see
+    /// [`reuse_cosine`]).
+    pub reuse_cosine: f32,
+}
+
+impl MaterialPlan {
+    /// The plan that samples `bsdf` with `strategy`.
+    #[must_use]
+    pub fn new(strategy: Strategy, bsdf: &Bsdf) -> Self {
+        Self { strategy, reuse_cosine: reuse_cosine(bsdf) }
+    }
+}

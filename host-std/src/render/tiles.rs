@@ -1,0 +1,68 @@
+//! The image in 16×16 tiles over rayon's threads, each tile with its own scratch (and so its
+//! own kept samplers), put together in a fixed order whatever the thread count.
+
+use crate::render::pixel::{Scratch, pixel};
+use crate::render::{Context, Counters};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Tile edge, in pixels.
+pub const TILE: usize = 16;
+
+/// A rendered image and what rendering it did.
+pub struct Image {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Linear RGB, rows top to bottom.
+    pub pixels: Vec<[f32; 3]>,
+    /// What the render did.
+    pub counters: Counters,
+}
+
+/// Renders every pixel. `start` is when the caller's clock started: the progress bar shows
+/// once a second has passed since (and `ctx.options.progress` asks for it).
+pub fn render_tiles(ctx: &Context<'_, '_>, start: Instant) -> Image {
+    let (w, h) = (ctx.camera.width as usize, ctx.camera.height as usize);
+    let tiles: Vec<(usize, usize)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
+    let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent}% ETA {eta}").expect("valid template"),
+    );
+    let shown = AtomicBool::new(false);
+    let results: Vec<(Vec<[f32; 3]>, Counters)> = tiles
+        .par_iter()
+        .map(|&(tx, ty)| {
+            let mut scratch = Scratch::new(ctx.scene.materials.len(), ctx.options.shading_points);
+            let mut out = Vec::with_capacity(TILE * TILE);
+            for y in ty * TILE..((ty + 1) * TILE).min(h) {
+                for x in tx * TILE..((tx + 1) * TILE).min(w) {
+                    out.push(pixel(ctx, x, y, &mut scratch));
+                }
+            }
+            if ctx.options.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+            bar.inc(1);
+            (out, scratch.counters)
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut pixels = vec![[0.0f32; 3]; w * h];
+    let mut counters = Counters::default();
+    for (&(tx, ty), (tile, c)) in tiles.iter().zip(&results) {
+        counters += *c;
+        let mut k = 0;
+        for y in ty * TILE..((ty + 1) * TILE).min(h) {
+            for x in tx * TILE..((tx + 1) * TILE).min(w) {
+                pixels[y * w + x] = tile[k];
+                k += 1;
+            }
+        }
+    }
+    Image { width: w, height: h, pixels, counters }
+}

@@ -1,0 +1,16 @@
+//! What is rendered: the scene model and the loaders that fill it — the built-in scene, the
+//! JSON format, USD stages, triangle meshes (OBJ, PLY) and image textures. Depends on `light`
+//! for the environment a scene names.
+
+pub mod builtin;
+pub mod json;
+pub mod mesh;
+mod model;
+pub mod ply;
+pub mod texture;
+#[cfg(feature = "usd")]
+pub mod usd;
+#[cfg(feature = "usd")]
+pub mod usd_info;
+
+pub use model::*;
