@@ -1,4 +1,4 @@
-//! The JSON scene format of `../shared/docs/scene-format.md` (copied in docs/scene-format.md):
+//! The JSON scene format of docs/scene-format.md:
 //! camera, environment, spheres, rectangles and meshes with diffuse, rough-conductor, Phong and
 //! car-paint materials. Unknown fields are errors: a misspelt key must not silently render
 //! something else.
