@@ -3350,7 +3350,9 @@ impl StageBuilder {
         // layer this collection opened.
         let root_stack_vars = self.root_stack_expression_variables(root_path)?;
         let session = self.collect_optional_session_layers(&root_stack_vars)?;
-        let root = self.collect_layers(root_path, &root_stack_vars)?;
+        let root = self.collect_layers(root_path, &root_stack_vars);
+        self.registry.forget_peeked();
+        let root = root?;
         let session_layer_count = session.layers.len();
         let layers = session.layers.into_iter().chain(root.layers).collect();
         let errors = session.errors.into_iter().chain(root.errors).collect();
