@@ -1,4 +1,6 @@
-use std::{fmt, result, str::FromStr};
+use std::hash::{Hash, Hasher};
+use std::sync::Arc;
+use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};
 
@@ -27,9 +29,59 @@ fn is_prim_name_char(c: char) -> bool {
 ///   begin with a colon.
 /// - Brackets ("[" and "]") are used to indicate relationship target paths for
 ///   relational attributes.
-#[derive(Debug, Default, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+///
+/// The text is shared (`Arc<str>`) and its hash computed once when the path is
+/// made: paths are cloned into and looked up in many maps (specs, prim indices,
+/// dependencies), and a prim's path is as long as its depth, so copying or
+/// hashing the text per use makes deep namespaces quadratic.
+#[derive(Clone)]
 pub struct Path {
-    path: String,
+    path: Arc<str>,
+    hash: u64,
+}
+
+impl Path {
+    fn from_string(text: String) -> Path {
+        Path::from_str_unchecked(&text)
+    }
+}
+
+impl Default for Path {
+    fn default() -> Self {
+        Path::from_str_unchecked("")
+    }
+}
+
+impl fmt::Debug for Path {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Path").field("path", &&*self.path).finish()
+    }
+}
+
+impl PartialEq for Path {
+    fn eq(&self, other: &Self) -> bool {
+        self.hash == other.hash && (Arc::ptr_eq(&self.path, &other.path) || self.path == other.path)
+    }
+}
+
+impl Eq for Path {}
+
+impl PartialOrd for Path {
+    fn partial_cmp(&self, other: &Self) -> Option<cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Path {
+    fn cmp(&self, other: &Self) -> cmp::Ordering {
+        self.path.cmp(&other.path)
+    }
+}
+
+impl Hash for Path {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_u64(self.hash);
+    }
 }
 
 impl fmt::Display for Path {
@@ -49,7 +101,7 @@ impl FromStr for Path {
     type Err = anyhow::Error;
 
     fn from_str(s: &str) -> result::Result<Path, Self::Err> {
-        Ok(Path { path: s.to_string() })
+        Ok(Path::from_str_unchecked(s))
     }
 }
 
@@ -64,7 +116,13 @@ impl Path {
     }
 
     fn from_str_unchecked(path: &str) -> Path {
-        Path { path: path.to_string() }
+        // A fixed-key SipHash, so equal texts hash equal in every map and process.
+        let mut hasher = std::hash::DefaultHasher::new();
+        path.hash(&mut hasher);
+        Path {
+            path: Arc::from(path),
+            hash: hasher.finish(),
+        }
     }
 
     #[inline]
@@ -75,7 +133,7 @@ impl Path {
     /// Returns `true` if this is the absolute root path `/` (pseudo-root).
     #[inline]
     pub fn is_abs_root(&self) -> bool {
-        self.path == "/"
+        &*self.path == "/"
     }
 
     /// Whether this path's prim is a root prim — a direct child of the
@@ -99,11 +157,11 @@ impl Path {
         ensure!(!self.is_property_path(), "Cannot append property to property path");
         ensure!(property != ".", "Property name cannot be '.'");
 
-        let mut new_path = self.path.clone();
+        let mut new_path = self.path.to_string();
         new_path.push('.');
         new_path.push_str(property);
 
-        Ok(Path { path: new_path })
+        Ok(Path::from_string(new_path))
     }
 
     pub fn append_path(&self, path: impl Into<Path>) -> Result<Path> {
@@ -121,7 +179,7 @@ impl Path {
 
         // If base is slash only.
         // "/" + "foo/bar" => "/foo/bar"
-        let combined = if self.path.as_str() == "/" {
+        let combined = if self.as_str() == "/" {
             format!("/{}", append.path)
         } else if self.is_prim_variant_selection_path() {
             // A prim child attaches directly to a variant selection with no
@@ -131,7 +189,7 @@ impl Path {
             format!("{}/{}", self.path, append.path)
         };
 
-        Ok(Path { path: combined })
+        Ok(Path::from_string(combined))
     }
 
     pub fn is_property_path(&self) -> bool {
@@ -338,7 +396,7 @@ impl Path {
     /// "/A{set=sel}"   -> Some(Variant { set: "set", selection: "sel" })
     /// ```
     pub fn last_element(&self) -> Option<PathElement<'_>> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // A property's element is the whole property name (everything after
@@ -379,7 +437,7 @@ impl Path {
     /// ""            -> None
     /// ```
     pub fn parent(&self) -> Option<Path> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // Drop a trailing `{set=sel}` variant selection.
@@ -446,7 +504,7 @@ impl Path {
     /// ""       -> None
     /// ```
     pub fn name(&self) -> Option<&str> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // The final prim name begins after the rightmost `/` or `}` (a child of
@@ -457,7 +515,7 @@ impl Path {
         if start < self.path.len() {
             Some(&self.path[start..])
         } else {
-            Some(self.path.rsplit_once('/').map_or(self.path.as_str(), |(_, name)| name))
+            Some(self.path.rsplit_once('/').map_or(self.as_str(), |(_, name)| name))
         }
     }
 
@@ -530,7 +588,7 @@ impl Path {
             return self.clone();
         }
         let mut out = String::with_capacity(self.path.len());
-        let mut rest = self.path.as_str();
+        let mut rest = self.as_str();
         let mut depth = 0usize;
         let mut chars = rest.char_indices();
         // Splice out each depth-0 `{…}` span; bracketed spans pass through.
@@ -872,13 +930,13 @@ impl From<&Path> for Path {
 
 impl From<&str> for Path {
     fn from(s: &str) -> Self {
-        Path { path: s.to_string() }
+        Path::from_str_unchecked(s)
     }
 }
 
 impl From<String> for Path {
     fn from(value: String) -> Self {
-        Path { path: value }
+        Path::from_string(value)
     }
 }
 
@@ -1174,7 +1232,7 @@ mod tests {
         let split = |s: &str| {
             Path::from_str_unchecked(s)
                 .split_property()
-                .map(|(p, n)| (p.path, n.to_owned()))
+                .map(|(p, n)| (p.path.to_string(), n.to_owned()))
         };
         let owned = |p: &str, n: &str| Some((p.to_owned(), n.to_owned()));
 
