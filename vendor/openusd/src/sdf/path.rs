@@ -110,9 +110,11 @@ impl Path {
         Path::from_str(path)
     }
 
+    /// The absolute root `/`, shared: it is made for many comparisons.
     #[inline]
     pub fn abs_root() -> Path {
-        Path::from_str_unchecked("/")
+        static ROOT: std::sync::LazyLock<Path> = std::sync::LazyLock::new(|| Path::from_str_unchecked("/"));
+        ROOT.clone()
     }
 
     fn from_str_unchecked(path: &str) -> Path {
@@ -697,6 +699,11 @@ impl Path {
             && !old_prefix.is_prim_variant_selection_path()
         {
             return None;
+        }
+        // Mapping a namespace onto itself (a prim's own node, the common case)
+        // yields the path itself: no new text to make.
+        if old_prefix == new_prefix {
+            return Some(self.clone());
         }
         // Ensure a separator between new prefix and suffix for non-root.
         if old == "/" && !suffix.is_empty() {
