@@ -14,6 +14,8 @@ use value::convert;
 use openusd::ar::{self, Resolver};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::{sdf, usd};
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::path::Path;
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -32,6 +34,8 @@ impl Xformable for AnyXformable {}
 pub struct Stage {
     inner: usd::Stage,
     time: usd::TimeCode,
+    /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
+    binding_api: RefCell<HashMap<String, bool>>,
 }
 
 type Result<T> = std::result::Result<T, String>;
@@ -51,7 +55,7 @@ impl Stage {
         let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
         let inner = usd::Stage::open(name).map_err(err)?;
         let time = usd::TimeCode::new(inner.start_time_code());
-        Ok(Self { inner, time })
+        Ok(Self { inner, time, binding_api: RefCell::default() })
     }
 
     /// Recoverable composition problems (a missing reference, payload or sublayer).
