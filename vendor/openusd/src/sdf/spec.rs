@@ -123,6 +123,10 @@ impl SpecData {
         if let Some(slot) = self.fields.iter_mut().find(|(k, _)| k == key) {
             slot.1 = value;
         } else {
+            // Grown one field at a time: a spec has a handful of fields, each as large
+            // as the largest `Value`, and the default first capacity of four would
+            // take more memory than the fields do.
+            self.fields.reserve_exact(1);
             self.fields.push((field_name(key), value));
         }
     }
@@ -181,7 +185,10 @@ impl SpecData {
         for (k, v) in other.fields {
             match self.fields.iter_mut().find(|(key, _)| *key == k) {
                 Some(slot) => slot.1 = v,
-                None => self.fields.push((k, v)),
+                None => {
+                    self.fields.reserve_exact(1);
+                    self.fields.push((k, v));
+                }
             }
         }
     }
