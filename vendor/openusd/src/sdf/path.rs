@@ -4,8 +4,6 @@ use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};
 
-use crate::tf;
-
 #[inline]
 pub fn path(str: impl AsRef<str>) -> Result<Path> {
     let path = str.as_ref();
@@ -43,6 +41,27 @@ pub struct Path {
 impl Path {
     fn from_string(text: String) -> Path {
         Path::from_str_unchecked(&text)
+    }
+
+    /// The path whose text is `parts` in a row. Short texts are put together on
+    /// the stack, so the path's own allocation is the only one.
+    pub(crate) fn from_parts(parts: &[&str]) -> Path {
+        const STACK: usize = 256;
+        let len: usize = parts.iter().map(|p| p.len()).sum();
+        if len > STACK {
+            return Path::from_string(parts.concat());
+        }
+        let mut buf = [0u8; STACK];
+        let mut at = 0;
+        for part in parts {
+            buf[at..at + part.len()].copy_from_slice(part.as_bytes());
+            at += part.len();
+        }
+        match std::str::from_utf8(&buf[..len]) {
+            Ok(text) => Path::from_str_unchecked(text),
+            // Unreachable: a concatenation of `str`s is UTF-8.
+            Err(_) => Path::from_string(parts.concat()),
+        }
     }
 }
 
@@ -151,19 +170,14 @@ impl Path {
         self.path.is_empty()
     }
 
-    pub fn append_property(&self, property: impl Into<tf::Token>) -> Result<Path> {
-        let property = property.into();
-        let property = property.as_str();
+    pub fn append_property(&self, property: impl AsRef<str>) -> Result<Path> {
+        let property = property.as_ref();
         // TODO: Validate property name more carefully here.
         ensure!(!property.is_empty(), "Property name cannot be empty");
         ensure!(!self.is_property_path(), "Cannot append property to property path");
         ensure!(property != ".", "Property name cannot be '.'");
 
-        let mut new_path = self.path.to_string();
-        new_path.push('.');
-        new_path.push_str(property);
-
-        Ok(Path::from_string(new_path))
+        Ok(Path::from_parts(&[self.as_str(), ".", property]))
     }
 
     pub fn append_path(&self, path: impl Into<Path>) -> Result<Path> {
@@ -182,16 +196,16 @@ impl Path {
         // If base is slash only.
         // "/" + "foo/bar" => "/foo/bar"
         let combined = if self.as_str() == "/" {
-            format!("/{}", append.path)
+            Path::from_parts(&["/", append.as_str()])
         } else if self.is_prim_variant_selection_path() {
             // A prim child attaches directly to a variant selection with no
             // separator: "/A{v=s}" + "B" => "/A{v=s}B" (C++ SdfPath::AppendChild).
-            format!("{}{}", self.path, append.path)
+            Path::from_parts(&[self.as_str(), append.as_str()])
         } else {
-            format!("{}/{}", self.path, append.path)
+            Path::from_parts(&[self.as_str(), "/", append.as_str()])
         };
 
-        Ok(Path::from_string(combined))
+        Ok(combined)
     }
 
     pub fn is_property_path(&self) -> bool {
