@@ -8,7 +8,9 @@ use std::collections::HashMap;
 
 /// The value of `prim`: the unresolved ancestors (nearest memoised one or the
 /// pseudo-root, whose value is `root`, excluded) are resolved top-down, each by
-/// `step(path, parent's value)`, and memoised.
+/// `step(path, parent's value)`, and memoised. `prim` itself is not: the walk asks
+/// once per prim, and only ancestors are asked again (by each prim below them), so
+/// a stage's leaves, most of its prims, take no memory.
 pub fn resolve_down<T: Clone>(
     memo: &mut HashMap<String, T>,
     prim: &str,
@@ -27,9 +29,11 @@ pub fn resolve_down<T: Clone>(
         chain.push(here);
         here = parent_path(here).unwrap_or("/");
     };
-    for path in chain.into_iter().rev() {
+    for (i, path) in chain.into_iter().enumerate().rev() {
         value = step(path, &value)?;
-        memo.insert(path.to_string(), value.clone());
+        if i > 0 {
+            memo.insert(path.to_string(), value.clone());
+        }
     }
     Ok(value)
 }

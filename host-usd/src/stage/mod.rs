@@ -14,6 +14,8 @@ use value::convert;
 use openusd::ar::{self, Resolver};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::{sdf, usd};
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::path::Path;
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -32,6 +34,10 @@ impl Xformable for AnyXformable {}
 pub struct Stage {
     inner: usd::Stage,
     time: usd::TimeCode,
+    /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
+    binding_api: RefCell<HashMap<String, bool>>,
+    /// The composed property names of the prim asked about last (see [`Stage::authors`]).
+    properties: RefCell<(String, Vec<openusd::tf::Token>)>,
 }
 
 type Result<T> = std::result::Result<T, String>;
@@ -51,7 +57,7 @@ impl Stage {
         let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
         let inner = usd::Stage::open(name).map_err(err)?;
         let time = usd::TimeCode::new(inner.start_time_code());
-        Ok(Self { inner, time })
+        Ok(Self { inner, time, binding_api: RefCell::default(), properties: RefCell::default() })
     }
 
     /// Recoverable composition problems (a missing reference, payload or sublayer).
@@ -119,9 +125,26 @@ impl Stage {
         Ok(names.iter().map(|t| t.as_str().to_string()).collect())
     }
 
+    /// Whether the prim has a property `name` among its composed property names. The
+    /// importer asks about each prim's attributes one after the other, most of them
+    /// unauthored (`doubleSided`, `visibility`, `purpose`, a mesh's optional arrays):
+    /// the prim's names are composed once and an absent attribute costs no value
+    /// resolution. Only the last prim's names are kept.
+    fn authors(&self, prim: &str, name: &str) -> Result<bool> {
+        let mut memo = self.properties.borrow_mut();
+        if memo.0 != prim {
+            let names = self.inner.prim(path(prim)?).property_names().map_err(err)?;
+            *memo = (prim.to_string(), names);
+        }
+        Ok(memo.1.iter().any(|n| n.as_str() == name))
+    }
+
     /// The composed value of `prim.attr` at the stage's start time (time samples
     /// interpolated), or its default; `None` when unauthored.
     pub fn value(&self, prim: &str, attr: &str) -> Result<Option<Value>> {
+        if !self.authors(prim, attr)? {
+            return Ok(None);
+        }
         let a = self.inner.prim(path(prim)?).attribute(attr);
         let v = a.get_at::<sdf::Value>(self.time).map_err(|e| format!("{prim}.{attr}: {}", err(e)))?;
         let v = match v {
@@ -133,18 +156,27 @@ impl Stage {
 
     /// A metadata field of an attribute (`interpolation`, `elementSize`).
     pub fn attr_metadata(&self, prim: &str, attr: &str, key: &str) -> Result<Option<Value>> {
+        if !self.authors(prim, attr)? {
+            return Ok(None);
+        }
         let a = self.inner.prim(path(prim)?).attribute(attr);
         Ok(a.get_metadata::<sdf::Value>(key).map_err(err)?.map(convert))
     }
 
     /// Targets of a relationship, as paths.
     pub fn targets(&self, prim: &str, rel: &str) -> Result<Vec<String>> {
+        if !self.authors(prim, rel)? {
+            return Ok(Vec::new());
+        }
         let r = self.inner.prim(path(prim)?).relationship(rel);
         Ok(r.targets().map_err(err)?.iter().map(|p| p.as_str().to_string()).collect())
     }
 
     /// The composed `xformOpOrder` (list edits applied), or `None` when unauthored.
     pub fn xform_op_order(&self, prim: &str) -> Result<Option<Vec<String>>> {
+        if !self.authors(prim, "xformOpOrder")? {
+            return Ok(None);
+        }
         AnyXformable(self.inner.prim(path(prim)?)).xform_op_order().map_err(err)
     }
 

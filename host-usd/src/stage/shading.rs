@@ -71,8 +71,8 @@ impl Stage {
             chain.push(here);
         }
         let mut with_api = Vec::new();
-        for here in &chain {
-            if MaterialBindingAPI::get(&self.inner, here.clone()).map_err(err)?.is_some() {
+        for (i, here) in chain.iter().enumerate() {
+            if self.applies_binding_api(here, i > 0)? {
                 with_api.push(here.clone());
             }
         }
@@ -111,6 +111,19 @@ impl Stage {
     }
 
     /// The material's surface shader id (`UsdPreviewSurface`, `ND_standard_surface…`), if any.
+    /// Whether the prim applies MaterialBindingAPI; memoised for `ancestor`s, which
+    /// every prim below them asks about again (once per prim, not per prim and level).
+    fn applies_binding_api(&self, prim: &sdf::Path, ancestor: bool) -> Result<bool> {
+        if let Some(&known) = self.binding_api.borrow().get(prim.as_str()) {
+            return Ok(known);
+        }
+        let applies = MaterialBindingAPI::get(&self.inner, prim.clone()).map_err(err)?.is_some();
+        if ancestor {
+            self.binding_api.borrow_mut().insert(prim.as_str().to_string(), applies);
+        }
+        Ok(applies)
+    }
+
     pub fn surface_shader(&self, material: &str) -> Result<Option<(String, String)>> {
         // The universal `outputs:surface`, followed through NodeGraph outputs (openusd 0.6
         // stops at a NodeGraph), is what a UsdPreviewSurface renderer reads.

@@ -197,7 +197,11 @@ impl Dependencies {
                 .insert(prim_index_path.clone());
         }
 
-        self.by_prim.insert(prim_index_path.clone(), registered);
+        // The common local-only index registers no site beyond its own root, so skip
+        // an empty entry (`remove` retracts nothing for a missing one).
+        if !registered.is_empty() {
+            self.by_prim.insert(prim_index_path.clone(), registered);
+        }
         self.by_prim_layers.insert(prim_index_path.clone(), layers);
         // The common arc-free, expression-free index registers under no stack
         // (its only stack is the implicit root), so skip an empty entry.

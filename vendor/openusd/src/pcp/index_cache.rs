@@ -675,7 +675,7 @@ impl IndexCache {
         };
 
         for node in index.nodes() {
-            let query_path = Path::new(&format!("{}{suffix}", node.path))?;
+            let query_path = Path::from_parts(&[node.path.as_str(), suffix]);
             for &(layer, _) in graph.layer_stack(node.layer_stack_id()).iter() {
                 if !local_layers.contains(&layer) {
                     continue;
@@ -2139,11 +2139,18 @@ impl IndexCache {
         // Report inconsistent property types once per prim composition (C++
         // `PcpErrorInconsistentPropertyType`); a later property-stack query
         // reports the conflict again, matching C++'s per-pass reporting.
-        // TODO(perf): this composes property names on every prim build to find a
-        // rare conflict; gate it on a cheaper signal (e.g. a node carrying both
-        // attribute and relationship specs) before scanning.
-        let names = self.composed_property_names(graph, path)?;
-        self.report_property_type_conflicts(graph, path, &names);
+        // A conflict takes two specs of one property, so a prim with a single live
+        // spec site (most prims of most stages) has none: the names are composed
+        // and scanned only when there is a second opinion to disagree with.
+        // (ppis patch: the upstream TODO(perf) at this spot.)
+        let has_two_sites = self
+            .store
+            .index_at(path)
+            .is_some_and(|index| index.live_spec_sites().nth(1).is_some());
+        if has_two_sites {
+            let names = self.composed_property_names(graph, path)?;
+            self.report_property_type_conflicts(graph, path, &names);
+        }
         Ok(())
     }
 

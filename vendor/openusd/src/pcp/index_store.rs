@@ -28,7 +28,7 @@ pub(super) struct IndexStore {
     /// Per-prim composition records, keyed by composed path. A [`sdf::PathTable`]
     /// so [`remove_subtree`](Self::remove_subtree) erases an invalidated subtree
     /// by a namespace walk.
-    entries: sdf::PathTable<PrimEntry>,
+    entries: sdf::PathTable<Box<PrimEntry>>,
     /// Reverse `(layer, site) → prim-index-path` map for surgical invalidation,
     /// kept in lockstep with `entries`.
     deps: Dependencies,
@@ -67,7 +67,7 @@ impl IndexStore {
 
     /// The whole per-prim table, for the builder and relocate evaluation to read
     /// already-composed indices keyed by stage path.
-    pub(super) fn entries(&self) -> &sdf::PathTable<PrimEntry> {
+    pub(super) fn entries(&self) -> &sdf::PathTable<Box<PrimEntry>> {
         &self.entries
     }
 
@@ -106,14 +106,16 @@ impl IndexStore {
         expr_var_deps: ExprVarDeps,
     ) {
         self.deps.add(path, &index, graph, expr_var_deps);
+        // Boxed: an entry is several hundred bytes, and the table's spare capacity
+        // (up to half of it after a growth) would hold that much per empty slot.
         self.entries.insert(
             path.clone(),
-            PrimEntry {
+            Box::new(PrimEntry {
                 index,
                 context,
                 errors,
                 resolved_targets: HashMap::new(),
-            },
+            }),
         );
     }
 

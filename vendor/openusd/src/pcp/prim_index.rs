@@ -654,7 +654,7 @@ impl PrimIndex {
         path: &Path,
         stack: &LayerGraph,
         ctx: &CompositionContext,
-        cached_indices: &sdf::PathTable<PrimEntry>,
+        cached_indices: &sdf::PathTable<Box<PrimEntry>>,
         load_payloads: bool,
     ) -> BuildResult<(Self, Vec<Error>, Vec<Demand>, ExprVarDeps)> {
         Self::build_with_cache_in(
@@ -680,7 +680,7 @@ impl PrimIndex {
         path: &Path,
         stack: &LayerGraph,
         ctx: &CompositionContext,
-        cached_indices: &sdf::PathTable<PrimEntry>,
+        cached_indices: &sdf::PathTable<Box<PrimEntry>>,
         ambient: LayerStackId,
         load_payloads: bool,
     ) -> BuildResult<(Self, Vec<Error>, Vec<Demand>, ExprVarDeps)> {
@@ -1102,7 +1102,7 @@ pub(crate) mod tests {
         chain.reverse();
 
         loop {
-            let mut cache: sdf::PathTable<PrimEntry> = sdf::PathTable::new();
+            let mut cache: sdf::PathTable<Box<PrimEntry>> = sdf::PathTable::new();
             let mut parent_ctx = CompositionContext {
                 variant_fallbacks: fallbacks.clone(),
                 ..CompositionContext::default()
@@ -1117,12 +1117,12 @@ pub(crate) mod tests {
                 parent_ctx = index.context_for_children(stack, &parent_ctx).0;
                 cache.insert(
                     ancestor.clone(),
-                    PrimEntry {
+                    Box::new(PrimEntry {
                         index: index.clone(),
                         context: CompositionContext::default(),
                         errors: Vec::new(),
                         resolved_targets: HashMap::new(),
-                    },
+                    }),
                 );
                 last = Some(index);
             }

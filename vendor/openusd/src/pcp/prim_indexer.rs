@@ -435,7 +435,7 @@ struct Inputs<'a> {
     /// Cached prim indices from the composition cache. The parent prim's index
     /// is read from here to seed this child's graph (C++
     /// `_BuildInitialPrimIndexFromAncestor`).
-    cached_indices: &'a sdf::PathTable<PrimEntry>,
+    cached_indices: &'a sdf::PathTable<Box<PrimEntry>>,
     /// Whether payload arcs are expanded during composition — the per-path
     /// decision for the site being built (`IndexCache::is_loaded`), not
     /// something `ctx` carries, since a sibling prim can resolve differently.
@@ -521,7 +521,7 @@ impl<'a, 'f> Indexer<'a, 'f> {
     pub(crate) fn new(
         stack: &'a LayerGraph,
         ctx: &'a CompositionContext,
-        cached_indices: &'a sdf::PathTable<PrimEntry>,
+        cached_indices: &'a sdf::PathTable<Box<PrimEntry>>,
         ambient: LayerStackId,
         load_payloads: bool,
     ) -> Self {
@@ -3849,12 +3849,12 @@ mod tests {
         let mut cached = sdf::PathTable::new();
         cached.insert(
             Path::from("/Root"),
-            PrimEntry {
+            Box::new(PrimEntry {
                 index: root_index,
                 context: CompositionContext::default(),
                 errors: Vec::new(),
                 resolved_targets: Default::default(),
-            },
+            }),
         );
         let child = Indexer::new(&s, &ctx, &cached, ambient, true)
             .build(&Path::from("/Root/Child"))

@@ -544,7 +544,7 @@ fn relocate_invalid_reason(source: &Path, target: &Path) -> Option<InvalidReloca
 pub(crate) fn effective_relocates(
     graph: &LayerGraph,
     path: &Path,
-    indices: &sdf::PathTable<PrimEntry>,
+    indices: &sdf::PathTable<Box<PrimEntry>>,
 ) -> RelocateList {
     let stack_maps = collect_stack_maps(graph, path, indices);
     let mut result: RelocateList = Vec::new();
@@ -597,7 +597,7 @@ pub(crate) fn effective_relocates(
 fn collect_stack_maps(
     graph: &LayerGraph,
     path: &Path,
-    indices: &sdf::PathTable<PrimEntry>,
+    indices: &sdf::PathTable<Box<PrimEntry>>,
 ) -> Vec<(LayerStackId, MapFunction)> {
     let mut maps: Vec<(LayerStackId, MapFunction)> = Vec::new();
 
@@ -632,7 +632,7 @@ fn collect_stack_maps(
 
     // Sort for deterministic iteration: the collected layer-map order feeds
     // downstream relocate composition, so it must not depend on hash order.
-    let mut entries: Vec<(&Path, &PrimEntry)> = indices.iter().collect();
+    let mut entries: Vec<(&Path, &PrimEntry)> = indices.iter().map(|(p, e)| (p, &**e)).collect();
     entries.sort_by(|(a, _), (b, _)| a.cmp(b));
     for (cached_path, cached_index) in entries {
         if root_prim_name(cached_path) != root_name {

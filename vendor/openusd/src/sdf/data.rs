@@ -225,7 +225,7 @@ impl AbstractData for Data {
     fn list_fields(&self, path: &Path) -> Option<Vec<String>> {
         self.specs
             .get(path)
-            .map(|spec| spec.fields.iter().map(|(k, _)| k.clone()).collect())
+            .map(|spec| spec.fields.iter().map(|(k, _)| k.to_string()).collect())
     }
 
     fn spec_paths(&self) -> Vec<Path> {
@@ -497,7 +497,7 @@ impl<T: AbstractData> AbstractData for CowData<T> {
 
     fn list_fields(&self, path: &Path) -> Option<Vec<String>> {
         match self.staged(path) {
-            Some(Patch::Created(spec)) => Some(spec.fields.iter().map(|(k, _)| k.clone()).collect()),
+            Some(Patch::Created(spec)) => Some(spec.fields.iter().map(|(k, _)| k.to_string()).collect()),
             Some(Patch::Tombstone) => None,
             Some(Patch::Edited { set, erased }) => {
                 // Base fields in authored order minus the erased ones, then the

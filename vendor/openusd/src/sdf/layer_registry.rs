@@ -16,6 +16,7 @@
 //! opinions to its own namespace and so must be present whenever the layer is
 //! (spec 10.3.1.1).
 
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
@@ -94,6 +95,10 @@ pub(crate) enum Error {
 /// format registration.
 pub struct LayerRegistry {
     resolver: Box<dyn ar::Resolver>,
+    /// Root layers read by [`own_expression_variables`](Self::own_expression_variables)
+    /// and not yet opened: the stage reads a root's variables before it opens the root's
+    /// stack, and parsing a large layer twice costs as much as the rest of the open.
+    peeked: RefCell<Vec<(ar::ResolvedPath, sdf::LayerData)>>,
 }
 
 impl Default for LayerRegistry {
@@ -108,7 +113,10 @@ impl Default for LayerRegistry {
 impl LayerRegistry {
     /// A registry resolving asset paths through `resolver`.
     pub fn new(resolver: Box<dyn ar::Resolver>) -> Self {
-        Self { resolver }
+        Self {
+            resolver,
+            peeked: RefCell::new(Vec::new()),
+        }
     }
 
     /// Canonicalizes `asset_path` into a stable identifier, anchoring a relative
@@ -232,7 +240,28 @@ impl LayerRegistry {
             .resolve_layer(&identifier)
             .with_context(|| format!("failed to resolve asset path: {asset_path}"))?;
         let data = self.read(&resolved)?;
-        Ok(expr::read_expression_variables(data.as_ref())?.into_owned())
+        let vars = expr::read_expression_variables(data.as_ref())?.into_owned();
+        self.peeked.borrow_mut().push((resolved, data));
+        Ok(vars)
+    }
+
+    /// Drops the layers [`own_expression_variables`](Self::own_expression_variables) read
+    /// that no stack opened (a stage open that failed half-way, or a muted session root).
+    pub(crate) fn forget_peeked(&self) {
+        self.peeked.borrow_mut().clear();
+    }
+
+    /// The layer at `resolved`: the copy [`own_expression_variables`](Self::own_expression_variables)
+    /// read if there is one (taken, so a reload reads the asset again), else read now.
+    fn read_root(&self, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
+        let mut peeked = self.peeked.borrow_mut();
+        match peeked.iter().position(|(p, _)| p == resolved) {
+            Some(i) => Ok(peeked.swap_remove(i).1),
+            None => {
+                drop(peeked);
+                self.read(resolved)
+            }
+        }
     }
 
     /// Opens `asset_path` (anchored against `anchor`) together with its sublayer
@@ -293,7 +322,7 @@ impl LayerRegistry {
         let Some(resolved) = self.resolve_layer(&identifier) else {
             return Ok(None);
         };
-        let data = self.read(&resolved)?;
+        let data = self.read_root(&resolved)?;
         visited.insert(identifier.clone());
 
         // The whole stack resolves its `${VAR}` sublayers against one context (C++

@@ -1,8 +1,8 @@
-use std::{fmt, result, str::FromStr};
+use std::hash::{Hash, Hasher};
+use std::sync::Arc;
+use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};
-
-use crate::tf;
 
 #[inline]
 pub fn path(str: impl AsRef<str>) -> Result<Path> {
@@ -27,9 +27,80 @@ fn is_prim_name_char(c: char) -> bool {
 ///   begin with a colon.
 /// - Brackets ("[" and "]") are used to indicate relationship target paths for
 ///   relational attributes.
-#[derive(Debug, Default, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+///
+/// The text is shared (`Arc<str>`) and its hash computed once when the path is
+/// made: paths are cloned into and looked up in many maps (specs, prim indices,
+/// dependencies), and a prim's path is as long as its depth, so copying or
+/// hashing the text per use makes deep namespaces quadratic.
+#[derive(Clone)]
 pub struct Path {
-    path: String,
+    path: Arc<str>,
+    hash: u64,
+}
+
+impl Path {
+    fn from_string(text: String) -> Path {
+        Path::from_str_unchecked(&text)
+    }
+
+    /// The path whose text is `parts` in a row. Short texts are put together on
+    /// the stack, so the path's own allocation is the only one.
+    pub(crate) fn from_parts(parts: &[&str]) -> Path {
+        const STACK: usize = 256;
+        let len: usize = parts.iter().map(|p| p.len()).sum();
+        if len > STACK {
+            return Path::from_string(parts.concat());
+        }
+        let mut buf = [0u8; STACK];
+        let mut at = 0;
+        for part in parts {
+            buf[at..at + part.len()].copy_from_slice(part.as_bytes());
+            at += part.len();
+        }
+        match std::str::from_utf8(&buf[..len]) {
+            Ok(text) => Path::from_str_unchecked(text),
+            // Unreachable: a concatenation of `str`s is UTF-8.
+            Err(_) => Path::from_string(parts.concat()),
+        }
+    }
+}
+
+impl Default for Path {
+    fn default() -> Self {
+        Path::from_str_unchecked("")
+    }
+}
+
+impl fmt::Debug for Path {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Path").field("path", &&*self.path).finish()
+    }
+}
+
+impl PartialEq for Path {
+    fn eq(&self, other: &Self) -> bool {
+        self.hash == other.hash && (Arc::ptr_eq(&self.path, &other.path) || self.path == other.path)
+    }
+}
+
+impl Eq for Path {}
+
+impl PartialOrd for Path {
+    fn partial_cmp(&self, other: &Self) -> Option<cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Path {
+    fn cmp(&self, other: &Self) -> cmp::Ordering {
+        self.path.cmp(&other.path)
+    }
+}
+
+impl Hash for Path {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_u64(self.hash);
+    }
 }
 
 impl fmt::Display for Path {
@@ -49,7 +120,7 @@ impl FromStr for Path {
     type Err = anyhow::Error;
 
     fn from_str(s: &str) -> result::Result<Path, Self::Err> {
-        Ok(Path { path: s.to_string() })
+        Ok(Path::from_str_unchecked(s))
     }
 }
 
@@ -58,13 +129,21 @@ impl Path {
         Path::from_str(path)
     }
 
+    /// The absolute root `/`, shared: it is made for many comparisons.
     #[inline]
     pub fn abs_root() -> Path {
-        Path::from_str_unchecked("/")
+        static ROOT: std::sync::LazyLock<Path> = std::sync::LazyLock::new(|| Path::from_str_unchecked("/"));
+        ROOT.clone()
     }
 
     fn from_str_unchecked(path: &str) -> Path {
-        Path { path: path.to_string() }
+        // A fixed-key SipHash, so equal texts hash equal in every map and process.
+        let mut hasher = std::hash::DefaultHasher::new();
+        path.hash(&mut hasher);
+        Path {
+            path: Arc::from(path),
+            hash: hasher.finish(),
+        }
     }
 
     #[inline]
@@ -75,7 +154,7 @@ impl Path {
     /// Returns `true` if this is the absolute root path `/` (pseudo-root).
     #[inline]
     pub fn is_abs_root(&self) -> bool {
-        self.path == "/"
+        &*self.path == "/"
     }
 
     /// Whether this path's prim is a root prim — a direct child of the
@@ -91,19 +170,14 @@ impl Path {
         self.path.is_empty()
     }
 
-    pub fn append_property(&self, property: impl Into<tf::Token>) -> Result<Path> {
-        let property = property.into();
-        let property = property.as_str();
+    pub fn append_property(&self, property: impl AsRef<str>) -> Result<Path> {
+        let property = property.as_ref();
         // TODO: Validate property name more carefully here.
         ensure!(!property.is_empty(), "Property name cannot be empty");
         ensure!(!self.is_property_path(), "Cannot append property to property path");
         ensure!(property != ".", "Property name cannot be '.'");
 
-        let mut new_path = self.path.clone();
-        new_path.push('.');
-        new_path.push_str(property);
-
-        Ok(Path { path: new_path })
+        Ok(Path::from_parts(&[self.as_str(), ".", property]))
     }
 
     pub fn append_path(&self, path: impl Into<Path>) -> Result<Path> {
@@ -121,17 +195,17 @@ impl Path {
 
         // If base is slash only.
         // "/" + "foo/bar" => "/foo/bar"
-        let combined = if self.path.as_str() == "/" {
-            format!("/{}", append.path)
+        let combined = if self.as_str() == "/" {
+            Path::from_parts(&["/", append.as_str()])
         } else if self.is_prim_variant_selection_path() {
             // A prim child attaches directly to a variant selection with no
             // separator: "/A{v=s}" + "B" => "/A{v=s}B" (C++ SdfPath::AppendChild).
-            format!("{}{}", self.path, append.path)
+            Path::from_parts(&[self.as_str(), append.as_str()])
         } else {
-            format!("{}/{}", self.path, append.path)
+            Path::from_parts(&[self.as_str(), "/", append.as_str()])
         };
 
-        Ok(Path { path: combined })
+        Ok(combined)
     }
 
     pub fn is_property_path(&self) -> bool {
@@ -338,7 +412,7 @@ impl Path {
     /// "/A{set=sel}"   -> Some(Variant { set: "set", selection: "sel" })
     /// ```
     pub fn last_element(&self) -> Option<PathElement<'_>> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // A property's element is the whole property name (everything after
@@ -379,7 +453,7 @@ impl Path {
     /// ""            -> None
     /// ```
     pub fn parent(&self) -> Option<Path> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // Drop a trailing `{set=sel}` variant selection.
@@ -446,7 +520,7 @@ impl Path {
     /// ""       -> None
     /// ```
     pub fn name(&self) -> Option<&str> {
-        if self.path.is_empty() || self.path == "/" {
+        if self.path.is_empty() || &*self.path == "/" {
             return None;
         }
         // The final prim name begins after the rightmost `/` or `}` (a child of
@@ -457,7 +531,7 @@ impl Path {
         if start < self.path.len() {
             Some(&self.path[start..])
         } else {
-            Some(self.path.rsplit_once('/').map_or(self.path.as_str(), |(_, name)| name))
+            Some(self.path.rsplit_once('/').map_or(self.as_str(), |(_, name)| name))
         }
     }
 
@@ -530,7 +604,7 @@ impl Path {
             return self.clone();
         }
         let mut out = String::with_capacity(self.path.len());
-        let mut rest = self.path.as_str();
+        let mut rest = self.as_str();
         let mut depth = 0usize;
         let mut chars = rest.char_indices();
         // Splice out each depth-0 `{…}` span; bracketed spans pass through.
@@ -639,6 +713,11 @@ impl Path {
             && !old_prefix.is_prim_variant_selection_path()
         {
             return None;
+        }
+        // Mapping a namespace onto itself (a prim's own node, the common case)
+        // yields the path itself: no new text to make.
+        if old_prefix == new_prefix {
+            return Some(self.clone());
         }
         // Ensure a separator between new prefix and suffix for non-root.
         if old == "/" && !suffix.is_empty() {
@@ -872,13 +951,13 @@ impl From<&Path> for Path {
 
 impl From<&str> for Path {
     fn from(s: &str) -> Self {
-        Path { path: s.to_string() }
+        Path::from_str_unchecked(s)
     }
 }
 
 impl From<String> for Path {
     fn from(value: String) -> Self {
-        Path { path: value }
+        Path::from_string(value)
     }
 }
 
@@ -1174,7 +1253,7 @@ mod tests {
         let split = |s: &str| {
             Path::from_str_unchecked(s)
                 .split_property()
-                .map(|(p, n)| (p.path, n.to_owned()))
+                .map(|(p, n)| (p.path.to_string(), n.to_owned()))
         };
         let owned = |p: &str, n: &str| Some((p.to_owned(), n.to_owned()));
 

@@ -90,7 +90,9 @@ pub struct SpecData {
     /// The type of this spec (prim, attribute, relationship, etc.).
     pub ty: sdf::SpecType,
     /// The fields stored on this spec, in authored order.
-    pub fields: Vec<(String, sdf::Value)>,
+    /// Field names are tokens: the names Sdf registers are static text, so a spec's
+    /// fields allocate nothing for their names.
+    pub fields: Vec<(tf::Token, sdf::Value)>,
 }
 
 /// Errors raised by typed spec-level authoring helpers.
@@ -121,7 +123,11 @@ impl SpecData {
         if let Some(slot) = self.fields.iter_mut().find(|(k, _)| k == key) {
             slot.1 = value;
         } else {
-            self.fields.push((key.to_owned(), value));
+            // Grown one field at a time: a spec has a handful of fields, each as large
+            // as the largest `Value`, and the default first capacity of four would
+            // take more memory than the fields do.
+            self.fields.reserve_exact(1);
+            self.fields.push((field_name(key), value));
         }
     }
 
@@ -177,8 +183,65 @@ impl SpecData {
     /// Merge fields from `other` into `self`, upserting each by name.
     pub fn extend_from(&mut self, other: SpecData) {
         for (k, v) in other.fields {
-            self.add(k, v);
+            match self.fields.iter_mut().find(|(key, _)| *key == k) {
+                Some(slot) => slot.1 = v,
+                None => {
+                    self.fields.reserve_exact(1);
+                    self.fields.push((k, v));
+                }
+            }
         }
+    }
+}
+
+/// A field name as a token: the static text of the names Sdf registers (the fields
+/// nearly every spec authors), a shared copy of any other.
+fn field_name(key: &str) -> tf::Token {
+    const NAMES: &[&str] = &[
+        "specifier",
+        "typeName",
+        "default",
+        "variability",
+        "custom",
+        "primChildren",
+        "properties",
+        "timeSamples",
+        "active",
+        "kind",
+        "apiSchemas",
+        "references",
+        "payload",
+        "inherits",
+        "specializes",
+        "variantSets",
+        "variantSetChildren",
+        "variantSelection",
+        "variantChildren",
+        "interpolation",
+        "elementSize",
+        "targetPaths",
+        "targetChildren",
+        "connectionPaths",
+        "connectionChildren",
+        "instanceable",
+        "documentation",
+        "customData",
+        "colorSpace",
+        "hidden",
+        "comment",
+        "assetInfo",
+        "allowedTokens",
+        "displayName",
+        "displayGroup",
+        "permission",
+        "prefixSubstitutions",
+        "suffixSubstitutions",
+        "symmetricPeer",
+        "spline",
+    ];
+    match NAMES.iter().find(|n| **n == key) {
+        Some(name) => tf::Token::new(name),
+        None => tf::Token::from(key),
     }
 }
 

@@ -555,14 +555,14 @@ impl Prim {
     /// neither authors a spec nor asserts the attribute is composed. An invalid
     /// property name yields a handle whose path falls back to the prim, which
     /// resolves as empty.
-    pub fn attribute(&self, name: impl Into<Token>) -> Attribute {
+    pub fn attribute(&self, name: impl AsRef<str>) -> Attribute {
         Attribute::new(&self.stage, self.property_path(name))
     }
 
     /// Returns a [`Relationship`] handle for the property `name` under this
     /// prim. Mirrors C++ `UsdPrim::GetRelationship`. See [`Self::attribute`]
     /// for the handle's non-authoring, non-validating contract.
-    pub fn relationship(&self, name: impl Into<Token>) -> Relationship {
+    pub fn relationship(&self, name: impl AsRef<str>) -> Relationship {
         Relationship::new(&self.stage, self.property_path(name))
     }
 
@@ -637,7 +637,7 @@ impl Prim {
 
     /// Property path for `name` under this prim, falling back to the prim path
     /// for an invalid name (the handle then resolves as empty).
-    fn property_path(&self, name: impl Into<Token>) -> sdf::Path {
+    fn property_path(&self, name: impl AsRef<str>) -> sdf::Path {
         self.path.append_property(name).unwrap_or_else(|_| self.path.clone())
     }
 

@@ -253,7 +253,7 @@ impl StagePopulationMask {
     /// `add_path` clears `paths` to `[abs_root]` whenever the root is added,
     /// so a single front-position check captures the invariant.
     pub fn is_all(&self) -> bool {
-        self.paths.first() == Some(&sdf::Path::abs_root())
+        self.paths.first().is_some_and(sdf::Path::is_abs_root)
     }
 
     /// Returns `true` if `path` is inside the population mask.
@@ -2396,7 +2396,7 @@ impl Stage {
     /// is excluded by the stage's population mask.
     pub(crate) fn resolve_at(&self, attr_path: impl Into<sdf::Path>, time: f64) -> Result<Option<sdf::Value>> {
         let attr_path = attr_path.into();
-        if !self.mask_includes(&attr_path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&attr_path.prim_path()) {
             return Ok(None);
         }
         let interp_type = self.interpolation_type.get();
@@ -2410,7 +2410,7 @@ impl Stage {
     /// [`AttributeValueSource::Static`](pcp::AttributeValueSource::Static)
     /// `None` when the attribute's prim is outside the population mask.
     pub(crate) fn resolve_value_source(&self, attr_path: &sdf::Path) -> Result<pcp::AttributeValueSource> {
-        if !self.mask_includes(&attr_path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&attr_path.prim_path()) {
             return Ok(pcp::AttributeValueSource::Static(None));
         }
         self.with_cache(|g, c| c.resolve_value_source(g, attr_path))
@@ -2474,7 +2474,7 @@ impl Stage {
     /// For property paths (e.g. `/Prim.attr`), checks whether the property
     /// exists in any layer contributing to the owning prim's composition index.
     pub(crate) fn has_spec(&self, path: &sdf::Path) -> Result<bool> {
-        if !self.mask_includes(&path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&path.prim_path()) {
             return Ok(false);
         }
         self.with_cache(|g, c| c.has_spec(g, path))
@@ -2483,7 +2483,7 @@ impl Stage {
     /// Returns the spec type at a composed path from the strongest contributing layer.
     pub(crate) fn spec_type(&self, path: impl Into<sdf::Path>) -> Result<Option<sdf::SpecType>> {
         let path = path.into();
-        if !self.mask_includes(&path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&path.prim_path()) {
             return Ok(None);
         }
         self.with_cache(|g, c| c.spec_type(g, &path))
@@ -2517,7 +2517,7 @@ impl Stage {
         T::Error: std::error::Error + Send + Sync + 'static,
     {
         let path = path.into();
-        if !self.mask_includes(&path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&path.prim_path()) {
             return Ok(None);
         }
         let raw = self.with_cache(|g, c| c.resolve_field(g, &path, field.as_ref()))?;
@@ -2538,7 +2538,7 @@ impl Stage {
         path: &sdf::Path,
         query: impl FnMut(&pcp::LayerGraph, &mut pcp::IndexCache) -> Result<T>,
     ) -> Result<T> {
-        if !self.mask_includes(&path.prim_path()) {
+        if !self.population_mask.is_all() && !self.mask_includes(&path.prim_path()) {
             return Ok(T::default());
         }
         self.with_cache(query)
@@ -3350,7 +3350,9 @@ impl StageBuilder {
         // layer this collection opened.
         let root_stack_vars = self.root_stack_expression_variables(root_path)?;
         let session = self.collect_optional_session_layers(&root_stack_vars)?;
-        let root = self.collect_layers(root_path, &root_stack_vars)?;
+        let root = self.collect_layers(root_path, &root_stack_vars);
+        self.registry.forget_peeked();
+        let root = root?;
         let session_layer_count = session.layers.len();
         let layers = session.layers.into_iter().chain(root.layers).collect();
         let errors = session.errors.into_iter().chain(root.errors).collect();

@@ -368,7 +368,7 @@ impl<'a> Parser<'a> {
 
         let mut name_token = self.fetch_next()?;
         if let Token::Identifier(prim_type) = name_token {
-            spec.add(FieldKey::TypeName, sdf::Value::token(prim_type));
+            spec.add(FieldKey::TypeName, sdf::Value::Token(prim_type_token(prim_type)));
             name_token = self.fetch_next()?;
         }
 
@@ -565,7 +565,7 @@ impl<'a> Parser<'a> {
     /// Create an attribute spec with the standard type/custom/variability fields.
     fn make_attribute_spec(type_info: &TypeInfo, custom: bool, variability: sdf::Variability) -> sdf::SpecData {
         let mut spec = sdf::SpecData::new(sdf::SpecType::Attribute);
-        spec.add(FieldKey::TypeName, sdf::Value::token(type_info.to_string()));
+        spec.add(FieldKey::TypeName, sdf::Value::Token(type_info.token()));
         if custom {
             spec.add(FieldKey::Custom, sdf::Value::Bool(true));
         }
@@ -1946,6 +1946,87 @@ impl<'a> TypeInfo<'a> {
             ty,
             type_name: "",
             is_array: false,
+        }
+    }
+}
+
+/// A prim type name as a token: static text for the common schema types, so most
+/// prims allocate nothing for their `typeName`.
+fn prim_type_token(name: &str) -> crate::tf::Token {
+    const COMMON: &[&str] = &[
+        "Xform",
+        "Scope",
+        "Mesh",
+        "Sphere",
+        "Cube",
+        "Cylinder",
+        "Cone",
+        "Capsule",
+        "Plane",
+        "Points",
+        "BasisCurves",
+        "PointInstancer",
+        "GeomSubset",
+        "Material",
+        "Shader",
+        "NodeGraph",
+        "Camera",
+        "DomeLight",
+        "DistantLight",
+        "SphereLight",
+        "RectLight",
+        "DiskLight",
+    ];
+    match COMMON.iter().find(|n| **n == name) {
+        Some(n) => crate::tf::Token::new(n),
+        None => crate::tf::Token::from(name),
+    }
+}
+
+impl TypeInfo<'_> {
+    /// The type name as a token: static text for the value types of the schemas,
+    /// so most attributes allocate nothing for their `typeName`.
+    fn token(&self) -> crate::tf::Token {
+        const COMMON: &[[&str; 2]] = &[
+            ["double", "double[]"],
+            ["float", "float[]"],
+            ["int", "int[]"],
+            ["bool", "bool[]"],
+            ["token", "token[]"],
+            ["string", "string[]"],
+            ["asset", "asset[]"],
+            ["half", "half[]"],
+            ["uint", "uint[]"],
+            ["int64", "int64[]"],
+            ["uchar", "uchar[]"],
+            ["timecode", "timecode[]"],
+            ["int2", "int2[]"],
+            ["int3", "int3[]"],
+            ["float2", "float2[]"],
+            ["float3", "float3[]"],
+            ["float4", "float4[]"],
+            ["double2", "double2[]"],
+            ["double3", "double3[]"],
+            ["double4", "double4[]"],
+            ["point3f", "point3f[]"],
+            ["point3d", "point3d[]"],
+            ["normal3f", "normal3f[]"],
+            ["normal3d", "normal3d[]"],
+            ["vector3f", "vector3f[]"],
+            ["vector3d", "vector3d[]"],
+            ["color3f", "color3f[]"],
+            ["color3d", "color3d[]"],
+            ["color4f", "color4f[]"],
+            ["texCoord2f", "texCoord2f[]"],
+            ["texCoord2d", "texCoord2d[]"],
+            ["matrix4d", "matrix4d[]"],
+            ["quatf", "quatf[]"],
+            ["quatd", "quatd[]"],
+            ["quath", "quath[]"],
+        ];
+        match COMMON.iter().find(|names| names[0] == self.type_name) {
+            Some(names) => crate::tf::Token::new(names[usize::from(self.is_array)]),
+            None => crate::tf::Token::from(self.to_string()),
         }
     }
 }
