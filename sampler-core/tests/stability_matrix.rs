@@ -231,7 +231,7 @@ fn every_estimator_on_every_extreme_case() {
                                 let s: TwoStageSampler<'_, '_> =
                                     TwoStageSampler::new(&env, &sat, brdf.as_ref(), &frame, wo);
                                 for p in pts {
-                                    push(lum(estimator::two_stage(&s, &env, &sp, p, &mut vis).value));
+                                    push(lum(estimator::sampled(&s, &sp, p, &mut vis).value));
                                 }
                             }
                             "ris" => {
