@@ -8,7 +8,7 @@ use core::ffi::c_void;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::glam::{DVec2, Vec3};
 use sampler_core::quadtree::ProductKind;
-use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
+use sampler_core::sampler::{ProductArena, ProductError, ProductParams, ProductSampler};
 
 /// BRDF samples a `ppis_product` holds (the paper's K).
 pub const PPIS_PRODUCT_CAPACITY: u32 = 256;
@@ -151,8 +151,10 @@ pub unsafe extern "C" fn ppis_product_build(
         Some(Err(e)) => return e,
     };
     product.env = &env.view;
-    product.arena.build(&env.view, brdf, &frame.into(), Vec3::from(wo), &params, seed);
-    ppis_status::PPIS_OK
+    match product.arena.build(&env.view, brdf, &frame.into(), Vec3::from(wo), &params, seed) {
+        Ok(_) => ppis_status::PPIS_OK,
+        Err(ProductError::AboveCapacity { .. }) => ppis_status::PPIS_ABOVE_CAPACITY,
+    }
 }
 
 /// Draws a direction from the last build at the uniform point (u0, u1).

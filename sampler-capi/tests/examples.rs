@@ -67,7 +67,7 @@ fn expected() -> Vec<String> {
     };
     let mut lines = Vec::new();
     let mut arena: Box<ProductArena> = Box::default();
-    let product = arena.build(&env, &metal, &frame, wo, &ProductParams::for_mis(256), 42);
+    let product = arena.build(&env, &metal, &frame, wo, &ProductParams::for_mis(256), 42).unwrap();
     for (k, p) in u.iter().enumerate() {
         let s = product.sample(*p).unwrap();
         lines.push(line("product", k, s.dir, s.pdf, product.pdf(s.dir)));

@@ -121,7 +121,7 @@ fn shading_points(c: &mut Criterion) {
                         b.iter(|| {
                             i += 1;
                             let (frame, wo) = &points[(i % 100) as usize];
-                            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, i);
+                            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, i).unwrap();
                             sobol02(i, 0, &mut pts[..warps]);
                             let mut acc = 0.0f32;
                             for u in &pts[..warps] {
@@ -151,7 +151,7 @@ fn shading_points(c: &mut Criterion) {
             b.iter(|| {
                 i += 1;
                 let (frame, wo) = &points[(i % 100) as usize];
-                let s = arena.build(&env, brdfs[2].1.as_ref(), frame, *wo, &ProductParams::default(), i);
+                let s = arena.build(&env, brdfs[2].1.as_ref(), frame, *wo, &ProductParams::default(), i).unwrap();
                 black_box(s.node_count())
             })
         });
@@ -200,7 +200,7 @@ fn two_level_points(c: &mut Criterion) {
                 b.iter(|| {
                     i += 1;
                     let (frame, wo) = &points[(i % 100) as usize];
-                    let s = arena.build(&env, brdf.as_ref(), frame, *wo, &ProductParams::default(), i);
+                    let s = arena.build(&env, brdf.as_ref(), frame, *wo, &ProductParams::default(), i).unwrap();
                     sobol02(i, 0, &mut pts);
                     black_box(pts.iter().filter_map(|u| s.sample(*u)).map(|d| d.pdf).sum::<f32>())
                 })

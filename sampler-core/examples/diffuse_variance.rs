@@ -43,7 +43,7 @@ fn main() {
         ("for_mis bilinear", ProductParams { bilinear: true, ..ProductParams::for_mis(256) }),
     ] {
         report(name, reps, n, |r, a, b, out| {
-            let s = arena.build(&env, &brdf, &frame, wo, &params, r);
+            let s = arena.build(&env, &brdf, &frame, wo, &params, r).unwrap();
             for k in 0..a.len() {
                 let [x, y] = estimator::sampled_mis(&s, &sp, a[k], b[k].as_vec2(), &mut vis);
                 out.push(lum(x.value + y.value));

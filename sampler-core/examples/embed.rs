@@ -98,7 +98,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         // Per shading point: seeded by the pixel, not the thread, so the image
                         // is the same whatever the thread count.
                         let point_seed = hash_combine(seed, pixel as u64);
-                        let sampler = arena.build(env, brdf, &frame, wo, params, point_seed);
+                        let sampler = arena.build(env, brdf, &frame, wo, params, point_seed).expect("256 samples fit");
                         let sp = ShadingPoint { frame, wo, brdf };
                         let (mut u, mut v) = ([DVec2::ZERO; 16], [DVec2::ZERO; 16]);
                         sobol02(point_seed ^ 1, 0, &mut u);

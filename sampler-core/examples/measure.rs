@@ -59,7 +59,7 @@ fn main() {
             let params = ProductParams { defensive: *eps, ..ProductParams::default() };
             let (mut s1, mut s2, mut cnt) = (0.0f64, 0.0f64, 0.0f64);
             for seed in 0..2000u64 {
-                let sampler = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed);
+                let sampler = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
                 let mut pts = [DVec2::ZERO; 64];
                 sobol02(seed + 77, 0, &mut pts);
                 for u in pts {

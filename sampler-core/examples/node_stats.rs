@@ -32,7 +32,7 @@ fn main() {
             let frame = Frame::from_normal(normal);
             let c = rng.next_f32();
             let wo = frame.to_world(Vec3::new((1.0 - c * c).sqrt(), 0.0, c));
-            let s = arena.build(&env, brdf.as_ref(), &frame, wo, &ProductParams::default(), i);
+            let s = arena.build(&env, brdf.as_ref(), &frame, wo, &ProductParams::default(), i).unwrap();
             sum += s.node_count();
             max = max.max(s.node_count());
         }

@@ -47,7 +47,7 @@ fn main() {
             let mut stats = [[0.0f64; 3]; 4];
             let mut net = [[0.0f64; 3]; 4];
             for seed in 0..400u64 {
-                let sampler = arena.build(&env, &brdf, &frame, wo, &params, seed);
+                let sampler = arena.build(&env, &brdf, &frame, wo, &params, seed).unwrap();
                 let mut pts = [DVec2::ZERO; 64];
                 let mut oth = [DVec2::ZERO; 64];
                 sobol02(seed + 77, 0, &mut pts);

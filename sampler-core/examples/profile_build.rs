@@ -39,7 +39,7 @@ fn main() {
         let normal = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
         let frame = Frame::from_normal(normal);
         let wo = frame.to_world(Vec3::new(0.2, 0.1, 1.0).normalize());
-        let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, i);
+        let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, i).unwrap();
         nodes += s.node_count();
         let mut pts = [DVec2::ZERO; 16];
         sobol02(i, 0, &mut pts);
@@ -72,13 +72,13 @@ fn main() {
     let t0 = std::time::Instant::now();
     for r in 0..reps {
         for (i, (frame, wo)) in frames.iter().enumerate() {
-            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, r * 1000 + i as u64);
+            let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, r * 1000 + i as u64).unwrap();
             nodes += s.node_count();
         }
     }
     let b = per(t0);
     let t0 = std::time::Instant::now();
-    let s = arena.build(&env, brdf.as_ref(), &frames[0].0, frames[0].1, &params, 1);
+    let s = arena.build(&env, brdf.as_ref(), &frames[0].0, frames[0].1, &params, 1).unwrap();
     let mut p16 = [DVec2::ZERO; 16];
     for r in 0..reps * 1000 {
         sobol02(r, 0, &mut p16);

@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::brdf::RoughConductor;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
-use sampler_core::estimator::{Contribution, ShadingPoint, mis_many, sampled_mis, sampled_mis_drawn, sampled_mis_many};
+use sampler_core::estimator::{Contribution, ShadingPoint, sampled_mis, sampled_mis_drawn, sampled_mis_many};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
@@ -69,7 +69,7 @@ fn main() {
                 *b = v.as_vec2();
             }
             let t = Instant::now();
-            let s = arena.build(&env, &brdf, frame, *wo, &params, i as u64);
+            let s = arena.build(&env, &brdf, frame, *wo, &params, i as u64).unwrap();
             t_build += t.elapsed().as_secs_f64();
             let t = Instant::now();
             for u in &us {
@@ -91,8 +91,7 @@ fn main() {
             t_pmb += t.elapsed().as_secs_f64();
             let t = Instant::now();
             for (u, b) in us.chunks(64).zip(brdf_points.chunks(64)) {
-                env.sample_many(u, &mut drawn[..u.len()]);
-                mis_many(&env, &sp, &drawn[..u.len()], b, &mut vis, &mut out);
+                sampled_mis_many(&env, &sp, u, b, &mut vis, &mut out);
                 acc += out.iter().map(|[a, b]| a.value + b.value).sum::<DVec3>();
             }
             t_misb += t.elapsed().as_secs_f64();

@@ -106,7 +106,7 @@ fn main() {
             }));
             let params = ProductParams::for_mis(256);
             row.push(measure(|seed| {
-                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed);
+                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
                 let (p, q) = points(seed);
                 (0..PAIRS)
                     .map(|k| {

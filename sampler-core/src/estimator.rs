@@ -8,15 +8,10 @@ use crate::direction::{DirectionSample, DirectionSampler};
 use crate::env::EnvHierarchy;
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
-use crate::sampler::ProductSampler;
-use crate::two_stage::TwoStageSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 mod batched;
-pub use batched::{
-    BATCH, brdf_many, env_many, mis_many, mis_split, product_mis_split, sampled_many, sampled_mis_many,
-    sampled_mis_split,
-};
+pub use batched::{BATCH, brdf_many, sampled_many, sampled_mis_many, sampled_mis_split};
 
 /// Answers whether the environment is visible from the shading point in a world direction.
 pub trait Visibility {
@@ -120,16 +115,6 @@ pub fn sampled_drawn<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     };
     let f = times(sampler.env().radiance_at(s.uv), sp.eval(s.dir));
     Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
-}
-
-/// [`sampled_drawn`] for the quadtree product.
-pub fn product_drawn<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: Option<DirectionSample>,
-    vis: &mut impl Visibility,
-) -> Contribution {
-    sampled_drawn(sampler, sp, drawn, vis)
 }
 
 /// BRDF-only sampling.
@@ -288,18 +273,4 @@ pub fn ris<B: Brdf + ?Sized>(
     let m = candidates.len() as f64;
     let value = if vis.visible(dir) { f * (total / m / target) } else { DVec3::ZERO };
     Contribution { dir, value, pdf: source, other_pdf: 0.0 }
-}
-
-/// Two-stage importance sampling (Cline et al. 2006, see `two_stage.rs`): one direction from
-/// the shading point's [`TwoStageSampler`].
-pub fn two_stage<B: Brdf + ?Sized, const R: usize>(
-    sampler: &TwoStageSampler<'_, '_, R>,
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    u: DVec2,
-    vis: &mut impl Visibility,
-) -> Contribution {
-    let Some(s) = sampler.sample(u) else { return Contribution::default() };
-    let f = times(env_h.radiance_at(s.uv), sp.eval(s.dir));
-    Contribution { dir: s.dir, value: weighted(f, s.pdf, vis, s.dir), pdf: s.pdf, other_pdf: 0.0 }
 }

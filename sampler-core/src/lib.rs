@@ -28,7 +28,7 @@
 //! let brdf = RoughConductor::new(0.1, Vec3::ONE);
 //! let frame = Frame::from_normal(Vec3::Z);
 //! let wo = Vec3::new(0.3, 0.0, 1.0).normalize();
-//! let sampler = arena.build(&env, &brdf, &frame, wo, &ProductParams::default(), 7);
+//! let sampler = arena.build(&env, &brdf, &frame, wo, &ProductParams::default(), 7).unwrap();
 //! let s = sampler.sample(DVec2::new(0.3, 0.6)).unwrap();
 //! assert_eq!(s.pdf, sampler.pdf(s.dir));
 //! ```

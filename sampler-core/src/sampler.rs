@@ -35,7 +35,7 @@ use heapless::Vec;
 /// Settings of the per-shading-point product.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProductParams {
-    /// BRDF samples drawn to build B̃ (at most the arena's capacity K).
+    /// BRDF samples drawn to build B̃ (at most the arena's capacity K: more is an error).
     pub brdf_samples: usize,
     /// Depth cap of the quadtree (≤ 24): coincident samples cannot split forever. Default 14
     /// (cells of 6e-5 of the square, ~2e-4 rad): deeper leaves shrink towards the f32 direction's
@@ -101,6 +101,30 @@ impl ProductParams {
     }
 }
 
+/// Why a product sampler could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProductError {
+    /// More BRDF samples were asked for than the arena holds (its `K`).
+    AboveCapacity {
+        /// [`ProductParams::brdf_samples`].
+        asked: usize,
+        /// The arena's `K`.
+        capacity: usize,
+    },
+}
+
+impl core::fmt::Display for ProductError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::AboveCapacity { asked, capacity } => {
+                write!(f, "{asked} BRDF samples asked of a product arena that holds {capacity}")
+            }
+        }
+    }
+}
+
+impl core::error::Error for ProductError {}
+
 /// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
 /// Reused from point to point; never allocates. `size_of::<ProductArena<K, NODES>>()` is about
 /// 48·K + 16·NODES bytes: each node's 8 bytes and its path probability's 8. The default NODES
@@ -156,7 +180,8 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
     }
 
     /// Builds the product sampler of one shading point. `wo` is the world-space direction
-    /// towards the viewer, `frame` the shading frame, `seed` randomises the BRDF samples.
+    /// towards the viewer, `frame` the shading frame, `seed` randomises the BRDF samples. More
+    /// BRDF samples than the arena's `K` is an error, never a silent clamp.
     pub fn build<'a, 'e, B: Brdf + ?Sized>(
         &'a mut self,
         env: &'a EnvHierarchy<'e>,
@@ -165,9 +190,12 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         wo: Vec3,
         params: &ProductParams,
         seed: u64,
-    ) -> ProductSampler<'a, 'e> {
+    ) -> Result<ProductSampler<'a, 'e>, ProductError> {
+        if params.brdf_samples > K {
+            return Err(ProductError::AboveCapacity { asked: params.brdf_samples, capacity: K });
+        }
         let wo_local = frame.to_local(wo);
-        let k = params.brdf_samples.min(K);
+        let k = params.brdf_samples;
         self.keys.clear();
         let mut count = 0;
         if !env.is_black() && k > 0 {
@@ -214,7 +242,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
         self.built = Some((defensive, count));
         let built: &'a Self = self;
-        built.last_built(env).expect("just built")
+        Ok(built.last_built(env).expect("just built"))
     }
 
     /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena

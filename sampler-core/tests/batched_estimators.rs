@@ -46,16 +46,16 @@ fn batched_mis_is_pair_by_pair_mis() {
             // Env and BRDF.
             let mut drawn = [None; 101];
             e.sample_many(&u, &mut drawn);
-            estimator::mis_many(&e, &sp, &drawn, &brdf_points, &mut vis, &mut out);
+            estimator::sampled_mis_many(&e, &sp, &u, &brdf_points, &mut vis, &mut out);
             for k in 0..u.len() {
                 let one = estimator::sampled_mis_drawn(&e, &sp, drawn[k], brdf_points[k], &mut vis);
                 assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "mis, brdf {i}, pair {k}");
                 compared += usize::from(out[k][0].value.max_element() > 0.0 && out[k][1].value.max_element() > 0.0);
             }
-            assert_split_is_pairs(&out, estimator::mis_split(&e, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
+            assert_split_is_pairs(&out, estimator::sampled_mis_split(&e, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
             // Env alone and BRDF alone.
             let mut singles = [Contribution::default(); 101];
-            estimator::env_many(&e, &sp, &drawn, &mut vis, &mut singles);
+            estimator::sampled_many(&e, &sp, &u, &mut vis, &mut singles);
             for k in 0..u.len() {
                 let one = estimator::sampled_drawn(&e, &sp, drawn[k], &mut vis);
                 assert_eq!(bits(&singles[k]), bits(&one), "env, brdf {i}, sample {k}");
@@ -66,7 +66,7 @@ fn batched_mis_is_pair_by_pair_mis() {
                 assert_eq!(bits(&singles[k]), bits(&one), "brdf, brdf {i}, sample {k}");
             }
             // Product and BRDF.
-            let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5);
+            let s = arena.build(&e, brdf.as_ref(), &frame, wo, &ProductParams::for_mis(256), 5).unwrap();
             let mut drawn = [None; 101];
             s.sample_many(&u, &mut drawn);
             estimator::sampled_mis_many(&s, &sp, &u, &brdf_points, &mut vis, &mut out);
@@ -74,7 +74,7 @@ fn batched_mis_is_pair_by_pair_mis() {
                 let one = estimator::sampled_mis_drawn(&s, &sp, drawn[k], brdf_points[k], &mut vis);
                 assert_eq!(out[k].map(|c| bits(&c)), one.map(|c| bits(&c)), "product-mis, brdf {i}, pair {k}");
             }
-            assert_split_is_pairs(&out, estimator::product_mis_split(&s, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
+            assert_split_is_pairs(&out, estimator::sampled_mis_split(&s, &sp, &u, &brdf_points, (0.5, 0.5), &mut vis));
         }
     }
     assert!(compared > 100, "only {compared} pairs with both halves lit");

@@ -131,7 +131,7 @@ fn product_cases(params: ProductParams) -> Vec<String> {
             for (seed, (view, normal, wo_local)) in views().into_iter().enumerate() {
                 let frame = Frame::from_normal(normal);
                 let wo = frame.to_world(wo_local);
-                let sampler = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed as u64);
+                let sampler = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed as u64).unwrap();
                 assert_eq!(sampler.is_bilinear(), params.bilinear && sampler.node_count() > 0);
                 let r = chi_square_dyadic(
                     SAMPLES,
@@ -233,9 +233,9 @@ fn bilinear_needs_an_arena_with_corners() {
     let wo = Vec3::new(0.0, 0.6, 0.8);
     let params = ProductParams { bilinear: true, ..ProductParams::default() };
     let mut plain: Box<ProductArena> = Box::new(ProductArena::new());
-    assert!(!plain.build(&e, &brdf, &frame, wo, &params, 1).is_bilinear());
+    assert!(!plain.build(&e, &brdf, &frame, wo, &params, 1).unwrap().is_bilinear());
     let mut with_corners: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
-    assert!(with_corners.build(&e, &brdf, &frame, wo, &params, 1).is_bilinear());
+    assert!(with_corners.build(&e, &brdf, &frame, wo, &params, 1).unwrap().is_bilinear());
 }
 
 #[test]
@@ -254,7 +254,7 @@ fn product_sampler_directions_match_pdf_on_a_sphere_grid() {
     let brdf = Lambert::new(Vec3::splat(0.5));
     let frame = Frame::from_normal(Vec3::new(0.2, 0.9, 0.1).normalize());
     let wo = frame.to_world(Vec3::new(0.0, 0.6, 0.8));
-    let sampler = arena.build(&e, &brdf, &frame, wo, &ProductParams::default(), 1);
+    let sampler = arena.build(&e, &brdf, &frame, wo, &ProductParams::default(), 1).unwrap();
     let r = chi_square(
         Chart::EqualArea,
         32,

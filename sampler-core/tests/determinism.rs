@@ -14,7 +14,7 @@ fn run(seed: u64, arena: &mut ProductArena) -> Vec<u32> {
     let e = env.view();
     let frame = Frame::from_normal(Vec3::new(0.1, 0.2, 0.9).normalize());
     let wo = frame.to_world(Vec3::new(0.5, 0.0, 0.8).normalize());
-    let s = arena.build(&e, &CarPaint::default(), &frame, wo, &ProductParams::default(), seed);
+    let s = arena.build(&e, &CarPaint::default(), &frame, wo, &ProductParams::default(), seed).unwrap();
     let mut pts = [DVec2::ZERO; 64];
     sobol02(seed, 0, &mut pts);
     pts.iter()

@@ -65,14 +65,14 @@ fn product_beats_env_and_brdf_sampling_and_product_mis_beats_product_on_needles(
             );
             let params = ProductParams::default();
             let (_, v_prod) = variance((0..n as u64 / 16).flat_map(|seed| {
-                let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed);
+                let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
                 let mut pts = [DVec2::ZERO; 16];
                 sobol02(seed + 99, 0, &mut pts);
                 pts.map(|u| lum(estimator::sampled(&s, &sp, u, &mut vis).value))
             }));
             // MIS spends two samples per estimate: compare its variance per sample.
             let (_, v_pair) = variance((0..n as u64 / 32).flat_map(|seed| {
-                let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed);
+                let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
                 let mut pts = [DVec2::ZERO; 16];
                 sobol02(seed + 7, 0, &mut pts);
                 let mut qts = [DVec2::ZERO; 16];

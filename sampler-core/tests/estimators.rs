@@ -150,7 +150,7 @@ fn run(estimator: &str) {
                 let params = ProductParams { kind, ..ProductParams::default() };
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let mut pts = [DVec2::ZERO; 32];
                         sobol02(seed ^ 0xabc, 0, &mut pts);
                         pts.iter().map(|p| lum(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0
@@ -222,7 +222,7 @@ fn run(estimator: &str) {
                 };
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts);
                         sobol02(seed ^ 0x123, 0, &mut qts);
@@ -250,12 +250,12 @@ fn run(estimator: &str) {
                 let params = ProductParams::for_mis(256);
                 (0..600u64)
                     .map(|seed| {
-                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed);
+                        let s = arena.build(&e, case.brdf.as_ref(), &case.frame, case.wo, &params, seed).unwrap();
                         let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
                         sobol02(seed ^ 0xdef, 0, &mut pts[..n_p]);
                         sobol02(seed ^ 0x123, 0, &mut qts[..n_b]);
                         let q = qts.map(|q| q.as_vec2());
-                        lum(estimator::product_mis_split(&s, &sp, &pts[..n_p], &q[..n_b], shares, &mut vis)) / 32.0
+                        lum(estimator::sampled_mis_split(&s, &sp, &pts[..n_p], &q[..n_b], shares, &mut vis)) / 32.0
                     })
                     .collect()
             }
@@ -264,7 +264,7 @@ fn run(estimator: &str) {
                     // Env-heavy MIS, as `auto` runs it on diffuse surfaces under extended light.
                     let pts: Vec<DVec2> = (0..12).map(|_| u()).collect();
                     let brdf_pts: Vec<Vec2> = (0..4).map(|_| u().as_vec2()).collect();
-                    lum(estimator::mis_split(&e, &sp, &pts, &brdf_pts, (0.75, 0.25), &mut vis)) / 16.0
+                    lum(estimator::sampled_mis_split(&e, &sp, &pts, &brdf_pts, (0.75, 0.25), &mut vis)) / 16.0
                 })
                 .collect(),
             "ris" => {
@@ -293,10 +293,8 @@ fn run(estimator: &str) {
                     // evaluations four lanes at a time.
                     let pts: Vec<DVec2> = (0..16).map(|_| u()).collect();
                     let brdf_pts: Vec<Vec2> = (0..16).map(|_| u().as_vec2()).collect();
-                    let mut drawn = [None; 16];
-                    e.sample_many(&pts, &mut drawn);
                     let mut pairs = [[estimator::Contribution::default(); 2]; 16];
-                    estimator::mis_many(&e, &sp, &drawn, &brdf_pts, &mut vis, &mut pairs);
+                    estimator::sampled_mis_many(&e, &sp, &pts, &brdf_pts, &mut vis, &mut pairs);
                     pairs.iter().map(|[a, b]| lum(a.value + b.value)).sum::<f64>() / 16.0
                 })
                 .collect(),

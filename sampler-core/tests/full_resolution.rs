@@ -45,7 +45,7 @@ fn a_one_texel_sun_in_a_4096_map_is_found_with_the_right_probability() {
     let wo = Vec3::Z;
     let brdf = RoughConductor::new(0.02, Vec3::ONE);
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let s = arena.build(&env, &brdf, &frame, wo, &ProductParams::default(), 9);
+    let s = arena.build(&env, &brdf, &frame, wo, &ProductParams::default(), 9).unwrap();
     let mut sun_hits = 0;
     for _ in 0..10_000 {
         let d = s.sample(DVec2::new(rng.next_f64(), rng.next_f64())).unwrap();

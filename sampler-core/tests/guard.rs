@@ -59,7 +59,7 @@ fn estimate(params: &ProductParams, env: &TestEnv, frame: &Frame, wo: Vec3) -> (
     let mut vis = |_: Vec3| true;
     let (mut sum, mut sum2, n) = (0.0f64, 0.0f64, 400);
     for seed in 0..n {
-        let s = arena.build(&e, &brdf, frame, wo, params, seed);
+        let s = arena.build(&e, &brdf, frame, wo, params, seed).unwrap();
         let mut pts = [DVec2::ZERO; 32];
         sobol02(seed + 1000, 0, &mut pts);
         let v = pts.iter().map(|p| luminance64(estimator::sampled(&s, &sp, *p, &mut vis).value)).sum::<f64>() / 32.0;
@@ -121,7 +121,7 @@ fn check_distribution<const K: usize, const N: usize>(
 ) -> usize {
     let e = env.view();
     let frame = Frame::from_normal(Vec3::Z);
-    let s = arena.build(&e, brdf, &frame, Vec3::new(0.0, 0.6, 0.8), params, 3);
+    let s = arena.build(&e, brdf, &frame, Vec3::new(0.0, 0.6, 0.8), params, 3).unwrap();
     assert!(s.node_count() <= N);
     let r = chi_square_dyadic(
         50_000,
@@ -151,7 +151,7 @@ fn all_zero_samples_fall_back_to_the_environment() {
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let e = env.view();
     let frame = Frame::from_normal(Vec3::Z);
-    let s = arena.build(&e, &Coincident { value: 0.0 }, &frame, Vec3::Z, &ProductParams::default(), 1);
+    let s = arena.build(&e, &Coincident { value: 0.0 }, &frame, Vec3::Z, &ProductParams::default(), 1).unwrap();
     assert_eq!(s.defensive(), 1.0);
     check_distribution(&mut arena, &Coincident { value: 0.0 }, &ProductParams::default(), &env);
 }
@@ -162,11 +162,28 @@ fn one_brdf_sample_and_a_full_arena_still_sample_correctly() {
     let brdf = sampler_core::brdf::RoughConductor::new(0.05, Vec3::ONE);
     // K = 1: a single leaf, i.e. B̃ constant.
     let mut tiny: Box<ProductArena<1, 16>> = Box::new(ProductArena::new());
-    let n = check_distribution(&mut tiny, &brdf, &ProductParams::default(), &env);
+    let one = ProductParams { brdf_samples: 1, ..ProductParams::default() };
+    let n = check_distribution(&mut tiny, &brdf, &one, &env);
     assert_eq!(n, 1);
     // 256 samples but room for only 64 nodes: splitting stops early, leaves keep the mean of
     // their samples, the distribution stays exact.
     let mut small: Box<ProductArena<256, 64>> = Box::new(ProductArena::new());
     let n = check_distribution(&mut small, &brdf, &ProductParams::default(), &env);
     assert!(n <= 64 && n > 16);
+}
+
+#[test]
+fn more_brdf_samples_than_the_arena_holds_is_an_error_naming_both() {
+    use sampler_core::sampler::ProductError;
+    let env = TestEnv::random_smooth(4, 1);
+    let e = env.view();
+    let mut arena: Box<ProductArena<64, 512>> = Box::default();
+    let frame = Frame::from_normal(Vec3::Z);
+    let params = ProductParams { brdf_samples: 65, ..ProductParams::default() };
+    let brdf = sampler_core::brdf::Lambert::new(Vec3::ONE);
+    let err = arena.build(&e, &brdf, &frame, Vec3::Z, &params, 1).unwrap_err();
+    assert_eq!(err, ProductError::AboveCapacity { asked: 65, capacity: 64 });
+    assert_eq!(err.to_string(), "65 BRDF samples asked of a product arena that holds 64");
+    let params = ProductParams { brdf_samples: 64, ..params };
+    assert!(arena.build(&e, &brdf, &frame, Vec3::Z, &params, 1).is_ok());
 }

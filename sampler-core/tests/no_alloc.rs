@@ -80,7 +80,7 @@ fn ten_thousand_shading_points_allocate_nothing() {
             2 => ProductParams { bilinear: true, ..ProductParams::for_mis(256) },
             _ => ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() },
         };
-        let sampler = arena.build(&env, brdf, &frame, wo, &params, i);
+        let sampler = arena.build(&env, brdf, &frame, wo, &params, i).unwrap();
         let mut points = [DVec2::ZERO; 4];
         sobol02(i, 0, &mut points);
         let sp = ShadingPoint { frame, wo, brdf };
@@ -99,7 +99,7 @@ fn ten_thousand_shading_points_allocate_nothing() {
             sink += estimator::ris(&env, &sp, &points, u.x, &mut vis).value.x;
             let two: sampler_core::two_stage::TwoStageSampler<'_, '_> =
                 sampler_core::two_stage::TwoStageSampler::new(&env, &sat, brdf, &frame, wo);
-            sink += estimator::two_stage(&two, &env, &sp, u, &mut vis).value.x;
+            sink += estimator::sampled(&two, &sp, u, &mut vis).value.x;
             let two = two_level.build(&env, &cones, brdf, &frame, wo).unwrap();
             sink += two.pdf(wo) as f64;
             sink += estimator::sampled(&two, &sp, u, &mut vis).value.x;
@@ -111,14 +111,12 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let brdf_points = points.map(|p| p.as_vec2());
         estimator::sampled_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
-        sink += estimator::product_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        sink += estimator::mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        let mut drawn = [None; 4];
-        env.sample_many(&points, &mut drawn);
-        estimator::mis_many(&env, &sp, &drawn, &brdf_points, &mut vis, &mut pairs);
+        sink += estimator::sampled_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
+        sink += estimator::sampled_mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
+        estimator::sampled_mis_many(&env, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
         let mut singles = [estimator::Contribution::default(); 4];
-        estimator::env_many(&env, &sp, &drawn, &mut vis, &mut singles);
+        estimator::sampled_many(&env, &sp, &points, &mut vis, &mut singles);
         sink += singles.iter().map(|c| c.value.x).sum::<f64>();
         estimator::brdf_many(&env, &sp, &brdf_points, &mut vis, &mut singles);
         sink += singles.iter().map(|c| c.value.x).sum::<f64>();

@@ -66,7 +66,7 @@ fn env_and_product_pdfs_integrate_to_one() {
                 {
                     let frame = Frame::from_normal(*normal);
                     let wo = frame.to_world(Vec3::new(0.6, 0.0, 0.8));
-                    let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, k as u64);
+                    let s = arena.build(&e, brdf.as_ref(), &frame, wo, &params, k as u64).unwrap();
                     let total = dyadic_integral(&|uv| s.constant_depth_at(uv), &|uv| s.pdf_square(uv), 0, 0, 0);
                     assert!((total - 1.0).abs() < 1e-4, "{name} {kind:?}: {total}");
                 }

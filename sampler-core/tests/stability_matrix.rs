@@ -216,7 +216,7 @@ fn every_estimator_on_every_extreme_case() {
                                 } else {
                                     ProductParams { kind, brdf_samples, ..ProductParams::default() }
                                 };
-                                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed);
+                                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
                                 for i in 0..32 {
                                     push(if *method == "product-mis" {
                                         let [a, c] =
@@ -231,7 +231,7 @@ fn every_estimator_on_every_extreme_case() {
                                 let s: TwoStageSampler<'_, '_> =
                                     TwoStageSampler::new(&env, &sat, brdf.as_ref(), &frame, wo);
                                 for p in pts {
-                                    push(lum(estimator::two_stage(&s, &env, &sp, p, &mut vis).value));
+                                    push(lum(estimator::sampled(&s, &sp, p, &mut vis).value));
                                 }
                             }
                             "ris" => {

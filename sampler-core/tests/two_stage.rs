@@ -97,7 +97,7 @@ fn two_stage_estimator_is_unbiased() {
         let (mut mean, mut m2) = (0.0f64, 0.0f64);
         for i in 0..n {
             let v = estimator::luminance64(
-                estimator::two_stage(&s, &e, &sp, DVec2::new(rng.next_f64(), rng.next_f64()), &mut |_| true).value,
+                estimator::sampled(&s, &sp, DVec2::new(rng.next_f64(), rng.next_f64()), &mut |_| true).value,
             );
             let d = v - mean;
             mean += d / (i + 1) as f64;
@@ -131,7 +131,7 @@ fn two_stage_finds_a_needle_lobe_under_a_uniform_sky() {
         let (mut mean, mut m2) = (0.0f64, 0.0f64);
         for i in 0..n {
             let u = DVec2::new(rng.next_f64(), rng.next_f64());
-            let v = estimator::luminance64(estimator::two_stage(&s, &e, &sp, u, &mut |_| true).value);
+            let v = estimator::luminance64(estimator::sampled(&s, &sp, u, &mut |_| true).value);
             let d = v - mean;
             mean += d / (i + 1) as f64;
             m2 += d * (v - mean);

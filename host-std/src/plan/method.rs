@@ -26,6 +26,11 @@ pub enum Method {
     Ris,
     /// Two-stage importance sampling (Cline et al. 2006).
     TwoStage,
+    /// The two-level product (Conty Estevez & Lecocq 2018): a coarse grid's cells weighted by
+    /// the BRDF's bound, then the map's own hierarchy inside the drawn cell.
+    TwoLevel,
+    /// MIS of the two-level product and BRDF samples, in pairs.
+    TwoLevelMis,
     /// Per material, the strategy of `auto`'s rules ([`rules::auto_strategy`]), checked by a
     /// pilot render of the material's pixels that replaces it where another measures
     /// [`OVERRIDE_MARGIN`](crate::plan::pilot::OVERRIDE_MARGIN)× as good (`plan::pilot`).
@@ -34,7 +39,7 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order `--help` lists them.
-    pub const ALL: [Method; 9] = [
+    pub const ALL: [Method; 11] = [
         Method::Product,
         Method::Wavelet,
         Method::Env,
@@ -43,6 +48,8 @@ impl Method {
         Method::ProductMis,
         Method::Ris,
         Method::TwoStage,
+        Method::TwoLevel,
+        Method::TwoLevelMis,
         Method::Auto,
     ];
 
@@ -58,6 +65,8 @@ impl Method {
             Method::ProductMis => "product-mis",
             Method::Ris => "ris",
             Method::TwoStage => "two-stage",
+            Method::TwoLevel => "two-level",
+            Method::TwoLevelMis => "two-level-mis",
             Method::Auto => "auto",
         }
     }
@@ -76,6 +85,8 @@ impl Method {
             Method::ProductMis => Strategy::ProductMis { product_share: rules::product_share(bsdf, env_peak) },
             Method::Ris => Strategy::Ris,
             Method::TwoStage => Strategy::TwoStage,
+            Method::TwoLevel => Strategy::TwoLevel,
+            Method::TwoLevelMis => Strategy::TwoLevelMis { two_level_share: 0.5 },
             Method::Auto => rules::auto_strategy(bsdf, env_peak),
         }
     }
@@ -92,6 +103,8 @@ impl Method {
             Strategy::ProductMis { .. } => Method::ProductMis,
             Strategy::Ris => Method::Ris,
             Strategy::TwoStage => Method::TwoStage,
+            Strategy::TwoLevel => Method::TwoLevel,
+            Strategy::TwoLevelMis { .. } => Method::TwoLevelMis,
         }
     }
 
@@ -125,7 +138,11 @@ impl FromStr for Method {
 pub fn strategy_name(strategy: Strategy) -> String {
     let name = Method::of(strategy).name();
     match strategy {
-        Strategy::Mis { env_share: split } | Strategy::ProductMis { product_share: split } if split != 0.5 => {
+        Strategy::Mis { env_share: split }
+        | Strategy::ProductMis { product_share: split }
+        | Strategy::TwoLevelMis { two_level_share: split }
+            if split != 0.5 =>
+        {
             format!("{name} {}:{}", (split * 4.0).round(), ((1.0 - split) * 4.0).round())
         }
         _ => name.to_string(),

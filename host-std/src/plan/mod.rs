@@ -10,7 +10,7 @@ pub use method::Method;
 
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
-use crate::render::{Context, Options, summed_area_table};
+use crate::render::{Context, Options, summed_area_table, two_level_cones};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
@@ -91,9 +91,19 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         .collect();
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));
+    let cones = env.and_then(|e| two_level_cones(e, &plans));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
-    let ctx = Context { scene, bvh, env, sat: sat.as_deref(), camera: &camera, options: &options, plans: &plans };
+    let ctx = Context {
+        scene,
+        bvh,
+        env,
+        sat: sat.as_deref(),
+        cones: cones.as_deref(),
+        camera: &camera,
+        options: &options,
+        plans: &plans,
+    };
     // Timed from here: `auto`'s pilot is part of its cost.
     let start = Instant::now();
     let (chosen, pilot) = match (settings.method, env) {

@@ -112,7 +112,12 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
         Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak),
         Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
-        Strategy::Product | Strategy::Wavelet | Strategy::Ris | Strategy::TwoStage => false,
+        Strategy::Product
+        | Strategy::Wavelet
+        | Strategy::Ris
+        | Strategy::TwoStage
+        | Strategy::TwoLevel
+        | Strategy::TwoLevelMis { .. } => false,
     }
 }
 

@@ -51,6 +51,9 @@ pub struct Context<'a, 'e> {
     pub env: Option<&'a EnvHierarchy<'e>>,
     /// The summed-area table of `env`, built when a material is sampled two-stage.
     pub sat: Option<&'a [f64]>,
+    /// The cell cones of the two-level product's coarse level, built when a material is
+    /// sampled with it.
+    pub cones: Option<&'a [sampler_core::cone::Cone]>,
     /// The camera.
     pub camera: &'a Camera,
     /// How pixels are sampled.
@@ -79,6 +82,18 @@ impl AddAssign for Counters {
         self.camera_rays += other.camera_rays;
         self.non_finite += other.non_finite;
     }
+}
+
+/// The cell cones the two-level product reads, built when a plan needs it: of
+/// [`strategy::TWO_LEVEL_LEVEL`], or of the map's finest level if that is coarser.
+#[must_use]
+pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<sampler_core::cone::Cone>> {
+    plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
+        let level = strategy::TWO_LEVEL_LEVEL.min(env.finest_level());
+        let mut cones = vec![sampler_core::cone::Cone::default(); sampler_core::cone::cell_count(level)];
+        sampler_core::cone::build_cell_cones(&mut cones);
+        cones
+    })
 }
 
 /// The summed-area table two-stage sampling reads, built when a plan needs it.

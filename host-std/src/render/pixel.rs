@@ -1,7 +1,7 @@
 //! One pixel, in named steps: for each of its shading points a camera ray
-//! ([`camera_ray`]), its intersection with the scene, the shading point there
-//! ([`surface`]); then the light sampled at every shading point ([`sample_light`]), and the
-//! pixel's mean ([`accumulate`]).
+//! (`camera_ray`), its intersection with the scene, the shading point there
+//! (`surface`); then the light sampled at every shading point (`sample_light`), and the
+//! pixel's mean (`accumulate`).
 
 use crate::render::sampler_cache::{Lead, SamplerCache};
 use crate::render::shade::{self, CountingVisibility, Run};

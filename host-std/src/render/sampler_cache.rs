@@ -19,6 +19,7 @@ use sampler_core::estimator::ShadingPoint;
 use sampler_core::glam::Vec3;
 use sampler_core::quadtree::ProductKind;
 use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
+use sampler_core::two_level::{TwoLevelArena, TwoLevelSampler};
 use sampler_core::two_stage::TwoStageSampler;
 
 /// Share of a material's lobe width within which the tile's next pixels reuse a product-MIS
@@ -33,13 +34,16 @@ const WIDEST_REUSED_LOBE: f32 = 0.4;
 
 /// Cosine of the largest angle at which a product-MIS sampler built at one shading point is
 /// reused at another of the same material: [`REUSE_SHARE`] of its sharpest lobe's width, and at
-/// most of [`WIDEST_REUSED_LOBE`] (diffuse). Sharing stays unbiased whatever the angle (MIS
+/// most of `WIDEST_REUSED_LOBE` (diffuse). Sharing stays unbiased whatever the angle (MIS
 /// with BRDF sampling and the defensive part cover every direction); the angle trades build
 /// time for variance.
 #[must_use]
 pub fn reuse_cosine(bsdf: &Bsdf) -> f32 {
     (REUSE_SHARE * bsdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
 }
+
+/// `--brdf-samples` is at most the arena's capacity (the command line's range).
+const BRDF_SAMPLES_FIT: &str = "--brdf-samples within the product arena's capacity";
 
 /// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
 /// direction of the shading point it was built at.
@@ -64,6 +68,8 @@ pub(crate) struct Lead<'a> {
 pub(crate) struct SamplerCache {
     /// For the product samplers built per shading point.
     arena: Option<Box<ProductArena>>,
+    /// For the two-level samplers, built per shading point.
+    two_level: Option<Box<TwoLevelArena>>,
     /// Per material, the product-MIS sampler built last and where.
     shared: Vec<Option<SharedSampler>>,
 }
@@ -71,7 +77,7 @@ pub(crate) struct SamplerCache {
 impl SamplerCache {
     /// An empty cache for a scene of `materials` materials.
     pub fn new(materials: usize) -> Self {
-        Self { arena: None, shared: (0..materials).map(|_| None).collect() }
+        Self { arena: None, two_level: None, shared: (0..materials).map(|_| None).collect() }
     }
 
     /// The sampling of `lead`'s material at its shading point, with the sampler it needs built
@@ -98,7 +104,24 @@ impl SamplerCache {
                 let sat = ctx.sat.expect("the summed-area table is built when a material is sampled two-stage");
                 Sampling::TwoStage(TwoStageSampler::new(env, sat, sp.brdf, &sp.frame, sp.wo))
             }
+            Strategy::TwoLevel => Sampling::TwoLevel(self.two_level(ctx, env, lead)),
+            Strategy::TwoLevelMis { two_level_share } => {
+                Sampling::TwoLevelMis { sampler: self.two_level(ctx, env, lead), two_level_share }
+            }
         }
+    }
+
+    /// The two-level sampler of `lead`'s shading point.
+    fn two_level<'s, 'e>(
+        &'s mut self,
+        ctx: &Context<'s, 'e>,
+        env: &'s EnvHierarchy<'e>,
+        lead: &Lead<'_>,
+    ) -> TwoLevelSampler<'s, 'e> {
+        let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
+        let arena = self.two_level.get_or_insert_with(Box::default);
+        let sp = lead.sp;
+        arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect("the cones are of a level the map and the arena hold")
     }
 
     /// A product sampler of the paper's estimator, built for `lead` alone.
@@ -112,7 +135,7 @@ impl SamplerCache {
         let params = ProductParams { brdf_samples: ctx.options.brdf_samples, kind, ..ProductParams::default() };
         let arena = self.arena.get_or_insert_with(|| Box::new(ProductArena::new()));
         let sp = lead.sp;
-        arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed)
+        arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT)
     }
 
     /// The product-MIS sampler of `lead`'s material: the kept one if it was built within the
@@ -132,7 +155,7 @@ impl SamplerCache {
         if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
             let c = slot.get_or_insert_with(|| SharedSampler { arena: Box::new(ProductArena::new()), normal, mirror });
             let params = ProductParams::for_mis(ctx.options.brdf_samples);
-            c.arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed);
+            c.arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT);
             (c.normal, c.mirror) = (normal, mirror);
         }
         let slot: &'s Option<SharedSampler> = slot;

@@ -3,12 +3,14 @@
 //! them one per technique, so it takes ⌊budget/2⌋ pairs (at least one).
 
 use sampler_core::brdf::Brdf;
+use sampler_core::direction::DirectionSampler;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::{self, BATCH, Contribution, ShadingPoint, Visibility};
 use sampler_core::glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::ProductSampler;
+use sampler_core::two_level::TwoLevelSampler;
 use sampler_core::two_stage::TwoStageSampler;
 
 /// Candidates per RIS estimate (each costs an env or BRDF sample and an evaluation, no ray).
@@ -59,6 +61,15 @@ pub enum Sampling<'s, 'e> {
     },
     /// Two-stage importance sampling through its partition.
     TwoStage(TwoStageSampler<'s, 'e>),
+    /// The two-level product, built for this shading point.
+    TwoLevel(TwoLevelSampler<'s, 'e>),
+    /// MIS of the two-level product and BRDF samples.
+    TwoLevelMis {
+        /// The two-level sampler.
+        sampler: TwoLevelSampler<'s, 'e>,
+        /// Share of the budget spent on two-level samples; ½ spends it in pairs.
+        two_level_share: f64,
+    },
 }
 
 /// Where a shading point's samples come from: the pixel's light-sample seed, and the block of
@@ -86,18 +97,19 @@ pub fn shade<B: Brdf + ?Sized>(
 ) -> DVec3 {
     let budget = budget.max(1);
     match sampling {
-        Sampling::ProductMis { sampler, product_share } => {
-            shade_split(First::Product(sampler), sp, budget, *product_share, run, vis)
+        Sampling::ProductMis { sampler, product_share } => shade_split(sampler, sp, budget, *product_share, run, vis),
+        Sampling::Mis { env_share } if *env_share != 0.5 => shade_split(env, sp, budget, *env_share, run, vis),
+        Sampling::TwoLevelMis { sampler, two_level_share } if *two_level_share != 0.5 => {
+            shade_split(sampler, sp, budget, *two_level_share, run, vis)
         }
-        Sampling::Mis { env_share } if *env_share != 0.5 => {
-            shade_split(First::Env(env), sp, budget, *env_share, run, vis)
-        }
-        Sampling::Mis { .. } => mis_pairs(env, sp, (budget / 2).max(1), run, vis),
-        Sampling::Env => env_only(env, sp, budget, run, vis),
+        Sampling::TwoLevelMis { sampler, .. } => sampled_pairs(sampler, sp, (budget / 2).max(1), run, vis),
+        Sampling::TwoLevel(sampler) => sampled_only(sampler, sp, budget, run, vis),
+        Sampling::Mis { .. } => sampled_pairs(env, sp, (budget / 2).max(1), run, vis),
+        Sampling::Env => sampled_only(env, sp, budget, run, vis),
         Sampling::Brdf => brdf_only(env, sp, budget, run, vis),
         Sampling::Ris => ris(env, sp, budget, run, vis),
-        Sampling::Product(sampler) => product(sampler, sp, budget, run, vis),
-        Sampling::TwoStage(sampler) => two_stage(sampler, env, sp, budget, run, vis),
+        Sampling::Product(sampler) => sampled_only(sampler, sp, budget, run, vis),
+        Sampling::TwoStage(sampler) => two_stage(sampler, sp, budget, run, vis),
     }
 }
 
@@ -126,50 +138,6 @@ fn brdf_points(points: &[DVec2]) -> [Vec2; BATCH] {
         *b = p.as_vec2();
     }
     out
-}
-
-/// MIS of env and BRDF samples in `n` pairs; the batch's env samples are drawn together (their
-/// descents overlap).
-fn mis_pairs<B: Brdf + ?Sized>(
-    env: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    n: usize,
-    run: Run,
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    let mut others = [DVec2::ZERO; BATCH];
-    let mut drawn = [None; BATCH];
-    let mut pairs = [[Contribution::default(); 2]; BATCH];
-    batched(n, run, |points, first, done, sum| {
-        let m = points.len();
-        sobol02(hash_combine(run.seed, 2), first + done as u32, &mut others[..m]);
-        env.sample_many(points, &mut drawn[..m]);
-        let brdf = brdf_points(&others[..m]);
-        estimator::mis_many(env, sp, &drawn[..m], &brdf[..m], vis, &mut pairs[..m]);
-        for pair in &pairs[..m] {
-            *sum += pair[0].value + pair[1].value;
-        }
-    })
-}
-
-/// Env samples only, each batch drawn together.
-fn env_only<B: Brdf + ?Sized>(
-    env: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    n: usize,
-    run: Run,
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    let mut drawn = [None; BATCH];
-    let mut singles = [Contribution::default(); BATCH];
-    batched(n, run, |points, _, _, sum| {
-        let m = points.len();
-        env.sample_many(points, &mut drawn[..m]);
-        estimator::env_many(env, sp, &drawn[..m], vis, &mut singles[..m]);
-        for s in &singles[..m] {
-            *sum += s.value;
-        }
-    })
 }
 
 /// BRDF samples only.
@@ -209,9 +177,9 @@ fn ris<B: Brdf + ?Sized>(
     })
 }
 
-/// Product samples, each batch drawn together.
-fn product<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
+/// Samples of one sampler of the environment (a product), each batch drawn together.
+fn sampled_only<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
     sp: &ShadingPoint<'_, B>,
     n: usize,
     run: Run,
@@ -222,15 +190,36 @@ fn product<B: Brdf + ?Sized>(
         let m = points.len();
         sampler.sample_many(points, &mut drawn[..m]);
         for d in &drawn[..m] {
-            *sum += estimator::product_drawn(sampler, sp, *d, vis).value;
+            *sum += estimator::sampled_drawn(sampler, sp, *d, vis).value;
         }
     })
 }
 
-/// Two-stage samples through the partition.
+/// MIS of a sampler of the environment and BRDF samples in `n` pairs, each batch drawn
+/// together.
+fn sampled_pairs<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
+    sp: &ShadingPoint<'_, B>,
+    n: usize,
+    run: Run,
+    vis: &mut impl Visibility,
+) -> DVec3 {
+    let mut others = [DVec2::ZERO; BATCH];
+    let mut pairs = [[Contribution::default(); 2]; BATCH];
+    batched(n, run, |points, first, done, sum| {
+        let m = points.len();
+        sobol02(hash_combine(run.seed, 2), first + done as u32, &mut others[..m]);
+        let brdf = brdf_points(&others[..m]);
+        estimator::sampled_mis_many(sampler, sp, points, &brdf[..m], vis, &mut pairs[..m]);
+        for pair in &pairs[..m] {
+            *sum += pair[0].value + pair[1].value;
+        }
+    })
+}
+
+/// Two-stage samples through the partition, one at a time.
 fn two_stage<B: Brdf + ?Sized>(
     sampler: &TwoStageSampler<'_, '_>,
-    env: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
     n: usize,
     run: Run,
@@ -238,22 +227,16 @@ fn two_stage<B: Brdf + ?Sized>(
 ) -> DVec3 {
     batched(n, run, |points, _, _, sum| {
         for u in points {
-            *sum += estimator::two_stage(sampler, env, sp, *u, vis).value;
+            *sum += estimator::sampled(sampler, sp, *u, vis).value;
         }
     })
-}
-
-/// The technique an MIS split draws beside BRDF sampling.
-enum First<'s, 'e> {
-    Product(&'s ProductSampler<'s, 'e>),
-    Env(&'s EnvHierarchy<'e>),
 }
 
 /// MIS at one shading point with the budget split: ⌊share·budget⌉ samples of `first` and the
 /// rest BRDF samples (at least one of each; a budget of one still takes one of each), each
 /// technique's points this shading point's run of the pixel's (0,2)-sequence for it.
-fn shade_split<B: Brdf + ?Sized>(
-    first: First<'_, '_>,
+fn shade_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    first: &S,
     sp: &ShadingPoint<'_, B>,
     budget: usize,
     share: f64,
@@ -283,10 +266,7 @@ fn shade_split<B: Brdf + ?Sized>(
             *b = o.as_vec2();
         }
         let (u_p, u_b) = (&first_points[..m_p], &brdf_points_f32[..m_b]);
-        sum += match first {
-            First::Product(sampler) => estimator::product_mis_split(sampler, sp, u_p, u_b, shares, vis),
-            First::Env(env) => estimator::mis_split(env, sp, u_p, u_b, shares, vis),
-        };
+        sum += estimator::sampled_mis_split(first, sp, u_p, u_b, shares, vis);
         (done_p, done_b) = (done_p + m_p, done_b + m_b);
     }
     sum / total

@@ -36,6 +36,26 @@ pub enum Strategy {
     /// Two-stage importance sampling (Cline et al. 2006, reconstructed in sampler-core's
     /// `two_stage.rs`): a BRDF-driven partition weighted through a summed-area table.
     TwoStage,
+    /// The two-level product (`sampler_core::two_level`): cells of a coarse level of the map
+    /// ([`TWO_LEVEL_LEVEL`]) drawn ∝ the BRDF's bound × their light, then a texel ∝ light.
+    TwoLevel,
+    /// MIS of the two-level product and BRDF samples, built per shading point.
+    TwoLevelMis {
+        /// Share of the budget spent on two-level samples; ½ spends it in pairs.
+        two_level_share: f64,
+    },
+}
+
+/// The coarse level of the two-level product: 16 × 16 cells of the equal-area square (clamped
+/// to the map's finest level).
+pub const TWO_LEVEL_LEVEL: u32 = 4;
+
+impl Strategy {
+    /// Whether its shading points draw from the two-level product.
+    #[must_use]
+    pub fn is_two_level(self) -> bool {
+        matches!(self, Strategy::TwoLevel | Strategy::TwoLevelMis { .. })
+    }
 }
 
 /// How a material is shaded, resolved once per render.

@@ -9,7 +9,6 @@ use crate::brdf::{Brdf, BrdfSample};
 use crate::direction::{DirectionSample, DirectionSampler};
 use crate::env::EnvHierarchy;
 use crate::mapping::SPHERE_AREA;
-use crate::sampler::ProductSampler;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
@@ -60,41 +59,6 @@ pub fn sampled_many<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
         let mut drawn = [None; BATCH];
         sampler.sample_many(&us[..n], &mut drawn[..n]);
         drawn_many(sampler.env(), sp, &drawn[..n], vis, &mut os[..n]);
-    }
-}
-
-/// [`sampled_mis_drawn`](super::sampled_mis_drawn) of the env-only sampler for every pair
-/// (`out[k]` from `drawn[k]` and `u_brdf[k]`), e.g. with the env samples of
-/// [`EnvHierarchy::sample_many`]: the same values as one pair at a time.
-pub fn mis_many<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<DirectionSample>],
-    u_brdf: &[Vec2],
-    vis: &mut impl Visibility,
-    out: &mut [[Contribution; 2]],
-) {
-    let n = drawn.len().min(u_brdf.len()).min(out.len());
-    for start in (0..n).step_by(BATCH) {
-        let end = (start + BATCH).min(n);
-        let pdf_square_many = |uv: &[Vec2], p: &mut [f32]| env_h.pdf_square_many(uv, p);
-        let (u_b, o) = (&u_brdf[start..end], &mut out[start..end]);
-        mis_with_brdf_batch(env_h, sp, &drawn[start..end], u_b, pdf_square_many, vis, o);
-    }
-}
-
-/// [`sampled_drawn`](super::sampled_drawn) of the env-only sampler for every drawn sample
-/// (`out[k]` from `drawn[k]`), the BRDF evaluated a batch at a time ([`Brdf::eval_pdf_many`]):
-/// the same values, bit for bit.
-pub fn env_many<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    drawn: &[Option<DirectionSample>],
-    vis: &mut impl Visibility,
-    out: &mut [Contribution],
-) {
-    for (ds, os) in drawn.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
-        drawn_many(env_h, sp, ds, vis, os);
     }
 }
 
@@ -205,7 +169,8 @@ fn brdf_draws<B: Brdf + ?Sized>(
     (brdf, p_other)
 }
 
-/// Product and BRDF sampling in MIS with the budget split unevenly (Veach's multi-sample
+/// Any sampler of the environment (a product, the env-only sampler…) and BRDF sampling in MIS
+/// with the budget split unevenly (Veach's multi-sample
 /// balance heuristic): `shares = (c_p, c_b)` are the fractions of the shading point's samples
 /// that each technique draws (c_p + c_b = 1), and every sample, whichever technique drew it,
 /// weighs f·V / (c_p·p_product + c_b·p_brdf). Returns the sum over these points — any number
@@ -214,38 +179,9 @@ fn brdf_draws<B: Brdf + ?Sized>(
 /// together they cover every direction where L·B > 0 (the product through its defensive part).
 /// Where a wide lobe meets extended light, product samples are worth more than BRDF samples,
 /// and a split towards them lowers the error (docs/perf.md#budget-splits); with shares (½, ½) and as many
-/// points of each it is [`sampled_mis_many`]'s estimate.
-pub fn product_mis_split<B: Brdf + ?Sized>(
-    sampler: &ProductSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    u_product: &[DVec2],
-    u_brdf: &[Vec2],
-    shares: (f32, f32),
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    sampled_mis_split(sampler, sp, u_product, u_brdf, shares, vis)
-}
-
-/// Env and BRDF sampling in MIS with the budget split unevenly: [`product_mis_split`] with
-/// env-only samples in place of product samples. With shares (½, ½) it is [`mis_many`]'s
-/// estimate; `ppis`'s `auto` spends 3 of 4 samples on the environment on diffuse surfaces under
-/// extended light, where a cosine-weighted BRDF sample finds the bright regions less often
-/// than an env sample (docs/perf.md#budget-splits).
-pub fn mis_split<B: Brdf + ?Sized>(
-    env_h: &EnvHierarchy<'_>,
-    sp: &ShadingPoint<'_, B>,
-    u_env: &[DVec2],
-    u_brdf: &[Vec2],
-    shares: (f32, f32),
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    sampled_mis_split(env_h, sp, u_env, u_brdf, shares, vis)
-}
-
-/// Any sampler of the environment and BRDF sampling in MIS with the budget split unevenly, as
-/// [`product_mis_split`] describes: the sum of f·V / (c_d·p_first + c_b·p_brdf) over the points
-/// of both techniques — all of the first technique's samples, then the BRDF's, one by one (the
-/// same order and rounding however the points are batched).
+/// points of each it is [`sampled_mis_many`]'s estimate. The sum runs over all of the first
+/// technique's samples, then the BRDF's, one by one (the same order and rounding however the
+/// points are batched).
 pub fn sampled_mis_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     first: &S,
     sp: &ShadingPoint<'_, B>,
