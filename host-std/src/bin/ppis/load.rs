@@ -13,7 +13,9 @@ pub(crate) struct Loaded {
     pub(crate) usd: Option<host_usd::UsdScene>,
 }
 
-/// Loads the scene the arguments name (or the default scene) and applies `--env`.
+/// Loads the scene the arguments name (or the default scene) and applies `--env`. `size` is
+/// the command line's width and height, which a USD stage's render settings are conformed to.
+#[cfg_attr(not(feature = "usd"), allow(unused_variables))]
 pub(crate) fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>)) -> Result<Loaded> {
     #[cfg(feature = "usd")]
     let mut usd = None;
