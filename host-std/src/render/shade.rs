@@ -109,7 +109,7 @@ pub fn shade<B: Brdf + ?Sized>(
         Sampling::Brdf => brdf_only(env, sp, budget, run, vis),
         Sampling::Ris => ris(env, sp, budget, run, vis),
         Sampling::Product(sampler) => sampled_only(sampler, sp, budget, run, vis),
-        Sampling::TwoStage(sampler) => two_stage(sampler, sp, budget, run, vis),
+        Sampling::TwoStage(sampler) => sampled_only(sampler, sp, budget, run, vis),
     }
 }
 
@@ -177,7 +177,7 @@ fn ris<B: Brdf + ?Sized>(
     })
 }
 
-/// Samples of one sampler of the environment (a product), each batch drawn together.
+/// Samples of one sampler of the environment (a product, two-stage), each batch drawn together.
 fn sampled_only<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     sampler: &S,
     sp: &ShadingPoint<'_, B>,
@@ -213,21 +213,6 @@ fn sampled_pairs<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
         estimator::sampled_mis_many(sampler, sp, points, &brdf[..m], vis, &mut pairs[..m]);
         for pair in &pairs[..m] {
             *sum += pair[0].value + pair[1].value;
-        }
-    })
-}
-
-/// Two-stage samples through the partition, one at a time.
-fn two_stage<B: Brdf + ?Sized>(
-    sampler: &TwoStageSampler<'_, '_>,
-    sp: &ShadingPoint<'_, B>,
-    n: usize,
-    run: Run,
-    vis: &mut impl Visibility,
-) -> DVec3 {
-    batched(n, run, |points, _, _, sum| {
-        for u in points {
-            *sum += estimator::sampled(sampler, sp, *u, vis).value;
         }
     })
 }
