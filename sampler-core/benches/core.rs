@@ -85,6 +85,18 @@ fn sunny_map(level: u32) -> Map {
     Map { level, rgb, pyramid }
 }
 
+/// 100 shading points with different normals and views, cycled by the benchmarks.
+fn shading_point_set() -> Vec<(Frame, Vec3)> {
+    let mut rng = Pcg32::new(7, 7);
+    (0..100)
+        .map(|_| {
+            let n = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
+            let f = Frame::from_normal(n);
+            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
+        })
+        .collect()
+}
+
 fn shading_points(c: &mut Criterion) {
     let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
@@ -93,15 +105,7 @@ fn shading_points(c: &mut Criterion) {
         ("carpaint", Box::new(CarPaint::default())),
     ];
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    // 100 shading points with different normals and views, cycled.
-    let mut rng = Pcg32::new(7, 7);
-    let points: Vec<(Frame, Vec3)> = (0..100)
-        .map(|_| {
-            let n = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
-            let f = Frame::from_normal(n);
-            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
-        })
-        .collect();
+    let points = shading_point_set();
     for level in [10u32, 12] {
         let map = sunny_map(level);
         let env = EnvHierarchy::new(map.level, &map.pyramid, &map.rgb).unwrap();
@@ -180,14 +184,7 @@ fn two_level_points(c: &mut Criterion) {
             v
         })
         .collect();
-    let mut rng = Pcg32::new(7, 7);
-    let points: Vec<(Frame, Vec3)> = (0..100)
-        .map(|_| {
-            let n = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
-            let f = Frame::from_normal(n);
-            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
-        })
-        .collect();
+    let points = shading_point_set();
     for level in [10u32, 12] {
         let map = sunny_map(level);
         let env = EnvHierarchy::new(map.level, &map.pyramid, &map.rgb).unwrap();

@@ -9,6 +9,7 @@
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, RoughConductor};
 use sampler_core::cone::{Cone, build_cell_cones, cell_count};
+use sampler_core::direction::DirectionSampler;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
@@ -87,47 +88,28 @@ fn main() {
             let frame = Frame::from_normal((normal + Vec3::new(0.08, 0.0, 0.0)).normalize());
             let wo = Vec3::new(-0.2, 0.1, 1.0).normalize();
             let sp = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
-            let points = |seed: u64| {
+            // One shading point's MIS estimate from `PAIRS` pairs, whatever the sampler.
+            let pairs = |s: &dyn DirectionSampler, seed: u64| {
                 let (mut p, mut q) = ([DVec2::ZERO; PAIRS], [DVec2::ZERO; PAIRS]);
                 sobol02(seed + 77, 0, &mut p);
                 sobol02(seed + 991, 0, &mut q);
-                (p, q.map(|q| q.as_vec2()))
-            };
-            let mut row = Vec::new();
-            row.push(measure(|seed| {
-                let (p, q) = points(seed);
-                (0..PAIRS)
-                    .map(|k| {
-                        let [a, b] = estimator::sampled_mis(&env, &sp, p[k], q[k], &mut |_| true);
+                let sum: f64 = p
+                    .iter()
+                    .zip(&q)
+                    .map(|(p, q)| {
+                        let [a, b] = estimator::sampled_mis(s, &sp, *p, q.as_vec2(), &mut |_| true);
                         luminance64(a.value + b.value)
                     })
-                    .sum::<f64>()
-                    / PAIRS as f64
-            }));
+                    .sum();
+                sum / PAIRS as f64
+            };
+            let mut row = vec![measure(|seed| pairs(&env, seed))];
             let params = ProductParams::for_mis(256);
             row.push(measure(|seed| {
-                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
-                let (p, q) = points(seed);
-                (0..PAIRS)
-                    .map(|k| {
-                        let [a, b] = estimator::sampled_mis(&s, &sp, p[k], q[k], &mut |_| true);
-                        luminance64(a.value + b.value)
-                    })
-                    .sum::<f64>()
-                    / PAIRS as f64
+                pairs(&arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap(), seed)
             }));
             for c in &cones {
-                row.push(measure(|seed| {
-                    let s = two.build(&env, c, brdf.as_ref(), &frame, wo).unwrap();
-                    let (p, q) = points(seed);
-                    (0..PAIRS)
-                        .map(|k| {
-                            let [a, b] = estimator::sampled_mis(&s, &sp, p[k], q[k], &mut |_| true);
-                            luminance64(a.value + b.value)
-                        })
-                        .sum::<f64>()
-                        / PAIRS as f64
-                }));
+                row.push(measure(|seed| pairs(&two.build(&env, c, brdf.as_ref(), &frame, wo).unwrap(), seed)));
             }
             let cells: Vec<String> = row.iter().map(|(v, us)| format!("{v:>9.3e} ({us:>5.1})")).collect();
             println!("{:<22} {}", name, cells.join(" "));
