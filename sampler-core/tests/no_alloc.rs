@@ -115,6 +115,21 @@ fn ten_thousand_shading_points_allocate_nothing() {
         sink += estimator::sampled_mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
         estimator::sampled_mis_many(&env, &sp, &points, &brdf_points, &mut vis, &mut pairs);
         sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+        // A wavefront over the shading point, both techniques.
+        let wave: [estimator::wavefront::WaveSample; 4] = core::array::from_fn(|k| estimator::wavefront::WaveSample {
+            point: 0,
+            technique: if k % 2 == 0 {
+                estimator::wavefront::Technique::Sampler
+            } else {
+                estimator::wavefront::Technique::Brdf
+            },
+            u: points[k],
+        });
+        let mut candidates = [estimator::wavefront::Candidate::default(); 4];
+        for w in [estimator::wavefront::Weighting::Single, estimator::wavefront::Weighting::Balance] {
+            estimator::wavefront::wavefront(&sampler, core::slice::from_ref(&sp), &wave, w, &mut candidates);
+            sink += candidates.iter().map(|c| c.value.x).sum::<f64>();
+        }
         let mut singles = [estimator::Contribution::default(); 4];
         estimator::sampled_many(&env, &sp, &points, &mut vis, &mut singles);
         sink += singles.iter().map(|c| c.value.x).sum::<f64>();

@@ -14,6 +14,7 @@ pub mod sampler_cache;
 pub mod shade;
 pub mod strategy;
 pub mod tiles;
+pub(crate) mod wavefront;
 
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;

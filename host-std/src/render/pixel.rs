@@ -4,8 +4,9 @@
 //! pixel's mean (`accumulate`).
 
 use crate::render::sampler_cache::{Lead, SamplerCache};
-use crate::render::shade::{self, CountingVisibility, Run};
+use crate::render::shade::{self, CountingVisibility, Run, Sampling};
 use crate::render::strategy::Strategy;
+use crate::render::wavefront::{self, WaveBuffers};
 use crate::render::{Context, Counters};
 use crate::scene::{Bsdf, Scene};
 use crate::trace::bvh;
@@ -43,6 +44,8 @@ pub struct Scratch {
     cache: SamplerCache,
     /// The pixel's primary hits.
     hits: Vec<Hit>,
+    /// The wavefronts' buffers.
+    waves: WaveBuffers,
     /// What the tile's pixels did so far.
     pub counters: Counters,
 }
@@ -54,6 +57,7 @@ impl Scratch {
         Self {
             cache: SamplerCache::new(materials),
             hits: Vec::with_capacity(shading_points.clamp(1, GROUP)),
+            waves: WaveBuffers::default(),
             counters: Counters::default(),
         }
     }
@@ -153,36 +157,82 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, index: usize) -> Op
 
 /// Samples the light at every shading point of the group in `scratch`, adding to `sum`: one
 /// sampler per shading point, or for product-MIS one per material, built at its first point.
+/// Where a material's sampler is the same at all its points (the environment, or the shared
+/// product-MIS sampler) and each point takes few samples, its points are shaded as one
+/// wavefront. The points' estimates are added in the order of the per-point path: hit order,
+/// and a product-MIS material's points together at its first.
 fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scratch: &mut Scratch, sum: &mut DVec3) {
-    let Scratch { cache, hits, counters } = scratch;
+    let Scratch { cache, hits, waves, counters } = scratch;
+    let n = hits.len();
     let p = ctx.options.shading_points.max(1);
     let budget = (ctx.options.spp / p).max(1);
     let shadows = ctx.options.shadows;
-    for first in 0..hits.len() {
-        let lead = &hits[first];
-        let group = lead.material;
-        let shared = matches!(ctx.plans[group].strategy, Strategy::ProductMis { .. });
-        if shared && hits[..first].iter().any(|h| h.material == group) {
-            // Shaded with the group's first point.
+    let run_of = |h: &Hit| Run {
+        seed: seeds.light,
+        block: permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize,
+    };
+    let mut values = [DVec3::ZERO; GROUP];
+    let mut done = [false; GROUP];
+    for first in 0..n {
+        if done[first] {
             continue;
         }
+        let lead = &hits[first];
+        let group = lead.material;
         let lead_sp = shading_point(ctx.scene, lead);
         let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
         let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });
-        let members =
-            hits[first..].iter().enumerate().filter(|(k, h)| if shared { h.material == group } else { *k == 0 });
-        for (_, h) in members {
-            counters.shading_points += 1;
-            let origin = h.origin;
-            let mut vis = CountingVisibility {
-                test: |d: Vec3| !shadows || !ctx.bvh.occluded(origin, d, 0.0, f32::INFINITY),
-                rays: 0,
-            };
-            let block = permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize;
-            let run = Run { seed: seeds.light, block };
-            *sum += shade::shade(&sampling, env, &shading_point(ctx.scene, h), budget, run, &mut vis);
-            // Only rays traced count.
-            counters.shadow_rays += if shadows { vis.rays } else { 0 };
+        // The material's points from here on, for a wavefront or a shared sampler.
+        let mut members = [0usize; GROUP];
+        let mut m = 0;
+        for k in (first..n).filter(|&k| hits[k].material == group) {
+            members[m] = k;
+            m += 1;
+        }
+        let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] =
+            std::array::from_fn(|i| shading_point(ctx.scene, &hits[members[i.min(m - 1)]]));
+        let runs: [Run; GROUP] = std::array::from_fn(|i| run_of(&hits[members[i.min(m - 1)]]));
+        let mut rays = 0u64;
+        let mut visible = |i: usize, d: Vec3| {
+            rays += 1;
+            !shadows || !ctx.bvh.occluded(hits[members[i]].origin, d, 0.0, f32::INFINITY)
+        };
+        let mut out = [DVec3::ZERO; GROUP];
+        let waved =
+            wavefront::shade_wavefront(&sampling, env, &points[..m], &runs[..m], budget, waves, &mut visible, &mut out);
+        let shaded = if waved.is_some() {
+            for (i, &k) in members[..m].iter().enumerate() {
+                (values[k], done[k]) = (out[i], true);
+            }
+            m
+        } else {
+            // One point, or a product-MIS material's points through their shared sampler.
+            let shaded = if matches!(sampling, Sampling::ProductMis { .. }) { m } else { 1 };
+            for (i, &k) in members[..shaded].iter().enumerate() {
+                let mut vis = CountingVisibility { test: |d: Vec3| visible(i, d), rays: 0 };
+                values[k] = shade::shade(&sampling, env, &points[i], budget, runs[i], &mut vis);
+                done[k] = true;
+            }
+            shaded
+        };
+        counters.shading_points += shaded as u64;
+        // Only rays traced count.
+        counters.shadow_rays += if shadows { rays } else { 0 };
+    }
+    add_in_order(ctx, hits, &values[..n], sum);
+}
+
+/// Adds the points' estimates to `sum` in hit order, a product-MIS material's points
+/// together at its first point.
+fn add_in_order(ctx: &Context<'_, '_>, hits: &[Hit], values: &[DVec3], sum: &mut DVec3) {
+    for (first, lead) in hits.iter().enumerate() {
+        let group = lead.material;
+        if !matches!(ctx.plans[group].strategy, Strategy::ProductMis { .. }) {
+            *sum += values[first];
+        } else if !hits[..first].iter().any(|h| h.material == group) {
+            for (k, _) in hits.iter().enumerate().skip(first).filter(|(_, h)| h.material == group) {
+                *sum += values[k];
+            }
         }
     }
 }

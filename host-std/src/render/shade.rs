@@ -2,6 +2,7 @@
 //! same budget: `budget` visibility samples (shadow rays) per shading point. MIS in pairs spends
 //! them one per technique, so it takes ⌊budget/2⌋ pairs (at least one).
 
+use crate::render::wavefront::split_counts;
 use sampler_core::brdf::Brdf;
 use sampler_core::direction::DirectionSampler;
 use sampler_core::env::EnvHierarchy;
@@ -229,12 +230,7 @@ fn shade_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     vis: &mut impl Visibility,
 ) -> DVec3 {
     let Run { seed, block } = run;
-    let (n_p, n_b) = if budget < 2 {
-        (1, 1)
-    } else {
-        let n_p = ((share * budget as f64).round() as usize).clamp(1, budget - 1);
-        (n_p, budget - n_p)
-    };
+    let (n_p, n_b) = split_counts(budget, share);
     let total = (n_p + n_b) as f64;
     let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
     let mut sum = DVec3::ZERO;

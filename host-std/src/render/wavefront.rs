@@ -1,0 +1,184 @@
+//! The light samples of all shading points of one material in a group, drawn as one wavefront
+//! (`sampler_core::estimator::wavefront`) where the material's sampler is the same at every
+//! point — the environment (env, BRDF and MIS sampling) or the pixel's shared product-MIS
+//! sampler — and each point takes few samples: then each point's estimate is the per-point
+//! estimator's ([`shade::shade`]) bit for bit, but the samples of all points are drawn
+//! together and their shadow rays traced together.
+
+use crate::render::shade::{Run, Sampling};
+use sampler_core::brdf::Brdf;
+use sampler_core::direction::DirectionSampler;
+use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
+use sampler_core::estimator::{BATCH, ShadingPoint};
+use sampler_core::glam::{DVec2, DVec3, Vec3};
+use sampler_core::points::sobol02;
+use sampler_core::rng::hash_combine;
+
+/// How each shading point of a wavefront spends its budget.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Layout {
+    /// `n` samples of one technique.
+    Single { technique: Technique, n: usize },
+    /// `n` pairs, one sample of each technique.
+    Pairs { n: usize },
+    /// `first` samples of the sampler, then `brdf` of the BRDF, the multi-sample balance
+    /// heuristic over them.
+    Split { first: usize, brdf: usize },
+}
+
+impl Layout {
+    /// Samples per shading point.
+    fn len(self) -> usize {
+        match self {
+            Layout::Single { n, .. } => n,
+            Layout::Pairs { n } => 2 * n,
+            Layout::Split { first, brdf } => first + brdf,
+        }
+    }
+}
+
+/// The wavefront layout of a budget as [`shade::shade`] spends it, where the strategy
+/// samples through one sampler for every point and each technique's samples fit one of its
+/// batches (larger budgets fill the per-point batches themselves).
+fn layout(sampling: &Sampling<'_, '_>, budget: usize) -> Option<Layout> {
+    let budget = budget.max(1);
+    let split = |share: f64| {
+        let (first, brdf) = split_counts(budget, share);
+        (first <= BATCH && brdf <= BATCH).then_some(Layout::Split { first, brdf })
+    };
+    let fits = |n: usize| n <= BATCH;
+    match *sampling {
+        Sampling::Env => fits(budget).then_some(Layout::Single { technique: Technique::Sampler, n: budget }),
+        Sampling::Brdf => fits(budget).then_some(Layout::Single { technique: Technique::Brdf, n: budget }),
+        Sampling::Mis { env_share: 0.5 } => {
+            let n = (budget / 2).max(1);
+            fits(n).then_some(Layout::Pairs { n })
+        }
+        Sampling::Mis { env_share } => split(env_share),
+        Sampling::ProductMis { product_share, .. } => split(product_share),
+        _ => None,
+    }
+}
+
+/// Samples of each technique for a split budget: ⌊share·budget⌉ of the first, the rest of
+/// the BRDF, at least one of each (as [`shade::shade`] splits it).
+pub(crate) fn split_counts(budget: usize, share: f64) -> (usize, usize) {
+    if budget < 2 {
+        (1, 1)
+    } else {
+        let first = ((share * budget as f64).round() as usize).clamp(1, budget - 1);
+        (first, budget - first)
+    }
+}
+
+/// Reused buffers of the wavefronts.
+#[derive(Default)]
+pub(crate) struct WaveBuffers {
+    samples: Vec<WaveSample>,
+    candidates: Vec<Candidate>,
+}
+
+/// Each shading point's estimate of its direct light into `out`, from `budget` samples drawn
+/// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
+/// through one sampler for all of them and the budget is small; `visible(k, dir)` traces point
+/// k's shadow ray. `None` (nothing done) otherwise.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shade_wavefront(
+    sampling: &Sampling<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    points: &[ShadingPoint<'_, dyn Brdf + '_>],
+    runs: &[Run],
+    budget: usize,
+    buffers: &mut WaveBuffers,
+    mut visible: impl FnMut(usize, Vec3) -> bool,
+    out: &mut [DVec3],
+) -> Option<()> {
+    let layout = layout(sampling, budget)?;
+    let weighting = match layout {
+        Layout::Single { .. } => Weighting::Single,
+        Layout::Pairs { .. } => Weighting::Balance,
+        Layout::Split { first, brdf } => {
+            let total = (first + brdf) as f64;
+            Weighting::Split { sampler: (first as f64 / total) as f32, brdf: (brdf as f64 / total) as f32 }
+        }
+    };
+    buffers.samples.clear();
+    for (point, run) in runs.iter().enumerate() {
+        push_samples(layout, point, *run, &mut buffers.samples);
+    }
+    buffers.candidates.clear();
+    buffers.candidates.resize(buffers.samples.len(), Candidate::default());
+    match sampling {
+        Sampling::ProductMis { sampler, .. } => draw(sampler, points, weighting, buffers),
+        _ => draw(env, points, weighting, buffers),
+    }
+    let per_point = layout.len();
+    for (point, (candidates, o)) in buffers.candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
+        let mut value = |c: &Candidate| if c.needs_ray && visible(point, c.dir) { c.value } else { DVec3::ZERO };
+        *o = reduce(layout, candidates, &mut value);
+    }
+    Some(())
+}
+
+/// The wavefront's candidates, drawn by `sampler`.
+fn draw<S: DirectionSampler + ?Sized>(
+    sampler: &S,
+    points: &[ShadingPoint<'_, dyn Brdf + '_>],
+    weighting: Weighting,
+    buffers: &mut WaveBuffers,
+) {
+    wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates);
+}
+
+/// A member's samples in the order its estimate sums them, from its run of the pixel's
+/// sequences (the same points [`shade::shade`] draws).
+fn push_samples(layout: Layout, point: usize, run: Run, samples: &mut Vec<WaveSample>) {
+    let Run { seed, block } = run;
+    let mut push = |technique, u| samples.push(WaveSample { point, technique, u });
+    let mut points = [DVec2::ZERO; BATCH];
+    match layout {
+        Layout::Single { technique, n } => {
+            sobol02(hash_combine(seed, 1), (block * n) as u32, &mut points[..n]);
+            points[..n].iter().for_each(|&u| push(technique, u));
+        }
+        Layout::Pairs { n } => {
+            let mut others = [DVec2::ZERO; BATCH];
+            sobol02(hash_combine(seed, 1), (block * n) as u32, &mut points[..n]);
+            sobol02(hash_combine(seed, 2), (block * n) as u32, &mut others[..n]);
+            for (&u, &v) in points[..n].iter().zip(&others[..n]) {
+                push(Technique::Sampler, u);
+                push(Technique::Brdf, v);
+            }
+        }
+        Layout::Split { first, brdf } => {
+            sobol02(hash_combine(seed, 1), (block * first) as u32, &mut points[..first]);
+            points[..first].iter().for_each(|&u| push(Technique::Sampler, u));
+            sobol02(hash_combine(seed, 2), (block * brdf) as u32, &mut points[..brdf]);
+            points[..brdf].iter().for_each(|&u| push(Technique::Brdf, u));
+        }
+    }
+}
+
+/// A member's estimate from its candidates, summed in the order and with the rounding of
+/// [`shade::shade`].
+fn reduce(layout: Layout, candidates: &[Candidate], value: &mut impl FnMut(&Candidate) -> DVec3) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    match layout {
+        Layout::Single { n, .. } => {
+            candidates.iter().for_each(|c| sum += value(c));
+            sum / n as f64
+        }
+        Layout::Pairs { n } => {
+            for pair in candidates.chunks(2) {
+                let (a, b) = (value(&pair[0]), value(&pair[1]));
+                sum += a + b;
+            }
+            sum / n as f64
+        }
+        Layout::Split { first, brdf } => {
+            candidates.iter().for_each(|c| sum += value(c));
+            sum / (first + brdf) as f64
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Samples at many shading points at once: a wavefront. Where each shading point takes only a
+//! sample or two (many primary rays per pixel, few light samples each), a per-point estimator
+//! runs its batched code one lane wide and waits on each lookup of the map in turn. Drawn
+//! across the shading points of a wavefront instead, the sampler's descents run side by side,
+//! the map's lookups of different samples overlap in the memory system, and the shadow rays
+//! are left to the caller to trace together: each sample comes back unshadowed, with the
+//! direction its shadow ray tests.
+//!
+//! The values are those of the per-point estimators, bit for bit: a sample drawn by the
+//! sampler is weighted as [`sampled_drawn`](super::sampled_drawn) (alone),
+//! [`sampled_mis_many`](super::sampled_mis_many) (in pairs) or
+//! [`sampled_mis_split`](super::sampled_mis_split) (a split budget) weigh it, and a BRDF sample
+//! as [`brdf_many`](super::brdf_many) or the MIS forms weigh theirs.
+
+use crate::brdf::{Brdf, BrdfSample};
+use crate::direction::{DirectionSample, DirectionSampler};
+use crate::estimator::{ShadingPoint, times};
+use crate::mapping::SPHERE_AREA;
+use glam::{DVec2, DVec3, Vec2, Vec3};
+
+/// Samples drawn together: the sampler's descents and the map's lookups of this many samples
+/// are in flight at once.
+pub const WAVE: usize = 64;
+
+/// Which technique draws a sample of a wavefront.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// The sampler of the environment (env-only, a product…).
+    Sampler,
+    /// The shading point's BRDF.
+    Brdf,
+}
+
+/// One sample of a wavefront: the shading point it belongs to, who draws it, and its point of
+/// the unit square.
+#[derive(Clone, Copy, Debug)]
+pub struct WaveSample {
+    /// Index of its shading point in the wavefront's `points`.
+    pub point: usize,
+    /// The technique that draws it.
+    pub technique: Technique,
+    /// Its point of [0, 1)².
+    pub u: DVec2,
+}
+
+/// How the samples of a wavefront are weighted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Weighting {
+    /// One technique alone: f/p.
+    Single,
+    /// The balance heuristic of one sample of each technique: f/(p_sampler + p_brdf).
+    Balance,
+    /// The multi-sample balance heuristic of a split budget, each technique's share of the
+    /// shading point's samples: f/(c_sampler·p_sampler + c_brdf·p_brdf).
+    Split {
+        /// The sampler's share c_sampler.
+        sampler: f32,
+        /// The BRDF's share c_brdf.
+        brdf: f32,
+    },
+}
+
+/// A sample's contribution before visibility, and the shadow ray it needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Candidate {
+    /// World direction of the shadow ray.
+    pub dir: Vec3,
+    /// f/p times the MIS weight, unshadowed (f64, as [`Contribution::value`](super::Contribution)).
+    pub value: DVec3,
+    /// Whether the value is non-zero and so needs the shadow ray; where it is false, `value`
+    /// is zero and no ray is traced.
+    pub needs_ray: bool,
+}
+
+impl Candidate {
+    /// The candidate of f with density `pdf` in direction `dir` (a ray only where f/p counts).
+    #[inline]
+    fn new(f: DVec3, pdf: f32, dir: Vec3) -> Self {
+        if pdf > 0.0 && f.cmpgt(DVec3::ZERO).any() {
+            Self { dir, value: f / pdf as f64, needs_ray: true }
+        } else {
+            Self { dir, value: DVec3::ZERO, needs_ray: false }
+        }
+    }
+}
+
+/// The candidates of `samples` (`out[k]` from `samples[k]`), at most [`WAVE`] at a time: the
+/// sampler's draws in one batch, the BRDF's draws and their points of the square in another,
+/// the other technique's densities and the map's radiance looked up for all of them together.
+pub fn wavefront<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
+    points: &[ShadingPoint<'_, B>],
+    samples: &[WaveSample],
+    weighting: Weighting,
+    out: &mut [Candidate],
+) {
+    for (s, o) in samples.chunks(WAVE).zip(out.chunks_mut(WAVE)) {
+        let n = s.len().min(o.len());
+        wave(sampler, points, &s[..n], weighting, &mut o[..n]);
+    }
+}
+
+/// [`wavefront`] of at most [`WAVE`] samples.
+fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
+    points: &[ShadingPoint<'_, B>],
+    samples: &[WaveSample],
+    weighting: Weighting,
+    out: &mut [Candidate],
+) {
+    let n = samples.len().min(WAVE);
+    let env = sampler.env();
+    // The sampler's draws, all in one batch (its descents side by side).
+    let mut u_sampler = [DVec2::ZERO; WAVE];
+    let mut drawn = [None; WAVE];
+    let mut n_sampler = 0;
+    for s in samples.iter().filter(|s| s.technique == Technique::Sampler) {
+        u_sampler[n_sampler] = s.u;
+        n_sampler += 1;
+    }
+    sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
+    // The BRDF's draws, each at its own shading point, then their points of the square and the
+    // other technique's densities there in one batch.
+    let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
+    let mut dirs = [Vec3::Z; WAVE];
+    let mut n_brdf = 0;
+    for s in samples.iter().filter(|s| s.technique == Technique::Brdf) {
+        let sp = &points[s.point];
+        sp.brdf.sample_many(sp.frame.to_local(sp.wo), &[s.u.as_vec2()], &mut brdf[n_brdf..n_brdf + 1]);
+        if let Some(b) = brdf[n_brdf] {
+            dirs[n_brdf] = sp.frame.to_world(b.wi);
+        }
+        n_brdf += 1;
+    }
+    let mut uvs = [Vec2::ZERO; WAVE];
+    env.squares_of(&dirs[..n_brdf], &mut uvs[..n_brdf]);
+    let mut p_square = [0.0f32; WAVE];
+    if weighting != Weighting::Single {
+        sampler.pdf_square_many(&uvs[..n_brdf], &mut p_square[..n_brdf]);
+    }
+    // Every sample's value, in order.
+    let (mut i_sampler, mut i_brdf) = (0, 0);
+    for (s, o) in samples[..n].iter().zip(out.iter_mut()) {
+        let sp = &points[s.point];
+        *o = match s.technique {
+            Technique::Sampler => {
+                i_sampler += 1;
+                drawn[i_sampler - 1].map_or(Candidate::default(), |d| sampler_candidate(sampler, sp, d, weighting))
+            }
+            Technique::Brdf => {
+                i_brdf += 1;
+                let k = i_brdf - 1;
+                brdf[k].map_or(Candidate::default(), |b| {
+                    let f = times(env.radiance_at(uvs[k]), b.value);
+                    let p_other = p_square[k] / SPHERE_AREA;
+                    let pdf = match weighting {
+                        Weighting::Single => b.pdf,
+                        Weighting::Balance => b.pdf + p_other,
+                        Weighting::Split { sampler, brdf } => brdf * b.pdf + sampler * p_other,
+                    };
+                    Candidate::new(f, pdf, dirs[k])
+                })
+            }
+        };
+    }
+}
+
+/// The candidate of a direction the sampler drew at `sp`.
+#[inline]
+fn sampler_candidate<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+    sampler: &S,
+    sp: &ShadingPoint<'_, B>,
+    d: DirectionSample,
+    weighting: Weighting,
+) -> Candidate {
+    let radiance = sampler.env().radiance_at(d.uv);
+    if weighting == Weighting::Single {
+        return Candidate::new(times(radiance, sp.eval(d.dir)), d.pdf, d.dir);
+    }
+    let mut evaluated = [(Vec3::ZERO, 0.0)];
+    sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &[sp.frame.to_local(d.dir)], &mut evaluated);
+    let (b, p_brdf) = evaluated[0];
+    let pdf = match weighting {
+        Weighting::Split { sampler, brdf } => sampler * d.pdf + brdf * p_brdf,
+        _ => d.pdf + p_brdf,
+    };
+    Candidate::new(times(radiance, b), pdf, d.dir)
+}
