@@ -122,22 +122,37 @@ fn a_small_render_writes_exr_png_and_stats() {
     assert_eq!(stats["non_finite_pixels"], 0);
 }
 
-/// Without --shading-points the default 4 primary rays shrink to a divisor of --spp (a P the
+/// Without --shading-points a pixel gets spp / 2 primary rays with the default method (a pair
+/// of light samples each), reduced to a divisor of --spp, and spp / 16 with `product` (a P the
 /// user gives that does not divide it is an error: `bad_input_fails_cleanly`).
 #[test]
-fn the_default_shading_points_divide_any_spp() {
+fn the_default_shading_points_grow_with_spp_and_divide_it() {
     let tmp = scratch("divide");
     let dir = tmp.path();
-    for (spp, p) in [("6", 2), ("7", 1), ("12", 4)] {
+    for (method, spp, p) in
+        [("product-mis", "6", 3), ("product-mis", "7", 1), ("mis", "256", 128), ("product", "64", 4)]
+    {
         let out = ppis()
             .current_dir(dir)
-            .args(["render", "--width", "8", "--height", "6", "--spp", spp, "--stats-json", "s.json"])
+            .args([
+                "render",
+                "--width",
+                "8",
+                "--height",
+                "6",
+                "--method",
+                method,
+                "--spp",
+                spp,
+                "--stats-json",
+                "s.json",
+            ])
             .output()
             .unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let stats: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).unwrap()).unwrap();
-        assert_eq!(stats["shading_points_per_pixel"], p, "--spp {spp}");
+        assert_eq!(stats["shading_points_per_pixel"], p, "{method} --spp {spp}");
     }
 }
 

@@ -71,6 +71,23 @@ impl Method {
         }
     }
 
+    /// Light samples per shading point where `--shading-points` is not given (so P = spp /
+    /// this): a pair for the MIS methods and one sample for the single techniques whose
+    /// sampler is built once per render or per pixel, and for the samplers built per
+    /// shading point the power of two nearest √(build cost / sample cost), the split that
+    /// minimises error × time when a point's light and its footprint vary alike
+    /// (docs/perf.md, "Shading points per pixel").
+    #[must_use]
+    pub fn samples_per_point(self) -> usize {
+        match self {
+            Method::Env | Method::Brdf | Method::Ris => 1,
+            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 2,
+            Method::TwoLevel => 2,
+            Method::TwoStage => 4,
+            Method::Product | Method::Wavelet => 16,
+        }
+    }
+
     /// What this method samples a material of `bsdf` with under a map of peak `env_peak`
     /// (`EnvHierarchy::peak(5)`; `f32::MAX` where not measured). Product-MIS takes its split
     /// from the rules ([`rules::product_share`]); `mis` stays Mitsuba's pairs.

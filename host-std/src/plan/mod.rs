@@ -2,10 +2,12 @@
 //! which resolves the method per material, runs the pilot where `auto` asks for one, and
 //! renders. Calls down into `render`, never the reverse.
 
+pub mod budget;
 pub mod method;
 pub mod pilot;
 pub mod rules;
 
+pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::render::strategy::MaterialPlan;

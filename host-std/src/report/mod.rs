@@ -13,7 +13,7 @@ pub use errors::{Regions, errors};
 pub use plot::plot;
 pub use tables::{csv, markdown, relmse_at};
 
-use crate::plan::{self, Method, Settings};
+use crate::plan::{self, Method, Settings, ShadingPoints};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
@@ -47,27 +47,8 @@ impl Measurement {
     }
 }
 
-/// Shading points per pixel for a given spp: with `per_point` visibility samples per shading
-/// point, P = spp / per_point (so primary rays, and with them the pixel-footprint integration,
-/// grow with spp — with a fixed P the antialiasing error of edges and of a visible sun floors
-/// every method at the same error); otherwise the requested P if it divides spp, else their
-/// greatest common divisor.
-pub fn shading_points_per_pixel(spp: usize, requested: usize, per_point: Option<usize>) -> usize {
-    match per_point {
-        Some(v) => (spp / v.max(1)).max(1),
-        None => shading_points_for(spp, requested),
-    }
-}
-
-/// The requested P if it divides spp, otherwise their greatest common divisor.
-pub fn shading_points_for(spp: usize, requested: usize) -> usize {
-    fn gcd(a: usize, b: usize) -> usize {
-        if b == 0 { a } else { gcd(b, a % b) }
-    }
-    gcd(spp, requested.max(1)).max(1)
-}
-
-/// Renders every (method, spp) pair and measures it against `reference`. With `bracket`
+/// Renders every (method, spp) pair, with `points` shading points per pixel, and measures it
+/// against `reference`. With `bracket`
 /// (the base method of the equal-time tables), every faster method is then rendered on at
 /// doubling spp — at most [`BRACKET_DOUBLINGS`] times — until its time reaches the base's at
 /// its largest spp, so that the tables interpolate its error there instead of extrapolating.
@@ -83,19 +64,15 @@ pub fn sweep(
     methods: &[Method],
     spps: &[usize],
     base: &Settings,
-    per_point: Option<usize>,
+    points: ShadingPoints,
     reference: &[[f32; 3]],
     bracket: Option<Method>,
     repeat: usize,
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
-    let settings = |method: Method, spp: usize| Settings {
-        method,
-        spp,
-        shading_points: shading_points_per_pixel(spp, base.shading_points, per_point),
-        ..*base
-    };
+    let settings =
+        |method: Method, spp: usize| Settings { method, spp, shading_points: points.resolve(method, spp), ..*base };
     let mut measure = |method: Method, spp: usize| {
         let image = plan::render(scene, bvh, env, &settings(method, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
@@ -221,12 +198,5 @@ mod tests {
         let x = vec![[2.0f32, 0.5, 0.0]; 4];
         let (rmse, rel) = errors(&x, &r);
         assert!((rmse - (1.0f64 / 3.0).sqrt()).abs() < 1e-9 && (rel - 1.0 / 1.01 / 3.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn shading_points_divide_spp() {
-        assert_eq!(shading_points_for(16, 4), 4);
-        assert_eq!(shading_points_for(2, 4), 2);
-        assert_eq!(shading_points_for(6, 4), 2);
     }
 }

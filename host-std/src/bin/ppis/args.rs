@@ -34,15 +34,13 @@ pub(crate) struct SceneArgs {
     pub(crate) env_rotate_y: Option<f32>,
 }
 
-/// Primary rays per pixel when `--shading-points` is not given (reduced to a divisor of spp).
-pub(crate) const DEFAULT_SHADING_POINTS: u32 = 4;
-
 /// How a render samples, shared by `render` and `report`.
 #[derive(Args)]
 pub(crate) struct SamplingArgs {
     /// Primary rays (shading points) per pixel, each spending spp/P visibility samples
-    /// [default: 4, or the largest divisor of --spp below it]. `render`: a P given must divide
-    /// --spp; `report`: reduced to a divisor of each spp.
+    /// [default: spp over the method's light samples per shading point — a pair for the MIS
+    /// methods, one for env, brdf and ris, more for the samplers built per shading point].
+    /// `render`: a P given must divide --spp; `report`: reduced to a divisor of each spp.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) shading_points: Option<u32>,
     /// BRDF samples per product sampler (the paper's K).

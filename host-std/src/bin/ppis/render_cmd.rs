@@ -1,16 +1,16 @@
 //! `ppis render`: one scene, one method, to a linear EXR, an sRGB PNG and optionally the
 //! stats JSON.
 
-use crate::args::{DEFAULT_SHADING_POINTS, MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, parse_method};
 use crate::load::{load_scene, warn_notes};
 use crate::stats::Stats;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
-use host_std::plan::{self, Method, Rendered, Settings, pilot};
+use host_std::output;
+use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
-use host_std::{output, report};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -50,7 +50,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let shading_points = match args.sampling.shading_points {
         Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
         Some(p) => p,
-        None => report::shading_points_for(args.spp as usize, DEFAULT_SHADING_POINTS as usize) as u32,
+        None => ShadingPoints::Rule.resolve(args.method, args.spp as usize) as u32,
     };
     let (exr_path, png_path) = output_paths(&args)?;
     let threads = args.sampling.threads();

@@ -1,13 +1,13 @@
 //! `ppis report`: every method at every sample count against a reference — error against
 //! render time as CSV, plot and equal-time tables.
 
-use crate::args::{DEFAULT_SHADING_POINTS, MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, parse_method};
 use crate::load::{load_scene, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
-use host_std::plan::{self, Settings};
+use host_std::plan::{self, Settings, ShadingPoints};
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
 use host_std::{output, report};
@@ -30,8 +30,8 @@ pub(crate) struct ReportArgs {
     /// Visibility samples per pixel of the rendered reference.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     reference_spp: u32,
-    /// Visibility samples per shading point: primary rays per pixel then grow as spp / V
-    /// (instead of the fixed --shading-points), so the pixel-footprint integration converges too.
+    /// Visibility samples per shading point for every method and the reference: primary rays
+    /// per pixel P = spp / V (instead of each method's own V).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     samples_per_point: Option<u32>,
     /// Method of the rendered reference (an independent code path from the product by default).
@@ -94,7 +94,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let base = Settings {
         method: Method::Product,
         spp: 1,
-        shading_points: args.sampling.shading_points.unwrap_or(DEFAULT_SHADING_POINTS) as usize,
+        shading_points: 1,
         brdf_samples: args.sampling.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: false,
@@ -107,7 +107,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
     let bracket = args.bracket.then_some(base_method);
     let measurements = pool.install(|| {
-        let per_point = args.samples_per_point.map(|v| v as usize);
+        let points = shading_points(&args);
         let methods = &args.methods;
         let repeat = args.repeat as usize;
         report::sweep(
@@ -117,7 +117,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             methods,
             &spps,
             &base,
-            per_point,
+            points,
             &reference,
             bracket,
             repeat,
@@ -152,7 +152,7 @@ fn render_reference(
     let settings = Settings {
         method: args.reference_method,
         spp,
-        shading_points: report::shading_points_per_pixel(spp, 16, args.samples_per_point.map(|v| v as usize)),
+        shading_points: shading_points(args).resolve(args.reference_method, spp),
         seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
         progress: true,
         ..*base
@@ -200,4 +200,14 @@ fn write_outputs(
 /// The report's reference note, and how renders were timed when more than once.
 fn timing_note(reference: &str, repeat: u32) -> String {
     if repeat > 1 { format!("{reference}; times: the fastest of {repeat} runs") } else { reference.to_string() }
+}
+
+/// The report's shading points per pixel: `--samples-per-point`, else `--shading-points`, else
+/// each method's rule.
+fn shading_points(args: &ReportArgs) -> ShadingPoints {
+    match (args.samples_per_point, args.sampling.shading_points) {
+        (Some(v), _) => ShadingPoints::PerPoint(v as usize),
+        (None, Some(p)) => ShadingPoints::Given(p as usize),
+        (None, None) => ShadingPoints::Rule,
+    }
 }

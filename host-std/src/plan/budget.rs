@@ -1,0 +1,67 @@
+//! How a pixel's budget of visibility samples (spp) is spent: P primary rays (shading points),
+//! each with spp/P light samples. Light noise falls with spp however it is split, but the
+//! pixel footprint — edges, textures, a sun seen in a glossy reflection — is integrated only by
+//! the primary rays: with P fixed, every method stops converging at the footprint's error.
+//! So P grows with spp, and each method keeps the few light samples per shading point that
+//! pay for what a shading point costs it (docs/perf.md, "Shading points per pixel").
+
+use crate::plan::Method;
+
+/// How many shading points a pixel gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingPoints {
+    /// spp / the method's [`samples_per_point`](Method::samples_per_point).
+    Rule,
+    /// Exactly this many (a render checks that it divides spp; a sweep takes the largest
+    /// divisor of each spp up to it).
+    Given(usize),
+    /// spp / this many light samples per shading point.
+    PerPoint(usize),
+}
+
+impl ShadingPoints {
+    /// P for a render of `method` at `spp`: a divisor of spp, at least 1.
+    #[must_use]
+    pub fn resolve(self, method: Method, spp: usize) -> usize {
+        let target = match self {
+            ShadingPoints::Rule => spp / method.samples_per_point(),
+            ShadingPoints::Given(p) => p,
+            ShadingPoints::PerPoint(v) => spp / v.max(1),
+        };
+        largest_divisor_up_to(spp, target)
+    }
+}
+
+/// The largest divisor of `n` that is at most `bound` (1 if `bound` is 0).
+fn largest_divisor_up_to(n: usize, bound: usize) -> usize {
+    (1..=bound.min(n)).rev().find(|d| n.is_multiple_of(*d)).unwrap_or(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shading_points_grow_with_spp_and_divide_it() {
+        for spp in [16, 64, 256, 1024] {
+            assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, spp), spp / 2, "a pair per point");
+            assert_eq!(ShadingPoints::Rule.resolve(Method::Env, spp), spp);
+            assert_eq!(ShadingPoints::Rule.resolve(Method::Product, spp), (spp / 16).max(1));
+        }
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 1), 1);
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 7), 1, "7 has no divisor up to 3 but 1");
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 12), 6);
+        assert_eq!(ShadingPoints::Given(4).resolve(Method::Mis, 6), 3);
+        assert_eq!(ShadingPoints::Given(4).resolve(Method::Mis, 2), 2);
+        assert_eq!(ShadingPoints::PerPoint(16).resolve(Method::Mis, 256), 16);
+        assert_eq!(ShadingPoints::PerPoint(16).resolve(Method::Mis, 8), 1);
+    }
+
+    #[test]
+    fn every_method_has_a_rule() {
+        for m in Method::ALL {
+            let v = m.samples_per_point();
+            assert!(v.is_power_of_two() && v <= 16, "{m}: {v}");
+        }
+    }
+}
