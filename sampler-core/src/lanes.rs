@@ -1,4 +1,4 @@
-//! Descents side by side: many points warped four at a time, branch-free within a level, so
+//! Descents side by side: many points warped [`LANES`] at a time, branch-free within a level, so
 //! that one descent's loads and arithmetic overlap the others' instead of each waiting on its
 //! own mispredicted branches (one per level and axis, each a coin flip).
 //!
@@ -6,7 +6,7 @@
 //! * [`ProductSampler::sample_many`]: product samples — the tree first, then the environment's
 //!   levels below the leaves with the same `WarpLane`s (and the defensive env samples from the
 //!   root).
-//! * [`ProductSampler::pdf_square_many`]: product densities, four descents by the points' bits.
+//! * [`ProductSampler::pdf_square_many`]: product densities, descents side by side by the points' bits.
 
 use crate::env::{EnvHierarchy, level_offset, morton2};
 use crate::mapping::SPHERE_AREA;
@@ -16,6 +16,10 @@ use crate::warp::{
     ONE_MINUS_EPSILON, child_offset, choose_child, choose_child_branchless, choose_grandchild_branchless, point_in_cell,
 };
 use glam::{DVec2, Vec2, Vec3};
+
+/// Descents advanced side by side: enough that the loads of the map's deep levels, which miss
+/// the caches, overlap.
+const LANES: usize = 8;
 
 /// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
 #[derive(Clone, Copy, Debug, Default)]
@@ -47,24 +51,24 @@ impl WarpLane {
 }
 
 impl EnvHierarchy<'_> {
-    /// Env samples for many points, four descents side by side (each level's loads and
-    /// arithmetic of the four are independent, so they overlap), branch-free within a level.
+    /// Env samples for many points, [`LANES`] descents side by side (each level's loads and
+    /// arithmetic of the lanes are independent, so they overlap), branch-free within a level.
     /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
     pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
-        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
+        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let n = us.len().min(os.len());
-            let mut lanes = [WarpLane::default(); 4];
+            let mut lanes = [WarpLane::default(); LANES];
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = WarpLane::new(0, 0, 0, *u);
             }
             self.warp_down_lanes(&mut lanes[..n]);
-            // The points and densities, then the four directions at once.
-            let mut points = [(Vec2::ZERO, 0.0); 4];
+            // The points and densities, then the directions at once.
+            let mut points = [(Vec2::ZERO, 0.0); LANES];
             for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
                 *p = self.point_in_texel(lane.x, lane.y, lane.xi);
             }
-            let mut dirs = [Vec3::ZERO; 4];
+            let mut dirs = [Vec3::ZERO; LANES];
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
             for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
                 let (uv, pdf) = points[k];
@@ -144,9 +148,9 @@ impl ProductSampler<'_, '_> {
         }
         let eps = self.defensive as f64;
         let root = self.nodes.first().copied().unwrap_or_default();
-        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
+        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let n = us.len().min(os.len());
-            let mut tree = [TreeLane::default(); 4];
+            let mut tree = [TreeLane::default(); LANES];
             for (lane, u) in tree.iter_mut().zip(&us[..n]) {
                 let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
                 let defensive = xi.x < eps;
@@ -160,30 +164,30 @@ impl ProductSampler<'_, '_> {
             self.descend_tree(&mut tree[..n]);
             // Below the leaves (or from the root, for defensive samples), the environment's
             // levels, also side by side.
-            let mut below = [WarpLane::default(); 4];
+            let mut below = [WarpLane::default(); LANES];
             for (e, t) in below.iter_mut().zip(&tree[..n]) {
                 *e = WarpLane::new(t.depth, t.x, t.y, t.xi);
                 e.alive = t.alive;
             }
             self.env.warp_down_lanes(&mut below[..n]);
-            let mut landed = [None; 4];
+            let mut landed = [None; LANES];
             for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
                 *l = self.finish(t, e);
             }
-            // The defensive samples' densities: the product's four descents at once.
-            let (mut points, mut which, mut count) = ([Vec2::ZERO; 4], [0; 4], 0);
+            // The defensive samples' densities: the product's descents side by side.
+            let (mut points, mut which, mut count) = ([Vec2::ZERO; LANES], [0; LANES], 0);
             for (k, t) in tree[..n].iter().enumerate() {
                 if let (true, Some((uv, _))) = (t.defensive, landed[k]) {
                     (points[count], which[count], count) = (uv, k, count + 1);
                 }
             }
-            let mut densities = [0.0f32; 4];
+            let mut densities = [0.0f32; LANES];
             self.pdf_square_many(&points[..count], &mut densities[..count]);
             for (&k, &d) in which[..count].iter().zip(&densities) {
                 landed[k] = landed[k].map(|(uv, _)| (uv, d / SPHERE_AREA));
             }
-            // The four directions at once.
-            let mut dirs = [Vec3::ZERO; 4];
+            // The directions at once.
+            let mut dirs = [Vec3::ZERO; LANES];
             self.env.dirs_of(&landed.map(|l| l.map_or(Vec2::ZERO, |(uv, _)| uv))[..n], &mut dirs[..n]);
             for (k, o) in os.iter_mut().enumerate().take(n) {
                 *o = landed[k].map(|(uv, pdf)| DirectionSample { dir: dirs[k], uv, pdf });
@@ -220,7 +224,7 @@ impl ProductSampler<'_, '_> {
 
     /// The sample's point at the end of a tree descent `t` and the environment descent `e` below
     /// it, with its density (solid angle) as [`sample`](Self::sample) computes it — except for
-    /// defensive samples, whose density (0 here) the caller looks up for four at once.
+    /// defensive samples, whose density (0 here) the caller looks up for a batch at once.
     fn finish(&self, t: &TreeLane, e: &WarpLane) -> Option<(Vec2, f32)> {
         if !t.alive || !e.alive {
             return None;
@@ -252,7 +256,7 @@ struct PdfLane {
 
 impl ProductSampler<'_, '_> {
     /// [`pdf_square`](Self::pdf_square) at every point of `uv` (into `out`, as many as both
-    /// hold), bit for bit: the same leaves and their path probabilities, four descents side by
+    /// hold), bit for bit: the same leaves and their path probabilities, [`LANES`] descents side by
     /// side.
     pub fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
         let Some(&root) = self.nodes.first() else {
@@ -263,9 +267,9 @@ impl ProductSampler<'_, '_> {
             out.iter_mut().zip(uv).for_each(|(o, uv)| *o = self.pdf_square(*uv));
             return;
         }
-        for (us, os) in uv.chunks(4).zip(out.chunks_mut(4)) {
+        for (us, os) in uv.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let n = us.len().min(os.len());
-            let mut lanes = [PdfLane::default(); 4];
+            let mut lanes = [PdfLane::default(); LANES];
             for (lane, uv) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), ..*lane };
             }

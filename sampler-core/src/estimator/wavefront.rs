@@ -138,20 +138,31 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     if weighting != Weighting::Single {
         sampler.pdf_square_many(&uvs[..n_brdf], &mut p_square[..n_brdf]);
     }
+    // The map's radiance at every sample, gathered in one tight loop so that the lookups, which
+    // miss the caches, are in flight together rather than one per sample's arithmetic.
+    let mut radiance_sampler = [Vec3::ZERO; WAVE];
+    for (r, d) in radiance_sampler.iter_mut().zip(&drawn[..n_sampler]) {
+        *r = d.map_or(Vec3::ZERO, |d| env.radiance_at(d.uv));
+    }
+    let mut radiance_brdf = [Vec3::ZERO; WAVE];
+    for (r, uv) in radiance_brdf.iter_mut().zip(&uvs[..n_brdf]) {
+        *r = env.radiance_at(*uv);
+    }
     // Every sample's value, in order.
     let (mut i_sampler, mut i_brdf) = (0, 0);
     for (s, o) in samples[..n].iter().zip(out.iter_mut()) {
         let sp = &points[s.point];
         *o = match s.technique {
             Technique::Sampler => {
+                let k = i_sampler;
                 i_sampler += 1;
-                drawn[i_sampler - 1].map_or(Candidate::default(), |d| sampler_candidate(sampler, sp, d, weighting))
+                drawn[k].map_or(Candidate::default(), |d| sampler_candidate(sp, d, radiance_sampler[k], weighting))
             }
             Technique::Brdf => {
+                let k = i_brdf;
                 i_brdf += 1;
-                let k = i_brdf - 1;
                 brdf[k].map_or(Candidate::default(), |b| {
-                    let f = times(env.radiance_at(uvs[k]), b.value);
+                    let f = times(radiance_brdf[k], b.value);
                     let p_other = p_square[k] / SPHERE_AREA;
                     let pdf = match weighting {
                         Weighting::Single => b.pdf,
@@ -165,15 +176,15 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
 }
 
-/// The candidate of a direction the sampler drew at `sp`.
+/// The candidate of a direction the sampler drew at `sp`, where the map's radiance is
+/// `radiance`.
 #[inline]
-fn sampler_candidate<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
-    sampler: &S,
+fn sampler_candidate<B: Brdf + ?Sized>(
     sp: &ShadingPoint<'_, B>,
     d: DirectionSample,
+    radiance: Vec3,
     weighting: Weighting,
 ) -> Candidate {
-    let radiance = sampler.env().radiance_at(d.uv);
     if weighting == Weighting::Single {
         return Candidate::new(times(radiance, sp.eval(d.dir)), d.pdf, d.dir);
     }
