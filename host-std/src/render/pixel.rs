@@ -189,18 +189,18 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
             members[m] = k;
             m += 1;
         }
-        let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] =
-            std::array::from_fn(|i| shading_point(ctx.scene, &hits[members[i.min(m - 1)]]));
-        let runs: [Run; GROUP] = std::array::from_fn(|i| run_of(&hits[members[i.min(m - 1)]]));
         let mut rays = 0u64;
-        let mut visible = |i: usize, d: Vec3| {
+        let mut visible = |k: usize, d: Vec3| {
             rays += 1;
-            !shadows || !ctx.bvh.occluded(hits[members[i]].origin, d, 0.0, f32::INFINITY)
+            !shadows || !ctx.bvh.occluded(hits[k].origin, d, 0.0, f32::INFINITY)
         };
-        let mut out = [DVec3::ZERO; GROUP];
-        let waved =
-            wavefront::shade_wavefront(&sampling, env, &points[..m], &runs[..m], budget, waves, &mut visible, &mut out);
-        let shaded = if waved.is_some() {
+        let shaded = if wavefront::fits(&sampling, budget) {
+            let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] =
+                std::array::from_fn(|i| shading_point(ctx.scene, &hits[members[i.min(m - 1)]]));
+            let runs: [Run; GROUP] = std::array::from_fn(|i| run_of(&hits[members[i.min(m - 1)]]));
+            let mut out = [DVec3::ZERO; GROUP];
+            let mut vis = |i: usize, d: Vec3| visible(members[i], d);
+            wavefront::shade_wavefront(&sampling, env, &points[..m], &runs[..m], budget, waves, &mut vis, &mut out);
             for (i, &k) in members[..m].iter().enumerate() {
                 (values[k], done[k]) = (out[i], true);
             }
@@ -208,9 +208,16 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         } else {
             // One point, or a product-MIS material's points through their shared sampler.
             let shaded = if matches!(sampling, Sampling::ProductMis { .. }) { m } else { 1 };
-            for (i, &k) in members[..shaded].iter().enumerate() {
-                let mut vis = CountingVisibility { test: |d: Vec3| visible(i, d), rays: 0 };
-                values[k] = shade::shade(&sampling, env, &points[i], budget, runs[i], &mut vis);
+            for &k in &members[..shaded] {
+                let mut vis = CountingVisibility { test: |d: Vec3| visible(k, d), rays: 0 };
+                values[k] = shade::shade(
+                    &sampling,
+                    env,
+                    &shading_point(ctx.scene, &hits[k]),
+                    budget,
+                    run_of(&hits[k]),
+                    &mut vis,
+                );
                 done[k] = true;
             }
             shaded

@@ -61,6 +61,12 @@ fn layout(sampling: &Sampling<'_, '_>, budget: usize) -> Option<Layout> {
     }
 }
 
+/// Whether [`shade_wavefront`] shades a group sampled as `sampling` with `budget` samples per
+/// point.
+pub(crate) fn fits(sampling: &Sampling<'_, '_>, budget: usize) -> bool {
+    layout(sampling, budget).is_some()
+}
+
 /// Samples of each technique for a split budget: ⌊share·budget⌉ of the first, the rest of
 /// the BRDF, at least one of each (as [`shade::shade`] splits it).
 pub(crate) fn split_counts(budget: usize, share: f64) -> (usize, usize) {
@@ -81,8 +87,8 @@ pub(crate) struct WaveBuffers {
 
 /// Each shading point's estimate of its direct light into `out`, from `budget` samples drawn
 /// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
-/// through one sampler for all of them and the budget is small; `visible(k, dir)` traces point
-/// k's shadow ray. `None` (nothing done) otherwise.
+/// through one sampler for all of them and the budget is small ([`fits`]); `visible(k, dir)`
+/// traces point k's shadow ray. `None` (nothing done) otherwise.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_wavefront(
     sampling: &Sampling<'_, '_>,
