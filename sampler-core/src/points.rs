@@ -136,13 +136,32 @@ pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
 /// run starting at a multiple of its length is a (0,m,2)-net: stratified in every elementary
 /// interval. Different seeds give independent randomisations.
 pub fn sobol02(seed: u64, first: u32, out: &mut [DVec2]) {
-    let s0 = hash_combine(seed, 0x5eed_0000) as u32;
-    let s1 = hash_combine(seed, 0x5eed_0001) as u32;
-    for (k, p) in out.iter_mut().enumerate() {
-        let i = first.wrapping_add(k as u32);
-        let x = nested_uniform_scramble(sobol_dim0(i), s0);
-        let y = nested_uniform_scramble(sobol_dim1(i), s1);
-        *p = DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32);
+    Sobol02::new(seed).fill(first, out);
+}
+
+/// The Owen-scrambled (0,2)-sequence of one seed ([`sobol02`]), its scrambling derived once
+/// for callers that take a few points at a time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sobol02 {
+    s0: u32,
+    s1: u32,
+}
+
+impl Sobol02 {
+    /// The sequence of `seed`.
+    #[must_use]
+    pub fn new(seed: u64) -> Self {
+        Self { s0: hash_combine(seed, 0x5eed_0000) as u32, s1: hash_combine(seed, 0x5eed_0001) as u32 }
+    }
+
+    /// Points `first .. first + out.len()`.
+    pub fn fill(&self, first: u32, out: &mut [DVec2]) {
+        for (k, p) in out.iter_mut().enumerate() {
+            let i = first.wrapping_add(k as u32);
+            let x = nested_uniform_scramble(sobol_dim0(i), self.s0);
+            let y = nested_uniform_scramble(sobol_dim1(i), self.s1);
+            *p = DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32);
+        }
     }
 }
 

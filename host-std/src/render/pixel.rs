@@ -195,9 +195,15 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
             !shadows || !ctx.bvh.occluded(hits[k].origin, d, 0.0, f32::INFINITY)
         };
         let shaded = if wavefront::fits(&sampling, budget) {
-            let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] =
-                std::array::from_fn(|i| shading_point(ctx.scene, &hits[members[i.min(m - 1)]]));
-            let runs: [Run; GROUP] = std::array::from_fn(|i| run_of(&hits[members[i.min(m - 1)]]));
+            // Past the members, placeholders that nothing reads.
+            let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] = std::array::from_fn(|i| match members[..m].get(i) {
+                Some(&k) => shading_point(ctx.scene, &hits[k]),
+                None => ShadingPoint { frame: lead_sp.frame, wo: lead_sp.wo, brdf: lead_sp.brdf },
+            });
+            let runs: [Run; GROUP] = std::array::from_fn(|i| match members[..m].get(i) {
+                Some(&k) => run_of(&hits[k]),
+                None => Run { seed: seeds.light, block: 0 },
+            });
             let mut out = [DVec3::ZERO; GROUP];
             let mut vis = |i: usize, d: Vec3| visible(members[i], d);
             wavefront::shade_wavefront(&sampling, env, &points[..m], &runs[..m], budget, waves, &mut vis, &mut out);

@@ -12,7 +12,7 @@ use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
 use sampler_core::estimator::{BATCH, ShadingPoint};
 use sampler_core::glam::{DVec2, DVec3, Vec3};
-use sampler_core::points::sobol02;
+use sampler_core::points::Sobol02;
 use sampler_core::rng::hash_combine;
 
 /// How each shading point of a wavefront spends its budget.
@@ -110,8 +110,12 @@ pub(crate) fn shade_wavefront(
         }
     };
     buffers.samples.clear();
+    // A pixel's shading points share its sequences, each taking its own run of them.
+    let seed = runs.first().map_or(0, |r| r.seed);
+    debug_assert!(runs.iter().all(|r| r.seed == seed), "a wavefront is one pixel's");
+    let sequences = (Sobol02::new(hash_combine(seed, 1)), Sobol02::new(hash_combine(seed, 2)));
     for (point, run) in runs.iter().enumerate() {
-        push_samples(layout, point, *run, &mut buffers.samples);
+        push_samples(layout, point, run.block, sequences, &mut buffers.samples);
     }
     buffers.candidates.clear();
     buffers.candidates.resize(buffers.samples.len(), Candidate::default());
@@ -137,30 +141,35 @@ fn draw<S: DirectionSampler + ?Sized>(
     wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates);
 }
 
-/// A member's samples in the order its estimate sums them, from its run of the pixel's
-/// sequences (the same points [`shade::shade`] draws).
-fn push_samples(layout: Layout, point: usize, run: Run, samples: &mut Vec<WaveSample>) {
-    let Run { seed, block } = run;
+/// A shading point's samples in the order its estimate sums them, from its `block` of the
+/// pixel's sequences for each technique (the same points [`shade::shade`] draws).
+fn push_samples(
+    layout: Layout,
+    point: usize,
+    block: usize,
+    (first_seq, brdf_seq): (Sobol02, Sobol02),
+    samples: &mut Vec<WaveSample>,
+) {
     let mut push = |technique, u| samples.push(WaveSample { point, technique, u });
     let mut points = [DVec2::ZERO; BATCH];
     match layout {
         Layout::Single { technique, n } => {
-            sobol02(hash_combine(seed, 1), (block * n) as u32, &mut points[..n]);
+            first_seq.fill((block * n) as u32, &mut points[..n]);
             points[..n].iter().for_each(|&u| push(technique, u));
         }
         Layout::Pairs { n } => {
             let mut others = [DVec2::ZERO; BATCH];
-            sobol02(hash_combine(seed, 1), (block * n) as u32, &mut points[..n]);
-            sobol02(hash_combine(seed, 2), (block * n) as u32, &mut others[..n]);
+            first_seq.fill((block * n) as u32, &mut points[..n]);
+            brdf_seq.fill((block * n) as u32, &mut others[..n]);
             for (&u, &v) in points[..n].iter().zip(&others[..n]) {
                 push(Technique::Sampler, u);
                 push(Technique::Brdf, v);
             }
         }
         Layout::Split { first, brdf } => {
-            sobol02(hash_combine(seed, 1), (block * first) as u32, &mut points[..first]);
+            first_seq.fill((block * first) as u32, &mut points[..first]);
             points[..first].iter().for_each(|&u| push(Technique::Sampler, u));
-            sobol02(hash_combine(seed, 2), (block * brdf) as u32, &mut points[..brdf]);
+            brdf_seq.fill((block * brdf) as u32, &mut points[..brdf]);
             points[..brdf].iter().for_each(|&u| push(Technique::Brdf, u));
         }
     }
