@@ -1,172 +1,11 @@
-//! The environment hierarchy: a borrowed view over a caller-owned mip pyramid of the
-//! equal-area map.
-//!
-//! Level `k` is a `2^k × 2^k` grid of scalar importance (luminance) with `x` along `u` and `y`
-//! along `v`, stored in Morton (Z) order so that a node's four children are one contiguous
-//! 16-byte block and a subtree stays together in memory — the warp touches one cache line per
-//! level. Levels are packed from the 1×1 root down to the finest level `K`: level `k` starts at
-//! [`level_offset`]`(k)`, node `(x, y)` sits at [`pyramid_index`]; the whole pyramid holds
-//! [`pyramid_len`]`(K)` values (4/3 of the finest level). Because every texel of the equal-area
-//! map covers the same solid angle, each coarser texel is the plain mean of its four children.
-//! RGB radiance for shading is kept at the finest level only, row-major. Lookups are nearest-texel, the same piecewise-constant function the
-//! sampling densities are built from, so radiance cancels exactly in the product estimator.
+//! The borrowed view over a caller-owned pyramid: the map's orientation and tint, its nodes
+//! relative to the mean, radiance lookups and the env-only density.
 
-use crate::direction::DirectionSample;
+use super::pyramid::{EnvError, check_lengths, level_offset, morton2, pyramid_index};
 use crate::mapping::{
     SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
 };
-use crate::warp::{child_offset, choose_child, choose_grandchild, point_in_cell};
-use glam::{DVec2, Mat3, Vec2, Vec3};
-
-/// Finest level supported: 2^14 = 16384² texels.
-pub const MAX_LEVEL: u32 = 14;
-
-/// Index of the first value of level `k` in a packed pyramid.
-#[inline]
-#[must_use]
-pub const fn level_offset(level: u32) -> usize {
-    ((1usize << (2 * level)) - 1) / 3
-}
-
-/// Number of values in a packed pyramid whose finest level is `2^finest × 2^finest`.
-#[inline]
-#[must_use]
-pub const fn pyramid_len(finest: u32) -> usize {
-    level_offset(finest + 1)
-}
-
-/// Index of node `(x, y)` of `level` in a packed pyramid (Morton order within the level).
-#[inline]
-#[must_use]
-pub fn pyramid_index(level: u32, x: u32, y: u32) -> usize {
-    level_offset(level) + morton2(x, y)
-}
-
-/// Interleaves the bits of two 16-bit coordinates (x in the even bits).
-#[inline]
-#[must_use]
-pub fn morton2(x: u32, y: u32) -> usize {
-    fn spread(v: u32) -> u32 {
-        let mut v = v & 0xFFFF;
-        v = (v | (v << 8)) & 0x00FF_00FF;
-        v = (v | (v << 4)) & 0x0F0F_0F0F;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
-    }
-    (spread(x) | (spread(y) << 1)) as usize
-}
-
-/// Rec. 709 luminance: the scalar importance of an RGB radiance.
-#[inline]
-#[must_use]
-pub fn luminance(c: Vec3) -> f32 {
-    0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
-}
-
-/// What can be wrong with the buffers handed to [`EnvHierarchy::new`] or [`build_pyramid`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EnvError {
-    /// The finest level is larger than [`MAX_LEVEL`].
-    TooLarge {
-        /// The finest level asked for.
-        finest: u32,
-    },
-    /// A buffer does not have the length its finest level implies.
-    WrongLength {
-        /// Which buffer (`"pyramid"` or `"radiance"`).
-        buffer: &'static str,
-        /// The length the finest level implies.
-        expected: usize,
-        /// The length handed in.
-        found: usize,
-    },
-    /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
-    NotSanitized,
-}
-
-impl core::fmt::Display for EnvError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Self::TooLarge { finest } => {
-                write!(f, "environment level {finest} exceeds the maximum {MAX_LEVEL} (16384²)")
-            }
-            Self::WrongLength { buffer, expected, found } => {
-                write!(f, "{buffer} buffer holds {found} values, expected {expected}")
-            }
-            Self::NotSanitized => write!(f, "environment holds NaN, infinite or negative values"),
-        }
-    }
-}
-
-impl core::error::Error for EnvError {}
-
-/// Replaces NaN, ±Inf and negative components by 0; returns how many texels were changed.
-pub fn sanitize_rgb(texels: &mut [[f32; 3]]) -> usize {
-    let mut bad = 0;
-    for t in texels {
-        let mut changed = false;
-        for c in t.iter_mut() {
-            if !c.is_finite() || *c < 0.0 {
-                *c = 0.0;
-                changed = true;
-            }
-        }
-        bad += usize::from(changed);
-    }
-    bad
-}
-
-/// Writes the luminance of each RGB texel (row-major, sanitized with [`sanitize_rgb`]) into the
-/// finest level of `pyramid` and fills the coarser levels.
-pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Result<(), EnvError> {
-    check_lengths(finest, rgb.len(), pyramid.len())?;
-    let n = 1usize << finest;
-    for (i, c) in rgb.iter().enumerate() {
-        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = luminance(Vec3::from_array(*c));
-    }
-    fill_pyramid(finest, pyramid);
-    Ok(())
-}
-
-/// Like [`build_pyramid`] from a row-major scalar importance of the finest level (any
-/// non-negative finite weight that is > 0 wherever the radiance is).
-pub fn build_pyramid_from_importance(finest: u32, importance: &[f32], pyramid: &mut [f32]) -> Result<(), EnvError> {
-    check_lengths(finest, importance.len(), pyramid.len())?;
-    let n = 1usize << finest;
-    for (i, v) in importance.iter().enumerate() {
-        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = *v;
-    }
-    fill_pyramid(finest, pyramid);
-    Ok(())
-}
-
-/// Fills levels `finest − 1 … 0` from the finest level: in Morton order the four children of
-/// node `i` are `4i .. 4i + 4` of the next level. Accumulated in f64 so that radiances up to
-/// f32::MAX do not overflow.
-fn fill_pyramid(finest: u32, pyramid: &mut [f32]) {
-    for level in (0..finest).rev() {
-        let (coarse, fine) = pyramid.split_at_mut(level_offset(level + 1));
-        let coarse = &mut coarse[level_offset(level)..];
-        for (i, c) in coarse.iter_mut().enumerate() {
-            let q = &fine[4 * i..4 * i + 4];
-            *c = (0.25 * ((q[0] as f64 + q[1] as f64) + (q[2] as f64 + q[3] as f64))) as f32;
-        }
-    }
-}
-
-fn check_lengths(finest: u32, rgb: usize, pyramid: usize) -> Result<(), EnvError> {
-    if finest > MAX_LEVEL {
-        return Err(EnvError::TooLarge { finest });
-    }
-    let texels = 1usize << (2 * finest);
-    if rgb != texels {
-        return Err(EnvError::WrongLength { buffer: "radiance", expected: texels, found: rgb });
-    }
-    if pyramid != pyramid_len(finest) {
-        return Err(EnvError::WrongLength { buffer: "pyramid", expected: pyramid_len(finest), found: pyramid });
-    }
-    Ok(())
-}
+use glam::{Mat3, Vec2, Vec3};
 
 /// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
 #[derive(Clone, Copy, Debug)]
@@ -182,7 +21,7 @@ pub struct EnvHierarchy<'a> {
 }
 
 impl<'a> EnvHierarchy<'a> {
-    /// A view over `pyramid` (filled by [`build_pyramid`]) and the finest-level `radiance`.
+    /// A view over `pyramid` (filled by [`build_pyramid`](super::build_pyramid)) and the finest-level `radiance`.
     pub fn new(finest: u32, pyramid: &'a [f32], radiance: &'a [[f32; 3]]) -> Result<Self, EnvError> {
         check_lengths(finest, radiance.len(), pyramid.len())?;
         let mean = pyramid[0];
@@ -259,7 +98,7 @@ impl<'a> EnvHierarchy<'a> {
     }
 
     /// The four children of node `(x, y)` of `level` (which must be < K), relative to the mean,
-    /// in [`child_offset`] order.
+    /// in [`child_offset`](crate::warp::child_offset) order.
     #[inline]
     #[must_use]
     pub fn children_relative(&self, level: u32, x: u32, y: u32) -> [f32; 4] {
@@ -401,58 +240,12 @@ impl<'a> EnvHierarchy<'a> {
     pub fn pdf(&self, dir: Vec3) -> f32 {
         self.pdf_square(self.square_of(dir)) / SPHERE_AREA
     }
-
-    /// Warps `xi` from node `(x, y)` of `level` down to a finest-level texel, ∝ importance.
-    /// Returns the texel, or `None` if the node has no mass.
-    #[inline]
-    pub fn warp_down(&self, level: u32, x: u32, y: u32, xi: &mut DVec2) -> Option<(u32, u32)> {
-        // Two levels per step over the 16 grandchildren (one cache line), and raw pyramid
-        // values: the choice only needs ratios, so the 1/mean scale is left out.
-        let (mut l, mut x, mut y, mut m) = (level, x, y, morton2(x, y));
-        while l + 2 <= self.finest {
-            let base = level_offset(l + 2) + 16 * m;
-            let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().ok()?;
-            let (c, gx, gy) = choose_grandchild(g, xi)?;
-            (l, x, y, m) = (l + 2, 4 * x + gx, 4 * y + gy, 16 * m + c);
-        }
-        if l < self.finest {
-            let base = level_offset(l + 1) + 4 * m;
-            let q = &self.pyramid[base..base + 4];
-            let c = choose_child([q[0], q[1], q[2], q[3]], xi)?;
-            let (dx, dy) = child_offset(c);
-            (x, y) = (2 * x + dx, 2 * y + dy);
-        }
-        Some((x, y))
-    }
-
-    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy).
-    #[inline]
-    pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
-        if self.is_black() {
-            return None;
-        }
-        let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
-        let (x, y) = self.warp_down(0, 0, 0, &mut xi)?;
-        Some(self.sample_in_texel(x, y, xi))
-    }
-
-    /// The sample at point `xi` of finest-level texel (x, y), with its density.
-    #[inline]
-    pub(crate) fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> DirectionSample {
-        let (uv, pdf) = self.point_in_texel(x, y, xi);
-        DirectionSample { dir: self.dir_of(uv), uv, pdf }
-    }
-
-    /// The point of texel (x, y) at `xi` and the density there (solid angle).
-    #[inline]
-    pub(crate) fn point_in_texel(&self, x: u32, y: u32, xi: DVec2) -> (Vec2, f32) {
-        (point_in_cell(x, y, self.finest, xi), self.node_relative(self.finest, x, y) / SPHERE_AREA)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::env::{build_pyramid, luminance};
 
     #[test]
     fn batched_directions_and_points_are_bit_identical() {
@@ -474,20 +267,6 @@ mod tests {
             assert_eq!(dirs[k].to_array().map(f32::to_bits), e.dir_of(uv[k]).to_array().map(f32::to_bits));
             assert_eq!(back[k].to_array().map(f32::to_bits), e.square_of(dirs[k]).to_array().map(f32::to_bits));
         }
-    }
-
-    #[test]
-    fn pyramid_layout() {
-        assert_eq!(pyramid_len(0), 1);
-        assert_eq!(pyramid_len(1), 5);
-        assert_eq!(pyramid_len(2), 21);
-        assert_eq!(level_offset(2), 5);
-        let mut p = [0.0f32; 21];
-        let fine = [1.0, 2.0, 0.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0, 8.0, 8.0, 0.0, 0.0, 8.0, 8.0];
-        p[5..].copy_from_slice(&fine);
-        build_pyramid_from_importance(2, &fine, &mut p).unwrap();
-        assert_eq!(&p[1..5], &[2.5, 0.0, 0.0, 8.0]);
-        assert_eq!(p[0], 2.625);
     }
 
     #[test]
@@ -525,14 +304,6 @@ mod tests {
     }
 
     #[test]
-    fn sanitize_counts_bad_texels() {
-        let mut t = [[1.0, f32::NAN, 0.0], [f32::INFINITY, 0.0, 0.0], [-1.0, 2.0, 3.0], [1.0, 2.0, 3.0]];
-        assert_eq!(sanitize_rgb(&mut t), 3);
-        assert_eq!(t[0], [1.0, 0.0, 0.0]);
-        assert_eq!(t[2], [0.0, 2.0, 3.0]);
-    }
-
-    #[test]
     fn peak_measures_how_concentrated_the_light_is() {
         // 8×8 map: constant → 1; one texel 64× brighter than the others.
         let mut rgb = [[1.0f32; 3]; 64];
@@ -548,17 +319,6 @@ mod tests {
         assert!((env.peak(5) - 64.0 / mean).abs() < 1e-4);
         assert!((env.peak(1) - (15.0 + 64.0) / 16.0 / mean).abs() < 1e-4);
         assert!((env.peak(0) - 1.0).abs() < 1e-6);
-    }
-
-    #[test]
-    fn black_map_samples_nothing() {
-        let rgb = [[0.0f32; 3]; 4];
-        let mut p = [0.0f32; 5];
-        build_pyramid(1, &rgb, &mut p).unwrap();
-        let env = EnvHierarchy::new(1, &p, &rgb).unwrap();
-        assert!(env.is_black());
-        assert!(env.sample(DVec2::splat(0.3)).is_none());
-        assert_eq!(env.pdf(Vec3::Z), 0.0);
     }
 
     #[test]

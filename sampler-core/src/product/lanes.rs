@@ -1,114 +1,18 @@
-//! Descents side by side: many points warped four at a time, branch-free within a level, so
-//! that one descent's loads and arithmetic overlap the others' instead of each waiting on its
-//! own mispredicted branches (one per level and axis, each a coin flip).
+//! Product descents side by side: many points warped four at a time, branch-free within a
+//! level, so that one descent's loads and arithmetic overlap the others' instead of each
+//! waiting on its own mispredicted branches.
 //!
-//! * [`EnvHierarchy::sample_many`]: env-only samples (`WarpLane`s down the pyramid).
 //! * [`ProductSampler::sample_many`]: product samples — the tree first, then the environment's
-//!   levels below the leaves with the same `WarpLane`s (and the defensive env samples from the
-//!   root).
+//!   levels below the leaves with the environment's own lanes (and the defensive env samples
+//!   from the root).
 //! * [`ProductSampler::pdf_square_many`]: product densities, four descents by the points' bits.
 
-use crate::env::{EnvHierarchy, level_offset, morton2};
+use super::quadtree::{COORD_BITS, Node, quantize};
+use super::sampler::{DirectionSample, ProductSampler};
+use crate::env::WarpLane;
 use crate::mapping::SPHERE_AREA;
-use crate::quadtree::{COORD_BITS, Node, quantize};
-use crate::sampler::{DirectionSample, ProductSampler};
-use crate::warp::{
-    ONE_MINUS_EPSILON, child_offset, choose_child, choose_child_branchless, choose_grandchild_branchless, point_in_cell,
-};
+use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child_branchless, point_in_cell};
 use glam::{DVec2, Vec2, Vec3};
-
-/// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct WarpLane {
-    pub level: u32,
-    pub x: u32,
-    pub y: u32,
-    /// Morton index of (x, y) within its level.
-    morton: usize,
-    pub xi: DVec2,
-    /// False once the descent met a node without mass (or never started).
-    pub alive: bool,
-}
-
-impl WarpLane {
-    /// A descent from node (x, y) of `level` with the point `u` (clamped into [0, 1)²).
-    pub(crate) fn new(level: u32, x: u32, y: u32, u: DVec2) -> Self {
-        let xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
-        Self { level, x, y, morton: morton2(x, y), xi, alive: true }
-    }
-
-    #[inline(always)]
-    fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
-        self.level += levels;
-        self.x = (self.x << levels) + dx;
-        self.y = (self.y << levels) + dy;
-        self.morton = (self.morton << (2 * levels)) + child;
-    }
-}
-
-impl EnvHierarchy<'_> {
-    /// Env samples for many points, four descents side by side (each level's loads and
-    /// arithmetic of the four are independent, so they overlap), branch-free within a level.
-    /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
-    /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
-    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
-        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
-            let n = us.len().min(os.len());
-            let mut lanes = [WarpLane::default(); 4];
-            for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
-                *lane = WarpLane::new(0, 0, 0, *u);
-            }
-            self.warp_down_lanes(&mut lanes[..n]);
-            // The points and densities, then the four directions at once.
-            let mut points = [(Vec2::ZERO, 0.0); 4];
-            for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
-                *p = self.point_in_texel(lane.x, lane.y, lane.xi);
-            }
-            let mut dirs = [Vec3::ZERO; 4];
-            self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
-            for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
-                let (uv, pdf) = points[k];
-                *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv, pdf });
-            }
-        }
-    }
-
-    /// [`warp_down`](Self::warp_down) for up to a few descents at once, each from its own node,
-    /// advanced level by level side by side. A lane that meets a node without mass dies.
-    pub(crate) fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
-        if self.is_black() {
-            lanes.iter_mut().for_each(|l| l.alive = false);
-            return;
-        }
-        loop {
-            let mut busy = false;
-            for lane in lanes.iter_mut().filter(|l| l.alive && l.level < self.finest) {
-                busy = true;
-                if lane.level + 2 <= self.finest {
-                    let base = level_offset(lane.level + 2) + 16 * lane.morton;
-                    let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().unwrap();
-                    match choose_grandchild_branchless(g, &mut lane.xi) {
-                        Some((c, gx, gy)) => lane.step(2, gx, gy, c),
-                        None => lane.alive = false,
-                    }
-                } else {
-                    let base = level_offset(lane.level + 1) + 4 * lane.morton;
-                    let q = &self.pyramid[base..base + 4];
-                    match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
-                        Some(c) => {
-                            let (dx, dy) = child_offset(c);
-                            lane.step(1, dx, dy, c);
-                        }
-                        None => lane.alive = false,
-                    }
-                }
-            }
-            if !busy {
-                return;
-            }
-        }
-    }
-}
 
 /// One descent through the product tree.
 #[derive(Clone, Copy, Default)]
@@ -289,49 +193,5 @@ impl ProductSampler<'_, '_> {
                 *o = self.mixture(self.leaf_density(self.paths[l.index], l.depth, l.x, l.y, texel), texel);
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::env::{build_pyramid, pyramid_len};
-    use glam::Vec3;
-
-    #[test]
-    fn sample_many_draws_what_sample_draws() {
-        let mut rgb = [[0.0f32; 3]; 32 * 32];
-        for (i, t) in rgb.iter_mut().enumerate() {
-            *t = [(i * 7 % 13) as f32, (i % 3) as f32, if i == 300 { 1e6 } else { 0.5 }];
-        }
-        rgb[17] = [0.0; 3];
-        for level in [4u32, 5] {
-            let n = 1usize << level;
-            let texels = &rgb[..n * n];
-            let mut p = [0.0f32; 1365];
-            let p = &mut p[..pyramid_len(level)];
-            build_pyramid(level, texels, p).unwrap();
-            let e = EnvHierarchy::new(level, p, texels).unwrap();
-            let mut u = [DVec2::ZERO; 4099];
-            crate::points::sobol02(level as u64, 0, &mut u);
-            u[3] = DVec2::new(1.0, 0.0); // clamped like `sample` clamps
-            let mut out = [None; 4099];
-            e.sample_many(&u, &mut out);
-            let mut moved = 0;
-            for (a, b) in u.iter().zip(&out) {
-                let (a, b) = (e.sample(*a).unwrap(), b.unwrap());
-                // Same cell; the point inside may differ in the last bits.
-                moved += usize::from(e.texel_at(a.uv) != e.texel_at(b.uv));
-                assert!((a.uv - b.uv).abs().max_element() < 1e-5, "{a:?} {b:?}");
-                assert_eq!(b.pdf, e.pdf_square(b.uv) / SPHERE_AREA);
-            }
-            assert!(moved <= 2, "{moved} of 4099 in another texel");
-        }
-        let black = [[0.0f32; 3]; 4];
-        let mut p = [0.0f32; 5];
-        build_pyramid(1, &black, &mut p).unwrap();
-        let mut out = [Some(DirectionSample { dir: Vec3::Z, uv: Vec2::ZERO, pdf: 1.0 }); 5];
-        EnvHierarchy::new(1, &p, &black).unwrap().sample_many(&[DVec2::splat(0.5); 5], &mut out);
-        assert!(out.iter().all(Option::is_none));
     }
 }
