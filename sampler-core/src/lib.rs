@@ -59,6 +59,6 @@ pub mod sampling;
 
 pub use baselines::{two_level, two_stage};
 pub use product::{bilinear, quadtree, sampler, wavelet};
-pub use sphere::{cone, latlong, mapping, warp};
+pub use sphere::{cell, cone, latlong, mapping, warp};
 
 pub use glam;

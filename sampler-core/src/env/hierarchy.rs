@@ -1,7 +1,8 @@
 //! The borrowed view over a caller-owned pyramid: the map's orientation and tint, its nodes
 //! relative to the mean, radiance lookups and the env-only density.
 
-use super::pyramid::{EnvError, check_lengths, level_offset, morton2, pyramid_index};
+use super::pyramid::{EnvError, check_lengths, level_offset, pyramid_index};
+use crate::cell::Cell;
 use crate::mapping::{
     SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
 };
@@ -79,30 +80,30 @@ impl<'a> EnvHierarchy<'a> {
         self.inv_mean == 0.0
     }
 
-    /// Mean importance of node `(x, y)` of `level`, relative to the whole map's mean (so the
-    /// map averages to 1 whatever its absolute scale).
+    /// Mean importance of a node (a cell of level ≤ K), relative to the whole map's mean (so
+    /// the map averages to 1 whatever its absolute scale).
     #[inline]
     #[must_use]
-    pub fn node_relative(&self, level: u32, x: u32, y: u32) -> f32 {
-        self.pyramid[pyramid_index(level, x, y)] * self.inv_mean
+    pub fn node_relative(&self, node: Cell) -> f32 {
+        self.pyramid[pyramid_index(node)] * self.inv_mean
     }
 
-    /// The 16 grandchildren of node `(x, y)` of `level` (which must be < K − 1), as stored
+    /// The 16 grandchildren of a node of level < K − 1, as stored
     /// (not relative to the mean: for ratios), in the Morton order of
     /// [`crate::warp::choose_grandchild`] — one cache line.
     #[inline]
     #[must_use]
-    pub fn grandchildren_raw(&self, level: u32, x: u32, y: u32) -> &[f32; 16] {
-        let base = level_offset(level + 2) + 16 * morton2(x, y);
+    pub fn grandchildren_raw(&self, node: Cell) -> &[f32; 16] {
+        let base = level_offset(node.level + 2) + 16 * node.morton();
         self.pyramid[base..base + 16].try_into().expect("16 grandchildren")
     }
 
-    /// The four children of node `(x, y)` of `level` (which must be < K), relative to the mean,
+    /// The four children of a node of level < K, relative to the mean,
     /// in [`child_offset`](crate::warp::child_offset) order.
     #[inline]
     #[must_use]
-    pub fn children_relative(&self, level: u32, x: u32, y: u32) -> [f32; 4] {
-        let base = level_offset(level + 1) + 4 * morton2(x, y);
+    pub fn children_relative(&self, node: Cell) -> [f32; 4] {
+        let base = level_offset(node.level + 1) + 4 * node.morton();
         let q = &self.pyramid[base..base + 4];
         let s = self.inv_mean;
         [q[0] * s, q[1] * s, q[2] * s, q[3] * s]
@@ -118,7 +119,7 @@ impl<'a> EnvHierarchy<'a> {
         let mut max = 0.0f32;
         for y in 0..n {
             for x in 0..n {
-                max = max.max(self.node_relative(level, x, y));
+                max = max.max(self.node_relative(Cell::new(level, x, y)));
             }
         }
         if max.is_finite() { max } else { f32::MAX }
@@ -128,12 +129,11 @@ impl<'a> EnvHierarchy<'a> {
     /// below the finest level a cell lies inside one texel.
     #[inline]
     #[must_use]
-    pub fn cell_relative(&self, depth: u32, x: u32, y: u32) -> f32 {
-        if depth <= self.finest {
-            self.node_relative(depth, x, y)
+    pub fn cell_relative(&self, cell: Cell) -> f32 {
+        if cell.level <= self.finest {
+            self.node_relative(cell)
         } else {
-            let sh = depth - self.finest;
-            self.node_relative(self.finest, x >> sh, y >> sh)
+            self.node_relative(cell.ancestor(self.finest))
         }
     }
 
@@ -231,7 +231,7 @@ impl<'a> EnvHierarchy<'a> {
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
         let (x, y) = self.texel_at(uv);
-        self.node_relative(self.finest, x, y)
+        self.node_relative(Cell::new(self.finest, x, y))
     }
 
     /// Env-only density with respect to solid angle of world direction `dir`.
@@ -281,16 +281,16 @@ mod tests {
         for l in 0..3u32 {
             for y in 0..(1u32 << l) {
                 for x in 0..(1u32 << l) {
-                    let c = e.children_relative(l, x, y);
-                    let at = |dx, dy| e.node_relative(l + 1, 2 * x + dx, 2 * y + dy);
+                    let c = e.children_relative(Cell::new(l, x, y));
+                    let at = |dx, dy| e.node_relative(Cell::new(l + 1, 2 * x + dx, 2 * y + dy));
                     assert_eq!(c, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)]);
                     let mean = 0.25 * c.iter().sum::<f32>();
-                    assert!((mean - e.node_relative(l, x, y)).abs() <= 1e-6 * mean);
+                    assert!((mean - e.node_relative(Cell::new(l, x, y))).abs() <= 1e-6 * mean);
                 }
             }
         }
         // The finest level reads back the row-major input.
-        assert_eq!(e.node_relative(3, 5, 2) / e.inv_mean, luminance(Vec3::from_array(rgb[2 * 8 + 5])));
+        assert_eq!(e.node_relative(Cell::new(3, 5, 2)) / e.inv_mean, luminance(Vec3::from_array(rgb[2 * 8 + 5])));
     }
 
     #[test]
@@ -300,7 +300,7 @@ mod tests {
         build_pyramid(1, &rgb, &mut p).unwrap();
         assert!(p[0].is_finite());
         let env = EnvHierarchy::new(1, &p, &rgb).unwrap();
-        assert!((env.node_relative(1, 1, 1) - 1.0).abs() < 1e-6);
+        assert!((env.node_relative(Cell::new(1, 1, 1)) - 1.0).abs() < 1e-6);
     }
 
     #[test]

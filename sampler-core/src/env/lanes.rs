@@ -5,7 +5,8 @@
 //! [`WarpLane`]s.
 
 use super::EnvHierarchy;
-use super::pyramid::{level_offset, morton2};
+use super::pyramid::level_offset;
+use crate::cell::Cell;
 use crate::direction::DirectionSample;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
@@ -13,10 +14,8 @@ use glam::{DVec2, Vec2, Vec3};
 /// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WarpLane {
-    pub level: u32,
-    pub x: u32,
-    pub y: u32,
-    /// Morton index of (x, y) within its level.
+    pub cell: Cell,
+    /// Morton index of the cell within its level.
     morton: usize,
     pub xi: DVec2,
     /// False once the descent met a node without mass (or never started).
@@ -24,17 +23,16 @@ pub(crate) struct WarpLane {
 }
 
 impl WarpLane {
-    /// A descent from node (x, y) of `level` with the point `u` (clamped into [0, 1)²).
-    pub(crate) fn new(level: u32, x: u32, y: u32, u: DVec2) -> Self {
+    /// A descent from `node` with the point `u` (clamped into [0, 1)²).
+    pub(crate) fn new(node: Cell, u: DVec2) -> Self {
         let xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
-        Self { level, x, y, morton: morton2(x, y), xi, alive: true }
+        Self { cell: node, morton: node.morton(), xi, alive: true }
     }
 
     #[inline(always)]
     fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
-        self.level += levels;
-        self.x = (self.x << levels) + dx;
-        self.y = (self.y << levels) + dy;
+        let c = &mut self.cell;
+        (c.level, c.x, c.y) = (c.level + levels, (c.x << levels) + dx, (c.y << levels) + dy);
         self.morton = (self.morton << (2 * levels)) + child;
     }
 }
@@ -49,13 +47,13 @@ impl EnvHierarchy<'_> {
             let n = us.len().min(os.len());
             let mut lanes = [WarpLane::default(); 4];
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
-                *lane = WarpLane::new(0, 0, 0, *u);
+                *lane = WarpLane::new(Cell::ROOT, *u);
             }
             self.warp_down_lanes(&mut lanes[..n]);
             // The points and densities, then the four directions at once.
             let mut points = [(Vec2::ZERO, 0.0); 4];
             for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
-                *p = self.point_in_texel(lane.x, lane.y, lane.xi);
+                *p = self.point_in_texel(lane.cell, lane.xi);
             }
             let mut dirs = [Vec3::ZERO; 4];
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
@@ -75,17 +73,17 @@ impl EnvHierarchy<'_> {
         }
         loop {
             let mut busy = false;
-            for lane in lanes.iter_mut().filter(|l| l.alive && l.level < self.finest) {
+            for lane in lanes.iter_mut().filter(|l| l.alive && l.cell.level < self.finest) {
                 busy = true;
-                if lane.level + 2 <= self.finest {
-                    let base = level_offset(lane.level + 2) + 16 * lane.morton;
+                if lane.cell.level + 2 <= self.finest {
+                    let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
                     let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().unwrap();
                     match choose_grandchild_branchless(g, &mut lane.xi) {
                         Some((c, gx, gy)) => lane.step(2, gx, gy, c),
                         None => lane.alive = false,
                     }
                 } else {
-                    let base = level_offset(lane.level + 1) + 4 * lane.morton;
+                    let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
                     let q = &self.pyramid[base..base + 4];
                     match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
                         Some(c) => {

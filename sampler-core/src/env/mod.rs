@@ -5,7 +5,7 @@
 //! along `v`, stored in Morton (Z) order so that a node's four children are one contiguous
 //! 16-byte block and a subtree stays together in memory — the warp touches one cache line per
 //! level. Levels are packed from the 1×1 root down to the finest level `K`: level `k` starts at
-//! [`level_offset`]`(k)`, node `(x, y)` sits at [`pyramid_index`]; the whole pyramid holds
+//! [`level_offset`]`(k)`, node `(x, y)` of level `k` (a [`Cell`](crate::cell::Cell)) sits at [`pyramid_index`]; the whole pyramid holds
 //! [`pyramid_len`]`(K)` values (4/3 of the finest level). Because every texel of the equal-area
 //! map covers the same solid angle, each coarser texel is the plain mean of its four children.
 //! RGB radiance for shading is kept at the finest level only, row-major. Lookups are
@@ -23,6 +23,6 @@ mod sample;
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::WarpLane;
 pub use pyramid::{
-    EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, morton2, pyramid_index,
+    EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, pyramid_index,
     pyramid_len, sanitize_rgb,
 };

@@ -2,6 +2,7 @@
 //! Morton order within a level), the luminance it holds, and the checks and builders of the
 //! caller-owned buffers.
 
+use crate::cell::Cell;
 use glam::Vec3;
 
 /// Finest level supported: 2^14 = 16384² texels.
@@ -21,25 +22,11 @@ pub const fn pyramid_len(finest: u32) -> usize {
     level_offset(finest + 1)
 }
 
-/// Index of node `(x, y)` of `level` in a packed pyramid (Morton order within the level).
+/// Index of a node in a packed pyramid (Morton order within its level).
 #[inline]
 #[must_use]
-pub fn pyramid_index(level: u32, x: u32, y: u32) -> usize {
-    level_offset(level) + morton2(x, y)
-}
-
-/// Interleaves the bits of two 16-bit coordinates (x in the even bits).
-#[inline]
-#[must_use]
-pub fn morton2(x: u32, y: u32) -> usize {
-    fn spread(v: u32) -> u32 {
-        let mut v = v & 0xFFFF;
-        v = (v | (v << 8)) & 0x00FF_00FF;
-        v = (v | (v << 4)) & 0x0F0F_0F0F;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
-    }
-    (spread(x) | (spread(y) << 1)) as usize
+pub fn pyramid_index(node: Cell) -> usize {
+    level_offset(node.level) + node.morton()
 }
 
 /// Rec. 709 luminance: the scalar importance of an RGB radiance.
@@ -108,7 +95,7 @@ pub fn build_pyramid(finest: u32, rgb: &[[f32; 3]], pyramid: &mut [f32]) -> Resu
     check_lengths(finest, rgb.len(), pyramid.len())?;
     let n = 1usize << finest;
     for (i, c) in rgb.iter().enumerate() {
-        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = luminance(Vec3::from_array(*c));
+        pyramid[pyramid_index(Cell::new(finest, (i % n) as u32, (i / n) as u32))] = luminance(Vec3::from_array(*c));
     }
     fill_pyramid(finest, pyramid);
     Ok(())
@@ -120,7 +107,7 @@ pub fn build_pyramid_from_importance(finest: u32, importance: &[f32], pyramid: &
     check_lengths(finest, importance.len(), pyramid.len())?;
     let n = 1usize << finest;
     for (i, v) in importance.iter().enumerate() {
-        pyramid[pyramid_index(finest, (i % n) as u32, (i / n) as u32)] = *v;
+        pyramid[pyramid_index(Cell::new(finest, (i % n) as u32, (i / n) as u32))] = *v;
     }
     fill_pyramid(finest, pyramid);
     Ok(())

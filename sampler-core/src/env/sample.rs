@@ -2,34 +2,33 @@
 //! texel ∝ importance, then placed uniformly inside it.
 
 use super::EnvHierarchy;
-use super::pyramid::{level_offset, morton2};
+use super::pyramid::level_offset;
+use crate::cell::Cell;
 use crate::direction::DirectionSample;
 use crate::mapping::SPHERE_AREA;
-use crate::warp::{child_offset, choose_child, choose_grandchild, point_in_cell};
+use crate::warp::{choose_child, choose_grandchild};
 use glam::{DVec2, Vec2};
 
 impl EnvHierarchy<'_> {
-    /// Warps `xi` from node `(x, y)` of `level` down to a finest-level texel, ∝ importance.
-    /// Returns the texel, or `None` if the node has no mass.
+    /// Warps `xi` from `node` down to a finest-level texel, ∝ importance. Returns the texel,
+    /// or `None` if the node has no mass.
     #[inline]
-    pub fn warp_down(&self, level: u32, x: u32, y: u32, xi: &mut DVec2) -> Option<(u32, u32)> {
+    pub fn warp_down(&self, node: Cell, xi: &mut DVec2) -> Option<Cell> {
         // Two levels per step over the 16 grandchildren (one cache line), and raw pyramid
         // values: the choice only needs ratios, so the 1/mean scale is left out.
-        let (mut l, mut x, mut y, mut m) = (level, x, y, morton2(x, y));
-        while l + 2 <= self.finest {
-            let base = level_offset(l + 2) + 16 * m;
+        let (mut cell, mut m) = (node, node.morton());
+        while cell.level + 2 <= self.finest {
+            let base = level_offset(cell.level + 2) + 16 * m;
             let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().ok()?;
             let (c, gx, gy) = choose_grandchild(g, xi)?;
-            (l, x, y, m) = (l + 2, 4 * x + gx, 4 * y + gy, 16 * m + c);
+            (cell, m) = (cell.grandchild(gx, gy), 16 * m + c);
         }
-        if l < self.finest {
-            let base = level_offset(l + 1) + 4 * m;
+        if cell.level < self.finest {
+            let base = level_offset(cell.level + 1) + 4 * m;
             let q = &self.pyramid[base..base + 4];
-            let c = choose_child([q[0], q[1], q[2], q[3]], xi)?;
-            let (dx, dy) = child_offset(c);
-            (x, y) = (2 * x + dx, 2 * y + dy);
+            cell = cell.child(choose_child([q[0], q[1], q[2], q[3]], xi)?);
         }
-        Some((x, y))
+        Some(cell)
     }
 
     /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy).
@@ -39,21 +38,21 @@ impl EnvHierarchy<'_> {
             return None;
         }
         let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
-        let (x, y) = self.warp_down(0, 0, 0, &mut xi)?;
-        Some(self.sample_in_texel(x, y, xi))
+        let texel = self.warp_down(Cell::ROOT, &mut xi)?;
+        Some(self.sample_in_texel(texel, xi))
     }
 
-    /// The sample at point `xi` of finest-level texel (x, y), with its density.
+    /// The sample at point `xi` of a finest-level texel, with its density.
     #[inline]
-    pub(crate) fn sample_in_texel(&self, x: u32, y: u32, xi: DVec2) -> DirectionSample {
-        let (uv, pdf) = self.point_in_texel(x, y, xi);
+    pub(crate) fn sample_in_texel(&self, texel: Cell, xi: DVec2) -> DirectionSample {
+        let (uv, pdf) = self.point_in_texel(texel, xi);
         DirectionSample { dir: self.dir_of(uv), uv, pdf }
     }
 
-    /// The point of texel (x, y) at `xi` and the density there (solid angle).
+    /// The point of a finest-level texel at `xi` and the density there (solid angle).
     #[inline]
-    pub(crate) fn point_in_texel(&self, x: u32, y: u32, xi: DVec2) -> (Vec2, f32) {
-        (point_in_cell(x, y, self.finest, xi), self.node_relative(self.finest, x, y) / SPHERE_AREA)
+    pub(crate) fn point_in_texel(&self, texel: Cell, xi: DVec2) -> (Vec2, f32) {
+        (texel.point(xi), self.node_relative(texel) / SPHERE_AREA)
     }
 }
 

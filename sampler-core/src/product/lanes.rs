@@ -9,9 +9,10 @@
 
 use super::quadtree::{COORD_BITS, Node, quantize};
 use super::sampler::{DirectionSample, ProductSampler};
+use crate::cell::Cell;
 use crate::env::WarpLane;
 use crate::mapping::SPHERE_AREA;
-use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child_branchless, point_in_cell};
+use crate::warp::{ONE_MINUS_EPSILON, choose_child_branchless};
 use glam::{DVec2, Vec2, Vec3};
 
 /// One descent through the product tree.
@@ -20,9 +21,8 @@ struct TreeLane {
     /// The node the descent is at (a copy: its leaf test needs no load) and its index.
     node: Node,
     index: usize,
-    depth: u32,
-    x: u32,
-    y: u32,
+    /// The node's cell.
+    cell: Cell,
     /// Probability of the path (the leaf's, once there).
     path: f64,
     xi: DVec2,
@@ -66,7 +66,7 @@ impl ProductSampler<'_, '_> {
             // levels, also side by side.
             let mut below = [WarpLane::default(); 4];
             for (e, t) in below.iter_mut().zip(&tree[..n]) {
-                *e = WarpLane::new(t.depth, t.x, t.y, t.xi);
+                *e = WarpLane::new(t.cell, t.xi);
                 e.alive = t.alive;
             }
             self.env.warp_down_lanes(&mut below[..n]);
@@ -112,9 +112,7 @@ impl ProductSampler<'_, '_> {
                     (lane.in_tree, lane.alive) = (false, false);
                     continue;
                 };
-                let (dx, dy) = child_offset(k);
-                (lane.node, lane.index) = (c[k], first + k);
-                (lane.depth, lane.x, lane.y) = (lane.depth + 1, 2 * lane.x + dx, 2 * lane.y + dy);
+                (lane.node, lane.index, lane.cell) = (c[k], first + k, lane.cell.child(k));
             }
             if !busy {
                 return;
@@ -130,11 +128,11 @@ impl ProductSampler<'_, '_> {
             return None;
         }
         let (uv, pdf_square) = if t.defensive {
-            (point_in_cell(e.x, e.y, self.env.finest_level(), e.xi), 0.0)
+            (e.cell.point(e.xi), 0.0)
         } else {
-            // Below a leaf finer than the map the env lane did not move: (e.x, e.y, e.xi) are
+            // Below a leaf finer than the map the env lane did not move: its cell and point are
             // the leaf's.
-            let (uv, product, texel) = self.land(t.path, t.depth, t.x, t.y, (e.x, e.y), e.xi);
+            let (uv, product, texel) = self.land(t.path, t.cell, e.cell, e.xi);
             (uv, self.mixture(product, texel))
         };
         Some((uv, pdf_square / SPHERE_AREA))
@@ -146,9 +144,7 @@ impl ProductSampler<'_, '_> {
 struct PdfLane {
     node: Node,
     index: usize,
-    depth: u32,
-    x: u32,
-    y: u32,
+    cell: Cell,
     /// The point's 24-bit coordinates.
     qx: u32,
     qy: u32,
@@ -177,12 +173,11 @@ impl ProductSampler<'_, '_> {
                 let mut busy = false;
                 for lane in lanes[..n].iter_mut().filter(|l| !l.node.is_leaf()) {
                     busy = true;
-                    let shift = COORD_BITS - 1 - lane.depth;
-                    let (dx, dy) = ((lane.qx >> shift) & 1, (lane.qy >> shift) & 1);
-                    let k = (dx + 2 * dy) as usize;
+                    let shift = COORD_BITS - 1 - lane.cell.level;
+                    let k = (((lane.qx >> shift) & 1) + 2 * ((lane.qy >> shift) & 1)) as usize;
                     lane.index = lane.node.child as usize + k;
                     lane.node = self.nodes[lane.index];
-                    (lane.depth, lane.x, lane.y) = (lane.depth + 1, 2 * lane.x + dx, 2 * lane.y + dy);
+                    lane.cell = lane.cell.child(k);
                 }
                 if !busy {
                     break;
@@ -190,7 +185,7 @@ impl ProductSampler<'_, '_> {
             }
             for ((o, l), uv) in os.iter_mut().zip(&lanes[..n]).zip(us) {
                 let texel = self.env.pdf_square(*uv);
-                *o = self.mixture(self.leaf_density(self.paths[l.index], l.depth, l.x, l.y, texel), texel);
+                *o = self.mixture(self.leaf_density(self.paths[l.index], l.cell, texel), texel);
             }
         }
     }

@@ -20,9 +20,10 @@
 
 use super::bilinear::Corners;
 use super::quadtree::{COORD_BITS, Node, quantize};
+use crate::cell::Cell;
 use crate::env::EnvHierarchy;
 use crate::mapping::SPHERE_AREA;
-use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, inverse_area, point_in_cell};
+use crate::warp::{ONE_MINUS_EPSILON, choose_child};
 use glam::{DVec2, Vec2, Vec3};
 
 pub use super::arena::ProductArena;
@@ -86,8 +87,7 @@ impl<'e> ProductSampler<'_, 'e> {
         let eps = self.defensive as f64;
         let (uv, pdf_square) = if xi.x < eps {
             xi.x = (xi.x / eps).min(ONE_MINUS_EPSILON);
-            let (x, y) = self.env.warp_down(0, 0, 0, &mut xi)?;
-            let uv = point_in_cell(x, y, self.env.finest_level(), xi);
+            let uv = self.env.warp_down(Cell::ROOT, &mut xi)?.point(xi);
             (uv, self.pdf_square(uv))
         } else {
             xi.x = ((xi.x - eps) / (1.0 - eps)).clamp(0.0, ONE_MINUS_EPSILON);
@@ -102,47 +102,45 @@ impl<'e> ProductSampler<'_, 'e> {
     /// Returns the point, the product's density per unit square area there and the relative
     /// importance of its texel (the env's density per unit square area).
     fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f64, f32)> {
-        let (mut i, mut depth, mut x, mut y) = (0usize, 0u32, 0u32, 0u32);
+        let (mut i, mut leaf) = (0usize, Cell::ROOT);
         while !self.nodes[i].is_leaf() {
             let first = self.nodes[i].child as usize;
             let c = &self.nodes[first..first + 4];
             let child = choose_child([c[0].product, c[1].product, c[2].product, c[3].product], xi)?;
-            let (dx, dy) = child_offset(child);
-            (i, depth, x, y) = (first + child, depth + 1, 2 * x + dx, 2 * y + dy);
+            (i, leaf) = (first + child, leaf.child(child));
         }
         let path = self.paths[i];
-        let finest = self.env.finest_level();
         if !self.corners.is_empty() {
-            return self.warp_bilinear(i, path, depth, x, y, xi);
+            return self.warp_bilinear(i, path, leaf, xi);
         }
-        let texel = if depth < finest { self.env.warp_down(depth, x, y, xi)? } else { (x, y) };
-        Some(self.land(path, depth, x, y, texel, *xi))
+        let texel = if leaf.level < self.env.finest_level() { self.env.warp_down(leaf, xi)? } else { leaf };
+        Some(self.land(path, leaf, texel, *xi))
     }
 
-    /// Where a product sample that reached leaf (depth, x, y) with probability `path` lands,
-    /// with ξ uniform in the last cell: in `texel` (chosen below the leaf by the env's levels)
-    /// when the leaf is coarser than the map, in the leaf itself otherwise. Returns the point,
-    /// the product's density per unit area there and the texel's relative importance.
-    pub(crate) fn land(&self, path: f64, depth: u32, x: u32, y: u32, texel: (u32, u32), xi: DVec2) -> (Vec2, f64, f32) {
-        let finest = self.env.finest_level();
-        let (uv, importance) = if depth < finest {
-            // `point_in_cell` keeps the point in the texel the descent chose, so the texel is
+    /// Where a product sample that reached `leaf` with probability `path` lands, with ξ
+    /// uniform in the last cell: in `texel` (chosen below the leaf by the env's levels) when the
+    /// leaf is coarser than the map, in the leaf itself otherwise (then `texel` is the leaf).
+    /// Returns the point, the product's density per unit area there and the texel's relative
+    /// importance.
+    pub(crate) fn land(&self, path: f64, leaf: Cell, texel: Cell, xi: DVec2) -> (Vec2, f64, f32) {
+        let (uv, importance) = if leaf.level < self.env.finest_level() {
+            // `Cell::point` keeps the point in the texel the descent chose, so the texel is
             // known: `leaf_density`'s result without its lookups.
-            (point_in_cell(texel.0, texel.1, finest, xi), self.env.node_relative(finest, texel.0, texel.1))
+            (texel.point(xi), self.env.node_relative(texel))
         } else {
-            let uv = point_in_cell(x, y, depth, xi);
+            let uv = leaf.point(xi);
             (uv, self.env.pdf_square(uv))
         };
-        (uv, self.leaf_density(path, depth, x, y, importance), importance)
+        (uv, self.leaf_density(path, leaf, importance), importance)
     }
 
-    /// Density per unit square area inside the leaf (depth, x, y) reached with probability
-    /// `path`, at a point whose texel has relative importance `texel`: the leaf's share spread
-    /// over its area, and below it the environment's texels in proportion to their importance.
-    pub(crate) fn leaf_density(&self, path: f64, depth: u32, x: u32, y: u32, texel: f32) -> f64 {
-        let area = inverse_area(depth);
-        if depth < self.env.finest_level() {
-            let leaf_env = self.env.node_relative(depth, x, y) as f64;
+    /// Density per unit square area inside `leaf`, reached with probability `path`, at a point
+    /// whose texel has relative importance `texel`: the leaf's share spread over its area, and
+    /// below it the environment's texels in proportion to their importance.
+    pub(crate) fn leaf_density(&self, path: f64, leaf: Cell, texel: f32) -> f64 {
+        let area = leaf.inverse_area();
+        if leaf.level < self.env.finest_level() {
+            let leaf_env = self.env.node_relative(leaf) as f64;
             if leaf_env > 0.0 { path * area * texel as f64 / leaf_env } else { 0.0 }
         } else {
             path * area
@@ -150,27 +148,27 @@ impl<'e> ProductSampler<'_, 'e> {
     }
 
     /// The product's density per unit square area at `uv`, from the product of the branch
-    /// probabilities the warp takes to reach its leaf (kept per node by the build): exactly the density the warp realises, however
-    /// the node values were computed (the Haar product's cancellation makes its node values
-    /// differ from the means of their children at extreme dynamic range). `texel`: the env's
-    /// relative importance at `uv` (`EnvHierarchy::pdf_square`), which the caller has already.
+    /// probabilities the warp takes to reach its leaf (kept per node by the build): exactly the
+    /// density the warp realises, however the node values were computed (the Haar product's
+    /// cancellation makes its node values differ from the means of their children at extreme
+    /// dynamic range). `texel`: the env's relative importance at `uv`
+    /// (`EnvHierarchy::pdf_square`), which the caller has already.
     fn product_density(&self, uv: Vec2, texel: f32) -> f64 {
         let Some(root) = self.nodes.first() else { return 0.0 };
         let (qx, qy) = (quantize(uv.x), quantize(uv.y));
-        let (mut node, mut index, mut depth, mut x, mut y) = (*root, 0usize, 0u32, 0u32, 0u32);
+        let (mut node, mut index, mut leaf) = (*root, 0usize, Cell::ROOT);
         while !node.is_leaf() {
-            let shift = COORD_BITS - 1 - depth;
-            let (dx, dy) = ((qx >> shift) & 1, (qy >> shift) & 1);
-            let k = (dx + 2 * dy) as usize;
+            let shift = COORD_BITS - 1 - leaf.level;
+            let k = (((qx >> shift) & 1) + 2 * ((qy >> shift) & 1)) as usize;
             index = node.child as usize + k;
             node = self.nodes[index];
-            (depth, x, y) = (depth + 1, 2 * x + dx, 2 * y + dy);
+            leaf = leaf.child(k);
         }
         let path = self.paths[index];
         if !self.corners.is_empty() {
-            return self.bilinear_density(index, path, depth, x, y, uv);
+            return self.bilinear_density(index, path, leaf, uv);
         }
-        self.leaf_density(path, depth, x, y, texel)
+        self.leaf_density(path, leaf, texel)
     }
 
     /// The mixture density per unit square area, from the product's density and the texel's
