@@ -2,7 +2,8 @@
 //! extreme geometry. Each case asserts no NaN/Inf (exactly 0 under a black sky and for a
 //! back-facing view) and compares the mean with a reference — quadrature of the sky plus the
 //! sun's excess integrated over its texel — in standard errors, writing the whole table (mean,
-//! reference, z, variance, time) to `target/stability_matrix.md`.
+//! reference, z, variance, time) to `stability_matrix.md` in the target directory's `tmp/`
+//! (`CARGO_TARGET_TMPDIR`, under `CARGO_TARGET_DIR` when that is set).
 //!
 //! * Estimators that cover both a needle lobe and a one-texel sun (product, wavelet, mis,
 //!   product-mis, ris): with ~1000 cases at 3σ, a few exceed 3σ by chance, so the test asserts
@@ -317,7 +318,7 @@ fn every_estimator_on_every_extreme_case() {
             }
         }
     }
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/stability_matrix.md");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("stability_matrix.md");
     let _ = std::fs::write(&path, &table);
     println!("{cases} cases, {over3} beyond 3σ, worst z = {:.2} ({}); table in {}", worst.0, worst.1, path.display());
     assert!(problems.is_empty(), "{}", problems.join("\n"));
