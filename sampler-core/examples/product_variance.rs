@@ -10,6 +10,7 @@ use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::sampler::{ProductArena, ProductParams};
 
 fn main() {
@@ -36,13 +37,13 @@ fn main() {
         let wo = frame.to_world(Vec3::new(-0.3, -0.4, 0.87).normalize());
         let sp = ShadingPoint { frame, wo, brdf: &brdf };
         for probe in [false, true] {
-            let params = ProductParams {
-                defensive: eps,
-                probe_leaves: probe,
-                refine_share: refine,
-                bilinear,
-                ..ProductParams::default()
+            let leaves = match (bilinear, probe) {
+                (true, _) => Leaves::Bilinear,
+                (false, true) => Leaves::Probed,
+                (false, false) => Leaves::Sampled,
             };
+            let kind = ProductKind::Quadtree { leaves, refine_share: refine };
+            let params = ProductParams { defensive: eps, kind, ..ProductParams::default() };
             // Relative variance per sample (over builds) and of 64-point net means (×64: 1 = no gain).
             let mut stats = [[0.0f64; 3]; 4];
             let mut net = [[0.0f64; 3]; 4];

@@ -10,6 +10,7 @@ use sampler_core::estimator::{Contribution, ShadingPoint, sampled_mis, sampled_m
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
 use sampler_core::sampler::{ProductArena, ProductParams};
 use std::time::Instant;
@@ -46,8 +47,8 @@ fn main() {
     let mut params = ProductParams::for_mis(256);
     match std::env::var("PARAMS").as_deref() {
         Ok("default") => params = ProductParams::default(),
-        Ok("noprobe") => params.probe_leaves = false,
-        Ok("norefine") => params.refine_share = 0.0,
+        Ok("noprobe") => params.kind = ProductKind::Quadtree { leaves: Leaves::Sampled, refine_share: 1.0 / 256.0 },
+        Ok("norefine") => params.kind = ProductKind::Quadtree { leaves: Leaves::Probed, refine_share: 0.0 },
         _ => {}
     }
     let mut us = vec![DVec2::ZERO; pairs];

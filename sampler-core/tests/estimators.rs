@@ -14,7 +14,7 @@ use sampler_core::env::{EnvHierarchy, luminance};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
-use sampler_core::quadtree::ProductKind;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
 use sampler_core::sampler::{ProductArena, ProductParams};
 use sampler_core::two_level::TwoLevelArena;
@@ -146,7 +146,7 @@ fn run(estimator: &str) {
             "product" | "wavelet" => {
                 // Each unit: a fresh B̃ (new BRDF samples) and 32 warped points: the whole
                 // estimator, including the randomness of the product itself.
-                let kind = if estimator == "product" { ProductKind::Quadtree } else { ProductKind::Wavelet };
+                let kind = if estimator == "product" { ProductKind::QUADTREE } else { ProductKind::WAVELET };
                 let params = ProductParams { kind, ..ProductParams::default() };
                 (0..600u64)
                     .map(|seed| {
@@ -216,7 +216,10 @@ fn run(estimator: &str) {
             }
             "product-mis" | "product-mis probed" | "product-mis for_mis" => {
                 let params = match estimator {
-                    "product-mis probed" => ProductParams { probe_leaves: true, ..ProductParams::default() },
+                    "product-mis probed" => ProductParams {
+                        kind: ProductKind::Quadtree { leaves: Leaves::Probed, refine_share: 0.0 },
+                        ..ProductParams::default()
+                    },
                     "product-mis for_mis" => ProductParams::for_mis(256),
                     _ => ProductParams::default(),
                 };

@@ -8,7 +8,7 @@ use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
-use sampler_core::quadtree::ProductKind;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
 use sampler_core::sampler::{ProductArena, ProductParams};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -77,8 +77,11 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let brdf = brdfs[(i % 4) as usize];
         let params = match i % 4 {
             0 => ProductParams::default(),
-            2 => ProductParams { bilinear: true, ..ProductParams::for_mis(256) },
-            _ => ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() },
+            2 => ProductParams {
+                kind: ProductKind::Quadtree { leaves: Leaves::Bilinear, refine_share: 1.0 / 256.0 },
+                ..ProductParams::for_mis(256)
+            },
+            _ => ProductParams { kind: ProductKind::WAVELET, ..ProductParams::default() },
         };
         let sampler = arena.build(&env, brdf, &frame, wo, &params, i).unwrap();
         let mut points = [DVec2::ZERO; 4];

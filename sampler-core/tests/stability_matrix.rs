@@ -206,9 +206,9 @@ fn every_estimator_on_every_extreme_case() {
                         match *method {
                             "product" | "wavelet" | "product-mis" | "product K=1" => {
                                 let kind = if *method == "wavelet" {
-                                    sampler_core::quadtree::ProductKind::Wavelet
+                                    sampler_core::quadtree::ProductKind::WAVELET
                                 } else {
-                                    sampler_core::quadtree::ProductKind::Quadtree
+                                    sampler_core::quadtree::ProductKind::QUADTREE
                                 };
                                 let brdf_samples = if *method == "product K=1" { 1 } else { 256 };
                                 // product-MIS with the preset the renderer uses beside BRDF sampling.

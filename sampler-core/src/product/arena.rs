@@ -4,7 +4,7 @@
 
 use super::bilinear::Corners;
 use super::params::{ProductError, ProductParams};
-use super::quadtree::{COORD_BITS, Node, ProductKind, TreeBuilder, sort_key};
+use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder, sort_key};
 use super::sampler::ProductSampler;
 use crate::brdf::{Brdf, BrdfDraw};
 use crate::env::{EnvHierarchy, luminance};
@@ -19,10 +19,9 @@ use heapless::Vec;
 /// 48·K + 16·NODES bytes: each node's 8 bytes and its path probability's 8. The default NODES
 /// holds the largest trees that 256 samples make (docs/perf.md#tree-size-and-memory); when
 /// NODES is exhausted, splitting stops and leaves keep the mean of their samples (still exact
-/// sampling). A bilinear B̃ (`ProductParams::bilinear`) also stores four corner values per node
-/// and needs CORNERS ≥ NODES (+16·NODES bytes); with the
-/// default CORNERS = 0 nobody pays for it and B̃ stays piecewise constant
-/// ([`ProductSampler::is_bilinear`] says which was built).
+/// sampling). A bilinear B̃ ([`Leaves::Bilinear`]) also stores four corner values per node and
+/// needs CORNERS ≥ NODES (+16·NODES bytes); with the default CORNERS = 0 nobody pays for it and
+/// B̃ stays piecewise constant ([`ProductSampler::kind`] says what was built).
 pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const CORNERS: usize = 0> {
     /// BRDF sample points, then the samples' points of the equal-area square.
     points: [Vec2; K],
@@ -38,8 +37,19 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     paths: Vec<f64, NODES>,
     /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
     corners: Vec<Corners, CORNERS>,
-    /// The last build's defensive fraction and usable BRDF samples (`None` before the first).
-    built: Option<(f32, usize)>,
+    /// What the last build made (`None` before the first).
+    built: Option<Built>,
+}
+
+/// What a build made, kept for [`ProductArena::last_built`].
+#[derive(Clone, Copy, Debug)]
+struct Built {
+    /// The effective defensive fraction.
+    defensive: f32,
+    /// The usable BRDF samples.
+    brdf_samples: usize,
+    /// The kind as built ([`ProductArena::buildable`]).
+    kind: ProductKind,
 }
 
 impl<const K: usize, const NODES: usize, const CORNERS: usize> Default for ProductArena<K, NODES, CORNERS> {
@@ -83,6 +93,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         if params.brdf_samples > K {
             return Err(ProductError::AboveCapacity { asked: params.brdf_samples, capacity: K });
         }
+        let kind = Self::buildable(params.kind);
         let wo_local = frame.to_local(wo);
         let k = params.brdf_samples;
         self.keys.clear();
@@ -117,11 +128,11 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             env,
             nodes: &mut self.nodes,
             max_depth: params.max_depth.min(COORD_BITS),
-            kind: params.kind,
+            wavelet: kind.is_wavelet(),
             eval,
-            probe_leaves: params.probe_leaves,
-            refine_share: if params.kind == ProductKind::Quadtree { params.refine_share } else { 0.0 },
-            bilinear: params.bilinear && params.kind == ProductKind::Quadtree && CORNERS >= NODES,
+            probe_leaves: kind.leaves() == Leaves::Probed,
+            refine_share: kind.refine_share(),
+            bilinear: kind.leaves() == Leaves::Bilinear,
             corners: &mut self.corners,
         };
         builder.build();
@@ -129,9 +140,21 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
-        self.built = Some((defensive, count));
+        self.built = Some(Built { defensive, brdf_samples: count, kind });
         let built: &'a Self = self;
         Ok(built.last_built(env).expect("just built"))
+    }
+
+    /// The kind this arena builds when asked for `kind`: bilinear leaves need the corners'
+    /// storage (CORNERS ≥ NODES), and without it the leaves are built from the samples.
+    #[must_use]
+    pub const fn buildable(kind: ProductKind) -> ProductKind {
+        match kind {
+            ProductKind::Quadtree { leaves: Leaves::Bilinear, refine_share } if CORNERS < NODES => {
+                ProductKind::Quadtree { leaves: Leaves::Sampled, refine_share }
+            }
+            kind => kind,
+        }
     }
 
     /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena
@@ -139,7 +162,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
     /// `env` must be the environment it was built on. `None` before the first build.
     #[must_use]
     pub fn last_built<'a, 'e>(&'a self, env: &'a EnvHierarchy<'e>) -> Option<ProductSampler<'a, 'e>> {
-        let (defensive, brdf_samples) = self.built?;
+        let Built { defensive, brdf_samples, kind } = self.built?;
         Some(ProductSampler {
             env,
             nodes: &self.nodes,
@@ -147,6 +170,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             corners: &self.corners,
             defensive,
             brdf_samples,
+            kind,
         })
     }
 }

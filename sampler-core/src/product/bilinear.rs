@@ -1,5 +1,5 @@
 //! Bilinear densities on a cell: B̃ interpolated between the BRDF's values at a leaf's corners
-//! (`ProductParams::bilinear`), sampled exactly by inverting its marginal and conditional,
+//! ([`Leaves::Bilinear`](super::quadtree::Leaves::Bilinear)), sampled exactly by inverting its marginal and conditional,
 //! both linear.
 //!
 //! Corner values are in child order (see `warp::child_offset`): (0,0), (1,0), (0,1), (1,1), in

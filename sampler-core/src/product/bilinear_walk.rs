@@ -1,4 +1,4 @@
-//! Below a bilinear leaf (`ProductParams::bilinear`): the walk down the environment's levels
+//! Below a bilinear leaf (`Leaves::Bilinear`): the walk down the environment's levels
 //! that weighs each cell by L·B̃ at its centre, for the warp and, replayed by a point's bits,
 //! for its density.
 

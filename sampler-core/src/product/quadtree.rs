@@ -5,7 +5,7 @@
 //!   contiguous run of samples and its four children split that run by the next two bits.
 //! * A leaf with samples takes the mean of their B·cos (luminance) — one sample unless the depth
 //!   cap or the node capacity stopped the split (e.g. coincident samples) — or, with
-//!   `probe_leaves`, B at its centre where that is larger.
+//!   [`Leaves::Probed`], B at its centre where that is larger.
 //! * An empty leaf takes its non-empty siblings' mean shrunk by the sample counts (see
 //!   `TreeBuilder::node`): a guess from its neighbourhood instead of 0, so the product does not
 //!   starve the regions between samples of a smooth lobe, yet small where many samples chose
@@ -16,7 +16,8 @@
 //!   place leaves where B is large, the refinement where B̃·L is (a sun in a lobe's tail).
 //! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
 //!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
-//!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`).
+//!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`). What B̃ is in a leaf is
+//!   [`Leaves`]; the combinations that exist are the variants of [`ProductKind`].
 
 use crate::bilinear::{self, Corners};
 use crate::cell::Cell;
@@ -56,15 +57,89 @@ impl Node {
     }
 }
 
-/// How internal nodes combine their children.
+/// What B̃ is inside a leaf of the quadtree product.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Leaves {
+    /// The mean of the leaf's BRDF samples' values, as in the paper.
+    #[default]
+    Sampled,
+    /// The samples' mean or B at the leaf's centre, the larger. Hosts use it for product-MIS,
+    /// where it lowers the error on glossy surfaces (docs/perf.md#product-mis-preset); plain
+    /// product sampling without BRDF-sampling MIS keeps a heavy tail on car paint at grazing
+    /// views either way.
+    Probed,
+    /// Bilinear between B·cos at the leaf's corners (five evaluations per split), instead of
+    /// one sample's value: B/B̃ then varies smoothly inside a leaf and B̃ is continuous across
+    /// leaves, which the (0,2)-nets reward. Below a leaf the walk through the environment's
+    /// levels weighs each cell by L·B̃ at its centre and the final texel is sampled ∝ B̃
+    /// inside. Per sample it is far better (`examples/product_variance`), but every sample and
+    /// every density walks the environment's levels weighing cells by B̃, which costs more than
+    /// it saves where rays are cheap and one build serves a pixel
+    /// (docs/perf.md#product-mis-preset): worth it where rays cost more than those lookups.
+    /// Needs an arena with `CORNERS ≥ NODES`; an arena without builds [`Leaves::Sampled`]
+    /// leaves, and the sampler says so (`ProductSampler::kind`).
+    Bilinear,
+}
+
+/// How the tree is built and its nodes combine their children: the options that exist only
+/// together.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ProductKind {
     /// Average of the four children's products (Clarberg & Akenine-Möller 2008).
-    #[default]
-    Quadtree,
+    Quadtree {
+        /// What B̃ is inside a leaf.
+        leaves: Leaves,
+        /// Split leaves that hold more than this share of the product's mass, B probed at the
+        /// new children's centres (or B̃ bilinear there), until none does (or the depth cap or
+        /// the arena stops it): B̃ then follows B where the light concentrates the product, e.g.
+        /// a sun in the lobe's tail. 0 builds the paper's tree.
+        refine_share: f32,
+    },
     /// Product of the nonstandard Haar expansions of B̃ and L (wavelet importance sampling,
-    /// Clarberg et al. 2005). Equal to `Quadtree` in exact arithmetic: a cross-check.
-    Wavelet,
+    /// Clarberg et al. 2005). Equal to `Quadtree` in exact arithmetic: a cross-check, with
+    /// piecewise-constant leaves and the paper's tree only.
+    Wavelet {
+        /// B̃ as [`Leaves::Probed`] makes it (otherwise [`Leaves::Sampled`]).
+        probe_leaves: bool,
+    },
+}
+
+impl ProductKind {
+    /// The paper's product: the quadtree average, B̃ from the samples, no refinement.
+    pub const QUADTREE: Self = Self::Quadtree { leaves: Leaves::Sampled, refine_share: 0.0 };
+    /// The Haar wavelet product, B̃ from the samples.
+    pub const WAVELET: Self = Self::Wavelet { probe_leaves: false };
+
+    /// What B̃ is inside a leaf.
+    #[must_use]
+    pub fn leaves(&self) -> Leaves {
+        match *self {
+            Self::Quadtree { leaves, .. } => leaves,
+            Self::Wavelet { probe_leaves: true } => Leaves::Probed,
+            Self::Wavelet { probe_leaves: false } => Leaves::Sampled,
+        }
+    }
+
+    /// The share of the product's mass above which leaves are refined (0: never).
+    #[must_use]
+    pub fn refine_share(&self) -> f32 {
+        match *self {
+            Self::Quadtree { refine_share, .. } => refine_share,
+            Self::Wavelet { .. } => 0.0,
+        }
+    }
+
+    /// True for the Haar wavelet product.
+    #[must_use]
+    pub fn is_wavelet(&self) -> bool {
+        matches!(self, Self::Wavelet { .. })
+    }
+}
+
+impl Default for ProductKind {
+    fn default() -> Self {
+        Self::QUADTREE
+    }
 }
 
 /// 24-bit fixed-point coordinates of a point of the square.
@@ -114,7 +189,8 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     pub env: &'b EnvHierarchy<'e>,
     pub nodes: &'b mut Vec<Node, NODES>,
     pub max_depth: u32,
-    pub kind: ProductKind,
+    /// Internal nodes by the Haar wavelet product instead of the average.
+    pub wavelet: bool,
     pub eval: F,
     /// Also probe B at the centre of every leaf that holds samples (see `node`).
     pub probe_leaves: bool,
@@ -241,10 +317,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             }
         }
         let mean_b = 0.25 * ((b[0] + b[1]) + (b[2] + b[3]));
-        let product = match self.kind {
-            ProductKind::Quadtree => 0.25 * ((p[0] + p[1]) + (p[2] + p[3])),
-            ProductKind::Wavelet => haar_product_mean(b, l, p),
-        };
+        let product = if self.wavelet { haar_product_mean(b, l, p) } else { 0.25 * ((p[0] + p[1]) + (p[2] + p[3])) };
         set(&mut self.nodes[index], first as u32, product);
         (mean_b, product)
     }

@@ -19,7 +19,7 @@
 //! The default is ε = 0.02.
 
 use super::bilinear::Corners;
-use super::quadtree::{COORD_BITS, Node, quantize};
+use super::quadtree::{COORD_BITS, Node, ProductKind, quantize};
 use crate::cell::Cell;
 use crate::env::EnvHierarchy;
 use crate::mapping::SPHERE_AREA;
@@ -41,6 +41,8 @@ pub struct ProductSampler<'a, 'e> {
     pub(crate) corners: &'a [Corners],
     pub(crate) defensive: f32,
     pub(super) brdf_samples: usize,
+    /// The kind as built.
+    pub(super) kind: ProductKind,
 }
 
 impl<'e> ProductSampler<'_, 'e> {
@@ -62,7 +64,15 @@ impl<'e> ProductSampler<'_, 'e> {
         self.brdf_samples
     }
 
-    /// True when B̃ is bilinear in the leaves (asked for, quadtree kind, arena with corners).
+    /// What was built: the kind asked for, except that bilinear leaves asked of an arena
+    /// without corners' storage are built from the samples ([`ProductArena::buildable`]).
+    #[must_use]
+    pub fn kind(&self) -> ProductKind {
+        self.kind
+    }
+
+    /// True when B̃ is bilinear in the leaves (asked for, of an arena with corners, and a tree
+    /// was built).
     #[must_use]
     pub fn is_bilinear(&self) -> bool {
         !self.corners.is_empty()
