@@ -10,7 +10,7 @@ use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
 use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
-use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -109,26 +109,38 @@ fn ten_thousand_shading_points_allocate_nothing() {
             let [a, b] = estimator::sampled_mis(&two, &sp, u, u.as_vec2(), &mut vis);
             sink += a.value.x + b.value.x;
         }
-        // The batched paths the renderer takes.
-        let mut pairs = [[estimator::Contribution::default(); 2]; 4];
-        let brdf_points = points.map(|p| p.as_vec2());
-        estimator::sampled_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
-        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
-        sink += estimator::sampled_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        sink += estimator::sampled_mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        estimator::sampled_mis_many(&env, &sp, &points, &brdf_points, &mut vis, &mut pairs);
-        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
-        let mut singles = [estimator::Contribution::default(); 4];
-        estimator::sampled_many(&env, &sp, &points, &mut vis, &mut singles);
-        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
-        estimator::brdf_many(&env, &sp, &brdf_points, &mut vis, &mut singles);
-        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
-        let mut many = [None; 4];
-        sampler.sample_many(&points, &mut many);
-        sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();
+        sink += batched(&sampler, &env, &sp, &points, &mut vis);
     }
     ARMED.with(|a| a.set(false));
     let count = COUNT.with(|c| c.get());
     assert!(sink.is_finite());
     assert_eq!(count, 0, "the core allocated {count} times");
+}
+
+/// The batched paths the renderer takes, at one shading point: the sum of what they return.
+fn batched(
+    sampler: &ProductSampler<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, dyn Brdf + '_>,
+    points: &[DVec2; 4],
+    vis: &mut impl FnMut(Vec3) -> bool,
+) -> f64 {
+    let mut sink = 0.0;
+    let mut pairs = [[estimator::Contribution::default(); 2]; 4];
+    let brdf_points = points.map(|p| p.as_vec2());
+    estimator::sampled_mis_many(sampler, sp, points, &brdf_points, vis, &mut pairs);
+    sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+    sink += estimator::sampled_mis_split(sampler, sp, &points[..3], &brdf_points[..1], (0.75, 0.25), vis).x;
+    sink += estimator::sampled_mis_split(env, sp, &points[..3], &brdf_points[..1], (0.75, 0.25), vis).x;
+    estimator::sampled_mis_many(env, sp, points, &brdf_points, vis, &mut pairs);
+    sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+    let mut singles = [estimator::Contribution::default(); 4];
+    estimator::sampled_many(env, sp, points, vis, &mut singles);
+    sink += singles.iter().map(|c| c.value.x).sum::<f64>();
+    estimator::brdf_many(env, sp, &brdf_points, vis, &mut singles);
+    sink += singles.iter().map(|c| c.value.x).sum::<f64>();
+    let mut many = [None; 4];
+    sampler.sample_many(points, &mut many);
+    sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();
+    sink
 }
