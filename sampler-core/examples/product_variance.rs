@@ -15,15 +15,7 @@ use sampler_core::sampler::{ProductArena, ProductParams};
 
 fn main() {
     let level = 9;
-    let m = 1usize << level;
-    let mut rgb = vec![[0.0f32; 3]; m * m];
-    for y in 0..m {
-        for x in 0..m {
-            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / m as f32, (y as f32 + 0.5) / m as f32));
-            let sky = 0.2 + d.z.max(0.0) + 0.3 * (5.0 * d.x).sin().abs();
-            rgb[y * m + x] = [sky, sky, sky];
-        }
-    }
+    let rgb = sky(level);
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
@@ -98,4 +90,18 @@ fn main() {
             );
         }
     }
+}
+
+/// A smooth grey sky on a `2^level` equal-area map: brighter towards +z, banded along x.
+fn sky(level: u32) -> Vec<[f32; 3]> {
+    let m = 1usize << level;
+    let mut rgb = vec![[0.0f32; 3]; m * m];
+    for y in 0..m {
+        for x in 0..m {
+            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / m as f32, (y as f32 + 0.5) / m as f32));
+            let sky = 0.2 + d.z.max(0.0) + 0.3 * (5.0 * d.x).sin().abs();
+            rgb[y * m + x] = [sky, sky, sky];
+        }
+    }
+    rgb
 }
