@@ -3,16 +3,17 @@
 
 use crate::error::UsdError;
 use crate::inherit::Hidden;
-use crate::material::Material;
-use crate::mesh::{self, LocalMesh};
-use crate::scene::{Counts, Mesh, Skip, Sphere, UpAxis, UsdScene};
+use crate::scene::{Counts, Skip, UpAxis, UsdScene};
 use crate::stage::{Stage, Value};
-use crate::xform::{WorldTransforms, uniform_scale, up_axis_conversion};
-use crate::{camera, dome, instancer, render_settings, shapes};
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use crate::xform::{WorldTransforms, up_axis_conversion};
+use crate::{camera, dome, instancer, render_settings};
+use glam::DMat4;
 use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
+
+mod gprim;
+mod material_binding;
 
 /// Import options.
 #[derive(Clone, Debug, Default)]
@@ -258,200 +259,4 @@ impl Importer<'_> {
         self.scene.counts.instances += instances.len();
         Ok(())
     }
-
-    /// One gprim with its local-to-renderer transform `m`.
-    fn gprim(&mut self, prim: &str, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
-        let stage = self.stage;
-        let double_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
-        let material = self.material_for(prim)?;
-        self.scene.counts.gprims += 1;
-        if type_name == "Sphere"
-            && let Some(s) = uniform_scale(m)
-        {
-            let r = shapes::number(stage, prim, "radius", 1.0)? * s;
-            let center = m.transform_point3(DVec3::ZERO);
-            if !(r.is_finite() && center.is_finite()) {
-                return Err("the sphere's transform or radius is not finite".into());
-            }
-            let (c, r) = (center.as_vec3(), r as f32);
-            self.grow(c - Vec3::splat(r));
-            self.grow(c + Vec3::splat(r));
-            let path = label.to_string();
-            self.scene.spheres.push(Sphere { path, center: c, radius: r, material, double_sided });
-            return Ok(());
-        }
-        // Per-face materials from GeomSubsets of the materialBind family.
-        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
-        let local = if type_name == "Mesh" {
-            self.scene.counts.meshes += 1;
-            // Texture coordinates only for a mesh whose materials read textures.
-            let uv = std::iter::once(material)
-                .chain(face_materials.iter().map(|f| f.1))
-                .find_map(|m| self.scene.materials[m].textures.first().map(|t| t.source.varname.clone()));
-            mesh::read(stage, prim, uv.as_deref())?
-        } else {
-            shapes::tessellate(stage, prim, type_name)?.unwrap_or_default()
-        };
-        let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
-        for (i, &face) in local.faces.iter().enumerate() {
-            let mat = face_materials.iter().find(|(faces, _)| faces.contains(&(face as i64))).map_or(material, |f| f.1);
-            groups.entry(mat).or_default().push(i);
-        }
-        let mut keys: Vec<usize> = groups.keys().copied().collect();
-        keys.sort_unstable();
-        let m3 = DMat3::from_mat4(*m);
-        let det = m3.determinant();
-        if !(det.is_finite() && det != 0.0) {
-            self.skip(label, "its world transform is singular (the gprim has no area)");
-            return Ok(());
-        }
-        let normal_matrix = m3.inverse().transpose();
-        for mat in keys {
-            let mesh = transform(&local, &groups[&mat], m, &normal_matrix, det < 0.0, label, mat, double_sided)?;
-            self.scene.counts.triangles += mesh.triangles.len();
-            for &p in &mesh.positions {
-                self.grow(p);
-            }
-            self.scene.meshes.push(mesh);
-        }
-        Ok(())
-    }
-
-    fn grow(&mut self, p: Vec3) {
-        let b = self.scene.bounds.get_or_insert((p, p));
-        *b = (b.0.min(p), b.1.max(p));
-    }
-
-    /// (faces, material) of the mesh's `materialBind` GeomSubsets that bind a material.
-    fn subset_materials(&mut self, prim: &str) -> Result<Vec<(std::collections::HashSet<i64>, usize)>, String> {
-        let mut out = Vec::new();
-        for child in self.stage.children(prim)? {
-            if self.stage.type_name(&child)? != "GeomSubset" {
-                continue;
-            }
-            let family = self.stage.value(&child, "familyName")?;
-            if family.as_ref().and_then(Value::token) != Some("materialBind") {
-                continue;
-            }
-            if self.stage.bound_material(&child)?.is_none() {
-                continue;
-            }
-            let faces = match self.stage.value(&child, "indices")? {
-                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
-                _ => Default::default(),
-            };
-            let mat = self.material_for(&child)?;
-            out.push((faces, mat));
-        }
-        Ok(out)
-    }
-
-    /// The index of the material bound to `prim` (imported on first use), or of a fallback.
-    fn material_for(&mut self, prim: &str) -> Result<usize, String> {
-        let bound = self.stage.bound_material(prim)?;
-        // Unbound gprims show their displayColor (its mean over the elements), as viewers do.
-        let display = match &bound {
-            Some(_) => None,
-            None => crate::primvar::Primvar::read(self.stage, prim, "displayColor", None)?
-                .filter(|p| p.width == 3 && !p.is_empty())
-                .map(|p| {
-                    let n = p.len();
-                    let sum = (0..n)
-                        .filter_map(|i| p.element(i))
-                        .fold([0.0; 3], |a, e| [a[0] + e[0], a[1] + e[1], a[2] + e[2]]);
-                    Vec3::new((sum[0] / n as f64) as f32, (sum[1] / n as f64) as f32, (sum[2] / n as f64) as f32)
-                }),
-        };
-        let key = match (&bound, display) {
-            (Some(m), _) => m.clone(),
-            (None, Some(c)) => format!("<displayColor {} {} {}>", c.x, c.y, c.z),
-            (None, None) => "<fallback>".to_string(),
-        };
-        if let Some(&i) = self.materials.get(&key) {
-            return Ok(i);
-        }
-        let material = match &bound {
-            None => {
-                let mut m = Material::fallback(&key);
-                if let Some(c) = display {
-                    m.diffuse_color = c;
-                }
-                m
-            }
-            Some(path) => match self.stage.surface_shader(path)? {
-                Some((shader, id)) if id == "UsdPreviewSurface" => {
-                    let (m, notes) = Material::read(self.stage, path, &shader)?;
-                    notes.into_iter().for_each(|n| self.skip(path, n));
-                    m
-                }
-                Some((shader, id)) => {
-                    self.skip(path, format!("surface shader {shader} ({id}) is not a UsdPreviewSurface (MaterialX?); fallback material used"));
-                    Material::fallback(path)
-                }
-                None => {
-                    self.skip(path, "no surface shader; fallback material used");
-                    Material::fallback(path)
-                }
-            },
-        };
-        self.scene.materials.push(material);
-        let i = self.scene.materials.len() - 1;
-        self.materials.insert(key, i);
-        Ok(i)
-    }
-}
-
-/// The triangles `which` of a local mesh, transformed by `m` (non-singular; normals by
-/// `normal_matrix`, its inverse transpose; winding reversed when it `mirror`s).
-#[allow(clippy::too_many_arguments)]
-fn transform(
-    local: &LocalMesh,
-    which: &[usize],
-    m: &DMat4,
-    normal_matrix: &DMat3,
-    mirror: bool,
-    label: &str,
-    material: usize,
-    double_sided: bool,
-) -> Result<Mesh, String> {
-    let mut remap: HashMap<u32, u32> = HashMap::new();
-    let mut positions = Vec::new();
-    let mut triangles = Vec::with_capacity(which.len());
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    for &i in which {
-        let mut t = local.triangles[i];
-        let mut n = local.normals.get(i).copied();
-        let mut uv = local.uvs.get(i).copied();
-        if mirror {
-            t.swap(1, 2);
-            if let Some(n) = n.as_mut() {
-                n.swap(1, 2);
-            }
-            if let Some(uv) = uv.as_mut() {
-                uv.swap(1, 2);
-            }
-        }
-        uvs.extend(uv);
-        let t = t.map(|v| {
-            *remap.entry(v).or_insert_with(|| {
-                positions.push(m.transform_point3(local.positions[v as usize]).as_vec3());
-                (positions.len() - 1) as u32
-            })
-        });
-        triangles.push(t);
-        if let Some(n) = n {
-            normals.push(n.map(|n| (*normal_matrix * n).normalize_or_zero().as_vec3()));
-        }
-    }
-    if normals.len() != triangles.len() {
-        normals.clear();
-    }
-    if uvs.len() != triangles.len() {
-        uvs.clear();
-    }
-    if positions.iter().any(|p: &Vec3| !p.is_finite()) {
-        return Err("a transformed point is not finite".into());
-    }
-    Ok(Mesh { path: label.to_string(), positions, triangles, normals, uvs, material, double_sided })
 }

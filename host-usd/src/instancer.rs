@@ -8,8 +8,11 @@ use glam::{DMat4, DQuat, DVec3};
 /// One instance: which prototype, and its transform relative to the instancer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Instance {
+    /// The instance's index among the instancer's `protoIndices`.
     pub index: usize,
+    /// Which of the instancer's `prototypes` it instantiates.
     pub prototype: usize,
+    /// Its transform relative to the instancer (scale · orient · translate).
     pub transform: DMat4,
 }
 

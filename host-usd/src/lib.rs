@@ -2,6 +2,8 @@
 //! crate (pinned to 0.6.0). `stage/` is the only module that touches openusd; the rest
 //! works on its plain values and yields a [`UsdScene`] of plain data.
 
+#![warn(missing_docs)]
+
 pub mod camera;
 pub mod conformance;
 pub mod dome;

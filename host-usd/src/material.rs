@@ -11,13 +11,21 @@ use glam::Vec3;
 pub struct Material {
     /// The Material prim, or `<fallback>` for gprims with no usable binding.
     pub name: String,
+    /// `inputs:diffuseColor`.
     pub diffuse_color: Vec3,
+    /// `inputs:specularColor` (used in the specular workflow).
     pub specular_color: Vec3,
+    /// `inputs:metallic` (used in the metallic workflow).
     pub metallic: f32,
+    /// `inputs:roughness`.
     pub roughness: f32,
+    /// `inputs:clearcoat`: the coat lobe's weight.
     pub clearcoat: f32,
+    /// `inputs:clearcoatRoughness`.
     pub clearcoat_roughness: f32,
+    /// `inputs:ior`: the dielectric specular's index of refraction.
     pub ior: f32,
+    /// `inputs:useSpecularWorkflow`: specularColor instead of metallic.
     pub specular_workflow: bool,
     /// Inputs driven by textures; the host decodes them and writes the inputs back.
     pub textures: Vec<Texture>,
@@ -26,9 +34,13 @@ pub struct Material {
 /// Which input a texture drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TextureInput {
+    /// `inputs:diffuseColor`.
     DiffuseColor,
+    /// `inputs:specularColor`.
     SpecularColor,
+    /// `inputs:metallic`.
     Metallic,
+    /// `inputs:roughness`.
     Roughness,
 }
 
@@ -36,18 +48,24 @@ pub enum TextureInput {
 /// why they could not be read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
+    /// The input it drives.
     pub input: TextureInput,
+    /// The UsdUVTexture as authored.
     pub source: TextureRef,
+    /// The image file's bytes, or why they could not be read.
     pub bytes: Result<Vec<u8>, String>,
 }
 
 /// The lobes the renderer builds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobes {
+    /// The diffuse lobe's albedo.
     pub diffuse: Vec3,
+    /// The specular lobe's reflectance at normal incidence.
     pub specular: Vec3,
     /// The specular lobe's GGX α: roughness², to be used as is (not squared again).
     pub alpha: f32,
+    /// The coat lobe's weight.
     pub clearcoat: f32,
     /// The coat's GGX α: clearcoatRoughness².
     pub clearcoat_alpha: f32,

@@ -11,6 +11,7 @@ use glam::{DVec3, Vec2};
 /// A mesh in its prim's local space.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LocalMesh {
+    /// Points in the prim's local space.
     pub positions: Vec<DVec3>,
     /// Counter-clockwise triangles (left-handed faces already reversed).
     pub triangles: Vec<[u32; 3]>,
@@ -20,6 +21,7 @@ pub struct LocalMesh {
     pub normals: Vec<[DVec3; 3]>,
     /// Per-triangle corner texture coordinates, or empty.
     pub uvs: Vec<[Vec2; 3]>,
+    /// True unless `subdivisionScheme` is `none` (rendered as its control cage, smooth normals).
     pub subdivision: bool,
 }
 

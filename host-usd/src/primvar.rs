@@ -6,14 +6,20 @@ use crate::stage::{Stage, Value};
 /// How a primvar's elements map onto a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Interpolation {
+    /// One value for the whole prim.
     Constant,
+    /// One value per face.
     Uniform,
+    /// One value per point, interpolated over the faces.
     Vertex,
+    /// One value per point, linearly interpolated.
     Varying,
+    /// One value per face-vertex (corner).
     FaceVarying,
 }
 
 impl Interpolation {
+    /// The interpolation named by a USD token (`faceVarying`, …), if it is one.
     pub fn from_token(t: &str) -> Option<Self> {
         Some(match t {
             "constant" => Self::Constant,
@@ -29,10 +35,13 @@ impl Interpolation {
 /// A primvar read from a prim.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Primvar {
+    /// The elements' components, flattened.
     pub values: Vec<f64>,
     /// Components per element (3 for normals).
     pub width: usize,
+    /// The `:indices` into the elements, when authored.
     pub indices: Option<Vec<i64>>,
+    /// How the elements map onto the mesh.
     pub interpolation: Interpolation,
 }
 
@@ -80,6 +89,7 @@ impl Primvar {
         }
     }
 
+    /// True when the primvar has no elements.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

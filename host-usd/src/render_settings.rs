@@ -15,7 +15,9 @@ pub enum Conform {
     ExpandAperture,
     /// Shrink the aperture in the direction that is too long.
     CropAperture,
+    /// Change the horizontal aperture to fit the image's aspect.
     AdjustApertureWidth,
+    /// Change the vertical aperture to fit the image's aspect.
     AdjustApertureHeight,
     /// Keep both apertures and change the pixel aspect ratio instead.
     AdjustPixelAspectRatio,
@@ -60,6 +62,7 @@ pub struct RenderSettings {
     pub resolution: (u32, u32),
     /// Pixel width over pixel height.
     pub pixel_aspect: f32,
+    /// How the camera's aperture is fitted to the image's aspect.
     pub conform: Conform,
     /// The camera to render through, when the settings name one.
     pub camera: Option<String>,

@@ -10,7 +10,9 @@ use std::path::PathBuf;
 /// (geometry, camera and lights alike): (x, y, z) → (x, z, −y).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum UpAxis {
+    /// Y up: the renderer's own frame.
     Y,
+    /// Z up: rotated into Y up on import.
     Z,
 }
 
@@ -20,6 +22,7 @@ pub struct Mesh {
     /// The prim it came from (an instance proxy or a PointInstancer instance is named by
     /// its prim path, with `[i]` for the instance).
     pub path: String,
+    /// Points in world space.
     pub positions: Vec<Vec3>,
     /// Counter-clockwise front faces (USD's `orientation` and negative-determinant
     /// transforms already applied).
@@ -29,23 +32,31 @@ pub struct Mesh {
     /// Per-triangle corner texture coordinates (read only when a material on the mesh is
     /// textured), or empty.
     pub uvs: Vec<[Vec2; 3]>,
+    /// Index into [`UsdScene::materials`].
     pub material: usize,
+    /// `doubleSided`: back faces shade like front faces.
     pub double_sided: bool,
 }
 
 /// An exact sphere (a UsdGeomSphere under a similarity transform).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sphere {
+    /// The Sphere prim (or instance) it came from.
     pub path: String,
+    /// Centre in world space.
     pub center: Vec3,
+    /// Radius in world units.
     pub radius: f32,
+    /// Index into [`UsdScene::materials`].
     pub material: usize,
+    /// `doubleSided`: back faces shade like front faces.
     pub double_sided: bool,
 }
 
 /// The DomeLight: radiance = texture · color · intensity · 2^exposure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dome {
+    /// The DomeLight prim.
     pub path: String,
     /// A lat-long image (name for messages, and its bytes); `None` for a constant dome.
     pub texture: Option<(String, Vec<u8>)>,
@@ -60,13 +71,21 @@ pub struct Dome {
 /// The camera in world space; field of view from focal length and apertures.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
+    /// The Camera prim.
     pub path: String,
+    /// Position in world space.
     pub origin: Vec3,
+    /// Viewing direction (unit).
     pub forward: Vec3,
+    /// Up direction (unit, orthogonal to `forward`).
     pub up: Vec3,
+    /// `focalLength`, in the apertures' units.
     pub focal_length: f32,
+    /// `horizontalAperture`.
     pub horizontal_aperture: f32,
+    /// `verticalAperture`.
     pub vertical_aperture: f32,
+    /// Near clipping distance (`clippingRange`'s first value), in world units.
     pub near: f32,
 }
 
@@ -94,39 +113,58 @@ impl Camera {
 /// A prim or feature the importer did not render, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Skip {
+    /// The prim (or property) left out.
     pub path: String,
+    /// What was left out and why, one line.
     pub what: String,
 }
 
 /// Counts for `ppis info` and the import summary.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Counts {
+    /// Prims traversed (prototypes' included).
     pub prims: usize,
+    /// Mesh prims rendered.
     pub meshes: usize,
+    /// Gprims of every kind rendered.
     pub gprims: usize,
+    /// Triangles of every mesh.
     pub triangles: usize,
     /// Instance proxies and PointInstancer instances that were rendered.
     pub instances: usize,
+    /// Gprims and instancers not rendered: invisible, or of a purpose not rendered.
     pub hidden: usize,
 }
 
 /// An imported scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UsdScene {
+    /// The file imported.
     pub file: PathBuf,
+    /// The stage's `upAxis`.
     pub up_axis: UpAxis,
+    /// The stage's `metersPerUnit`.
     pub meters_per_unit: f64,
+    /// The time code values are read at (the stage's start).
     pub time_code: f64,
+    /// Triangle meshes in world space.
     pub meshes: Vec<Mesh>,
+    /// Exact spheres.
     pub spheres: Vec<Sphere>,
+    /// Every material a mesh or sphere refers to.
     pub materials: Vec<Material>,
+    /// The DomeLight, if the stage has one.
     pub dome: Option<Dome>,
+    /// The camera to render through, if the stage has one.
     pub camera: Option<Camera>,
     /// The UsdRenderSettings that apply (`render_settings`), if the stage has any.
     pub render_settings: Option<crate::render_settings::RenderSettings>,
     /// World bounds of the geometry (min, max), Y up.
     pub bounds: Option<(Vec3, Vec3)>,
+    /// Everything left out, with why.
     pub skipped: Vec<Skip>,
+    /// What was imported, counted.
     pub counts: Counts,
+    /// Wall time of the import.
     pub import_seconds: f64,
 }

@@ -7,6 +7,7 @@ use crate::stage::Stage;
 use glam::{DMat3, DMat4, DVec3};
 use std::collections::HashMap;
 
+/// Each prim's world transform, memoised by path.
 #[derive(Default)]
 pub struct WorldTransforms {
     cache: HashMap<String, DMat4>,

@@ -115,7 +115,8 @@ typedef struct {
   uint32_t kind;
   // Non-zero: B probed at the centre of each leaf holding samples.
   int32_t probe_leaves;
-  // Leaves holding more than this share of the product's mass are split (0: never).
+  // Leaves holding more than this share of the product's mass are split (0: never; the
+  // wavelet product is never refined: with `kind` 1 it must be 0).
   float refine_share;
 } ppis_product_params;
 

@@ -7,7 +7,7 @@ use crate::{
 use core::ffi::c_void;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::glam::{DVec2, Vec3};
-use sampler_core::quadtree::ProductKind;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::sampler::{ProductArena, ProductError, ProductParams, ProductSampler};
 
 /// BRDF samples a `ppis_product` holds (the paper's K).
@@ -27,7 +27,8 @@ pub struct ppis_product_params {
     pub kind: u32,
     /// Non-zero: B probed at the centre of each leaf holding samples.
     pub probe_leaves: i32,
-    /// Leaves holding more than this share of the product's mass are split (0: never).
+    /// Leaves holding more than this share of the product's mass are split (0: never; the
+    /// wavelet product is never refined: with `kind` 1 it must be 0).
     pub refine_share: f32,
 }
 
@@ -37,9 +38,9 @@ impl From<ProductParams> for ppis_product_params {
             brdf_samples: p.brdf_samples as u32,
             max_depth: p.max_depth,
             defensive: p.defensive,
-            kind: u32::from(p.kind == ProductKind::Wavelet),
-            probe_leaves: i32::from(p.probe_leaves),
-            refine_share: p.refine_share,
+            kind: u32::from(p.kind.is_wavelet()),
+            probe_leaves: i32::from(p.kind.leaves() == Leaves::Probed),
+            refine_share: p.kind.refine_share(),
         }
     }
 }
@@ -52,18 +53,18 @@ impl TryFrom<&ppis_product_params> for ProductParams {
             return Err(ppis_status::PPIS_ABOVE_CAPACITY);
         }
         let unit = |v: f32| (0.0..=1.0).contains(&v);
-        if p.max_depth > 24 || !unit(p.defensive) || !unit(p.refine_share) || p.kind > 1 {
+        let refined_wavelet = p.kind == 1 && p.refine_share != 0.0;
+        if p.max_depth > 24 || !unit(p.defensive) || !unit(p.refine_share) || p.kind > 1 || refined_wavelet {
             return Err(ppis_status::PPIS_BAD_VALUE);
         }
-        Ok(Self {
-            brdf_samples: p.brdf_samples as usize,
-            max_depth: p.max_depth,
-            defensive: p.defensive,
-            kind: if p.kind == 1 { ProductKind::Wavelet } else { ProductKind::Quadtree },
-            probe_leaves: p.probe_leaves != 0,
-            refine_share: p.refine_share,
-            bilinear: false,
-        })
+        let probe_leaves = p.probe_leaves != 0;
+        let kind = if p.kind == 1 {
+            ProductKind::Wavelet { probe_leaves }
+        } else {
+            let leaves = if probe_leaves { Leaves::Probed } else { Leaves::Sampled };
+            ProductKind::Quadtree { leaves, refine_share: p.refine_share }
+        };
+        Ok(Self { brdf_samples: p.brdf_samples as usize, max_depth: p.max_depth, defensive: p.defensive, kind })
     }
 }
 

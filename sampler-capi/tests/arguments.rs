@@ -111,6 +111,10 @@ fn bad_arguments_are_error_codes() {
         params.brdf_samples = 64;
         params.defensive = 2.0;
         assert_eq!(ppis_product_build(product, m.env, brdf, &frame, wo, &params, 1), PPIS_BAD_VALUE);
+        // The wavelet product is never refined: asking for both is an error, not a silent drop.
+        let mut refined_wavelet = ppis_product_params_for_mis(64);
+        refined_wavelet.kind = 1;
+        assert_eq!(ppis_product_build(product, m.env, brdf, &frame, wo, &refined_wavelet, 1), PPIS_BAD_VALUE);
         assert_eq!(ppis_product_build(product, null(), brdf, &frame, wo, null(), 1), PPIS_NULL_POINTER);
         assert_eq!(ppis_product_build(product, m.env, brdf, &frame, wo, null(), 1), PPIS_OK);
         assert_eq!(ppis_product_sample(product, 0.5, 0.5, &mut s), PPIS_OK);

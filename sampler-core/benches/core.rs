@@ -113,8 +113,8 @@ fn shading_points(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("shading point {res}x{res}"));
         for (name, brdf) in &brdfs {
             for warps in [1usize, 4, 16] {
-                for kind in [ProductKind::Quadtree, ProductKind::Wavelet] {
-                    if kind == ProductKind::Wavelet && (warps != 16 || level != 12) {
+                for kind in [ProductKind::QUADTREE, ProductKind::WAVELET] {
+                    if kind.is_wavelet() && (warps != 16 || level != 12) {
                         continue;
                     }
                     let params = ProductParams { kind, ..ProductParams::default() };

@@ -10,6 +10,7 @@ use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::sampler::{ProductArena, ProductParams};
 fn main() {
     let level = 9;
@@ -38,9 +39,9 @@ fn main() {
     let (n, reps) = (64, 400);
     for (name, params) in [
         ("for_mis", ProductParams::for_mis(256)),
-        ("for_mis noprobe", ProductParams { probe_leaves: false, ..ProductParams::for_mis(256) }),
-        ("for_mis norefine", ProductParams { refine_share: 0.0, ..ProductParams::for_mis(256) }),
-        ("for_mis bilinear", ProductParams { bilinear: true, ..ProductParams::for_mis(256) }),
+        ("for_mis noprobe", for_mis_with(Leaves::Sampled, 1.0 / 256.0)),
+        ("for_mis norefine", for_mis_with(Leaves::Probed, 0.0)),
+        ("for_mis bilinear", for_mis_with(Leaves::Bilinear, 1.0 / 256.0)),
     ] {
         report(name, reps, n, |r, a, b, out| {
             let s = arena.build(&env, &brdf, &frame, wo, &params, r).unwrap();
@@ -87,4 +88,9 @@ fn report(name: &str, reps: u64, n: usize, mut estimate: impl FnMut(u64, &[DVec2
         (s2 / c - mean * mean) / (mean * mean),
         (t2 / reps as f64 - mn * mn) / (mn * mn)
     );
+}
+
+/// `ProductParams::for_mis(256)` with other leaves or refinement.
+fn for_mis_with(leaves: Leaves, refine_share: f32) -> ProductParams {
+    ProductParams { kind: ProductKind::Quadtree { leaves, refine_share }, ..ProductParams::for_mis(256) }
 }

@@ -10,19 +10,12 @@ use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::sampler::{ProductArena, ProductParams};
 
 fn main() {
     let level = 9;
-    let m = 1usize << level;
-    let mut rgb = vec![[0.0f32; 3]; m * m];
-    for y in 0..m {
-        for x in 0..m {
-            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / m as f32, (y as f32 + 0.5) / m as f32));
-            let sky = 0.2 + d.z.max(0.0) + 0.3 * (5.0 * d.x).sin().abs();
-            rgb[y * m + x] = [sky, sky, sky];
-        }
-    }
+    let rgb = sky(level);
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
@@ -36,13 +29,13 @@ fn main() {
         let wo = frame.to_world(Vec3::new(-0.3, -0.4, 0.87).normalize());
         let sp = ShadingPoint { frame, wo, brdf: &brdf };
         for probe in [false, true] {
-            let params = ProductParams {
-                defensive: eps,
-                probe_leaves: probe,
-                refine_share: refine,
-                bilinear,
-                ..ProductParams::default()
+            let leaves = match (bilinear, probe) {
+                (true, _) => Leaves::Bilinear,
+                (false, true) => Leaves::Probed,
+                (false, false) => Leaves::Sampled,
             };
+            let kind = ProductKind::Quadtree { leaves, refine_share: refine };
+            let params = ProductParams { defensive: eps, kind, ..ProductParams::default() };
             // Relative variance per sample (over builds) and of 64-point net means (×64: 1 = no gain).
             let mut stats = [[0.0f64; 3]; 4];
             let mut net = [[0.0f64; 3]; 4];
@@ -97,4 +90,18 @@ fn main() {
             );
         }
     }
+}
+
+/// A smooth grey sky on a `2^level` equal-area map: brighter towards +z, banded along x.
+fn sky(level: u32) -> Vec<[f32; 3]> {
+    let m = 1usize << level;
+    let mut rgb = vec![[0.0f32; 3]; m * m];
+    for y in 0..m {
+        for x in 0..m {
+            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / m as f32, (y as f32 + 0.5) / m as f32));
+            let sky = 0.2 + d.z.max(0.0) + 0.3 * (5.0 * d.x).sin().abs();
+            rgb[y * m + x] = [sky, sky, sky];
+        }
+    }
+    rgb
 }

@@ -17,12 +17,7 @@ fn main() {
     let iters: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(50_000);
     let params =
         if args.get(3).is_some_and(|a| a == "mis") { ProductParams::for_mis(256) } else { ProductParams::default() };
-    let brdf: Box<dyn Brdf> = match which {
-        "lambert" => Box::new(Lambert::new(Vec3::splat(0.5))),
-        "phong" => Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),
-        "carpaint" => Box::new(CarPaint::default()),
-        _ => Box::new(RoughConductor::new(0.1, Vec3::ONE)),
-    };
+    let brdf = brdf_named(which);
     let level = 10;
     let n = 1usize << level;
     let mut rgb = vec![[0.5f32; 3]; n * n];
@@ -93,4 +88,14 @@ fn main() {
         dt / iters as f64 * 1e6,
         nodes as f64 / iters as f64
     );
+}
+
+/// The BRDF the first argument names (GGX α = 0.1 by default).
+fn brdf_named(which: &str) -> Box<dyn Brdf> {
+    match which {
+        "lambert" => Box::new(Lambert::new(Vec3::splat(0.5))),
+        "phong" => Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),
+        "carpaint" => Box::new(CarPaint::default()),
+        _ => Box::new(RoughConductor::new(0.1, Vec3::ONE)),
+    }
 }

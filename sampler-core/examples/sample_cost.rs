@@ -10,6 +10,7 @@ use sampler_core::estimator::{Contribution, ShadingPoint, sampled_mis, sampled_m
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
 use sampler_core::sampler::{ProductArena, ProductParams};
 use std::time::Instant;
@@ -18,38 +19,15 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let alpha: f32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(0.05);
     let level: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(10);
-    let n = 1usize << level;
-    let sun = Vec3::new(0.4, 0.5, 0.75).normalize();
-    let mut rgb = vec![[0.0f32; 3]; n * n];
-    for y in 0..n {
-        for x in 0..n {
-            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
-            let sky = 0.3 + 0.7 * d.z.max(0.0) + 0.2 * (13.0 * d.x).sin() * (7.0 * d.y).cos();
-            let s = if d.dot(sun) > 0.9998 { 1e4 } else { 0.0 };
-            rgb[y * n + x] = [0.4 * sky + s, 0.6 * sky + s, sky + s];
-        }
-    }
+    let rgb = sky_with_sun(level);
     let mut pyramid = vec![0.0; pyramid_len(level)];
     build_pyramid(level, &rgb, &mut pyramid).unwrap();
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
     let brdf = RoughConductor::new(alpha, Vec3::ONE);
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
-    let mut rng = Pcg32::new(3, 3);
-    let points: Vec<(Frame, Vec3)> = (0..64)
-        .map(|_| {
-            let nrm = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
-            let f = Frame::from_normal(nrm);
-            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
-        })
-        .collect();
+    let points = shading_points(64);
     let pairs = 512;
-    let mut params = ProductParams::for_mis(256);
-    match std::env::var("PARAMS").as_deref() {
-        Ok("default") => params = ProductParams::default(),
-        Ok("noprobe") => params.probe_leaves = false,
-        Ok("norefine") => params.refine_share = 0.0,
-        _ => {}
-    }
+    let params = params_from_env();
     let mut us = vec![DVec2::ZERO; pairs];
     let mut vs = vec![DVec2::ZERO; pairs];
     let mut brdf_points = vec![Vec2::ZERO; pairs];
@@ -123,4 +101,44 @@ fn main() {
             acc.x
         );
     }
+}
+
+/// A blue sky with structure and a small sun of radiance 1e4, on a `2^level` equal-area map.
+fn sky_with_sun(level: u32) -> Vec<[f32; 3]> {
+    let n = 1usize << level;
+    let sun = Vec3::new(0.4, 0.5, 0.75).normalize();
+    let mut rgb = vec![[0.0f32; 3]; n * n];
+    for y in 0..n {
+        for x in 0..n {
+            let d = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
+            let sky = 0.3 + 0.7 * d.z.max(0.0) + 0.2 * (13.0 * d.x).sin() * (7.0 * d.y).cos();
+            let s = if d.dot(sun) > 0.9998 { 1e4 } else { 0.0 };
+            rgb[y * n + x] = [0.4 * sky + s, 0.6 * sky + s, sky + s];
+        }
+    }
+    rgb
+}
+
+/// The settings `PARAMS` names: `default`, `noprobe`, `norefine`, or `ProductParams::for_mis`.
+fn params_from_env() -> ProductParams {
+    let mut params = ProductParams::for_mis(256);
+    match std::env::var("PARAMS").as_deref() {
+        Ok("default") => params = ProductParams::default(),
+        Ok("noprobe") => params.kind = ProductKind::Quadtree { leaves: Leaves::Sampled, refine_share: 1.0 / 256.0 },
+        Ok("norefine") => params.kind = ProductKind::Quadtree { leaves: Leaves::Probed, refine_share: 0.0 },
+        _ => {}
+    }
+    params
+}
+
+/// `n` shading points: normals from the middle band of the square, views within ~35° of them.
+fn shading_points(n: usize) -> Vec<(Frame, Vec3)> {
+    let mut rng = Pcg32::new(3, 3);
+    (0..n)
+        .map(|_| {
+            let nrm = square_to_sphere(Vec2::new(rng.next_f32(), 0.5 * rng.next_f32() + 0.25));
+            let f = Frame::from_normal(nrm);
+            (f, f.to_world(Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize()))
+        })
+        .collect()
 }

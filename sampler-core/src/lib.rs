@@ -42,24 +42,23 @@
 #[cfg(test)]
 extern crate std;
 
-pub mod bilinear;
+// The source groups what belongs together (`sphere/`, `env/`, `product/`, `baselines/`,
+// `estimator/`, `brdf/`); the public modules keep one flat path each.
+mod baselines;
+mod product;
+mod sphere;
+
 pub mod brdf;
-pub mod cone;
 pub mod direction;
 pub mod env;
 pub mod estimator;
 pub mod frame;
-mod lanes;
-pub mod latlong;
-pub mod mapping;
 pub mod points;
-pub mod quadtree;
 pub mod rng;
-pub mod sampler;
 pub mod sampling;
-pub mod two_level;
-pub mod two_stage;
-pub mod warp;
-pub mod wavelet;
+
+pub use baselines::{two_level, two_stage};
+pub use product::{bilinear, quadtree, sampler, wavelet};
+pub use sphere::{cell, cone, latlong, mapping, warp};
 
 pub use glam;

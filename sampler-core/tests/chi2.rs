@@ -9,7 +9,7 @@ use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::SPHERE_AREA;
-use sampler_core::quadtree::ProductKind;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
 
 const SAMPLES: usize = 100_000;
@@ -132,7 +132,8 @@ fn product_cases(params: ProductParams) -> Vec<String> {
                 let frame = Frame::from_normal(normal);
                 let wo = frame.to_world(wo_local);
                 let sampler = arena.build(&e, brdf.as_ref(), &frame, wo, &params, seed as u64).unwrap();
-                assert_eq!(sampler.is_bilinear(), params.bilinear && sampler.node_count() > 0);
+                let bilinear = params.kind.leaves() == Leaves::Bilinear;
+                assert_eq!(sampler.is_bilinear(), bilinear && sampler.node_count() > 0);
                 let r = chi_square_dyadic(
                     SAMPLES,
                     11 + seed as u64,
@@ -144,7 +145,7 @@ fn product_cases(params: ProductParams) -> Vec<String> {
                 // The pdf returned with each sample equals pdf(ω) (up to the rare direction
                 // whose round trip through the mapping crosses a texel edge).
                 let mut mismatch = 0;
-                let tolerance = if params.bilinear { 1e-2 } else { 1e-4 };
+                let tolerance = if bilinear { 1e-2 } else { 1e-4 };
                 let mut rng = sampler_core::rng::Pcg32::new(9, seed as u64);
                 for _ in 0..10_000 {
                     let s = sampler.sample(DVec2::new(rng.next_f64(), rng.next_f64())).unwrap();
@@ -202,7 +203,7 @@ fn quadtree_product_sampler_matches_its_pdf() {
 
 #[test]
 fn quadtree_product_sampler_with_probed_leaves_matches_its_pdf() {
-    let f = product_cases(ProductParams { probe_leaves: true, ..ProductParams::default() });
+    let f = product_cases(ProductParams { kind: probed(), ..ProductParams::default() });
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
@@ -218,29 +219,34 @@ fn quadtree_product_sampler_with_refined_leaves_matches_its_pdf() {
 /// dyadic cell's mass is still its centre's density times its area).
 #[test]
 fn quadtree_product_sampler_with_bilinear_leaves_matches_its_pdf() {
-    let f = product_cases(ProductParams { bilinear: true, ..ProductParams::default() });
+    let f = product_cases(ProductParams { kind: bilinear(), ..ProductParams::default() });
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
 /// A bilinear B̃ needs an arena with room for corners; the default arena builds the
-/// piecewise-constant B̃ instead (nobody pays for corners they do not use).
+/// piecewise-constant B̃ instead (nobody pays for corners they do not use), and its sampler says
+/// so.
 #[test]
-fn bilinear_needs_an_arena_with_corners() {
+fn bilinear_needs_an_arena_with_corners_and_the_sampler_says_what_was_built() {
     let env = TestEnv::random_smooth(5, 4);
     let e = env.view();
     let brdf = Lambert::new(Vec3::splat(0.5));
     let frame = Frame::from_normal(Vec3::Z);
     let wo = Vec3::new(0.0, 0.6, 0.8);
-    let params = ProductParams { bilinear: true, ..ProductParams::default() };
+    let params = ProductParams { kind: bilinear(), ..ProductParams::default() };
     let mut plain: Box<ProductArena> = Box::new(ProductArena::new());
-    assert!(!plain.build(&e, &brdf, &frame, wo, &params, 1).unwrap().is_bilinear());
+    let built = plain.build(&e, &brdf, &frame, wo, &params, 1).unwrap();
+    assert!(!built.is_bilinear());
+    assert_eq!(built.kind(), ProductKind::QUADTREE);
     let mut with_corners: Box<ProductArena<256, 2048, 2048>> = Box::new(ProductArena::new());
-    assert!(with_corners.build(&e, &brdf, &frame, wo, &params, 1).unwrap().is_bilinear());
+    let built = with_corners.build(&e, &brdf, &frame, wo, &params, 1).unwrap();
+    assert!(built.is_bilinear());
+    assert_eq!(built.kind(), bilinear());
 }
 
 #[test]
 fn wavelet_product_sampler_matches_its_pdf() {
-    let f = product_cases(ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() });
+    let f = product_cases(ProductParams { kind: ProductKind::WAVELET, ..ProductParams::default() });
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
@@ -265,4 +271,14 @@ fn product_sampler_directions_match_pdf_on_a_sphere_grid() {
         |d| sampler.pdf(d),
     );
     assert!(r.p_value > 0.01 && r.impossible == 0 && r.pdf_mismatch < 1e-3, "{r:?}");
+}
+
+/// The quadtree with B probed at its leaves' centres, not refined.
+fn probed() -> ProductKind {
+    ProductKind::Quadtree { leaves: Leaves::Probed, refine_share: 0.0 }
+}
+
+/// The quadtree with bilinear leaves, not refined.
+fn bilinear() -> ProductKind {
+    ProductKind::Quadtree { leaves: Leaves::Bilinear, refine_share: 0.0 }
 }

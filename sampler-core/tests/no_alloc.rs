@@ -8,9 +8,9 @@ use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::points::sobol02;
-use sampler_core::quadtree::ProductKind;
+use sampler_core::quadtree::{Leaves, ProductKind};
 use sampler_core::rng::Pcg32;
-use sampler_core::sampler::{ProductArena, ProductParams};
+use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -77,8 +77,11 @@ fn ten_thousand_shading_points_allocate_nothing() {
         let brdf = brdfs[(i % 4) as usize];
         let params = match i % 4 {
             0 => ProductParams::default(),
-            2 => ProductParams { bilinear: true, ..ProductParams::for_mis(256) },
-            _ => ProductParams { kind: ProductKind::Wavelet, ..ProductParams::default() },
+            2 => ProductParams {
+                kind: ProductKind::Quadtree { leaves: Leaves::Bilinear, refine_share: 1.0 / 256.0 },
+                ..ProductParams::for_mis(256)
+            },
+            _ => ProductParams { kind: ProductKind::WAVELET, ..ProductParams::default() },
         };
         let sampler = arena.build(&env, brdf, &frame, wo, &params, i).unwrap();
         let mut points = [DVec2::ZERO; 4];
@@ -106,41 +109,57 @@ fn ten_thousand_shading_points_allocate_nothing() {
             let [a, b] = estimator::sampled_mis(&two, &sp, u, u.as_vec2(), &mut vis);
             sink += a.value.x + b.value.x;
         }
-        // The batched paths the renderer takes.
-        let mut pairs = [[estimator::Contribution::default(); 2]; 4];
-        let brdf_points = points.map(|p| p.as_vec2());
-        estimator::sampled_mis_many(&sampler, &sp, &points, &brdf_points, &mut vis, &mut pairs);
-        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
-        sink += estimator::sampled_mis_split(&sampler, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        sink += estimator::sampled_mis_split(&env, &sp, &points[..3], &brdf_points[..1], (0.75, 0.25), &mut vis).x;
-        estimator::sampled_mis_many(&env, &sp, &points, &brdf_points, &mut vis, &mut pairs);
-        sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
-        // A wavefront over the shading point, both techniques.
-        let wave: [estimator::wavefront::WaveSample; 4] = core::array::from_fn(|k| estimator::wavefront::WaveSample {
-            point: 0,
-            technique: if k % 2 == 0 {
-                estimator::wavefront::Technique::Sampler
-            } else {
-                estimator::wavefront::Technique::Brdf
-            },
-            u: points[k],
-        });
-        let mut candidates = [estimator::wavefront::Candidate::default(); 4];
-        for w in [estimator::wavefront::Weighting::Single, estimator::wavefront::Weighting::Balance] {
-            estimator::wavefront::wavefront(&sampler, core::slice::from_ref(&sp), &wave, w, &mut candidates);
-            sink += candidates.iter().map(|c| c.value.x).sum::<f64>();
-        }
-        let mut singles = [estimator::Contribution::default(); 4];
-        estimator::sampled_many(&env, &sp, &points, &mut vis, &mut singles);
-        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
-        estimator::brdf_many(&env, &sp, &brdf_points, &mut vis, &mut singles);
-        sink += singles.iter().map(|c| c.value.x).sum::<f64>();
-        let mut many = [None; 4];
-        sampler.sample_many(&points, &mut many);
-        sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();
+        sink += batched(&sampler, &env, &sp, &points, &mut vis);
+        sink += wavefront(&sampler, &sp, &points);
     }
     ARMED.with(|a| a.set(false));
     let count = COUNT.with(|c| c.get());
     assert!(sink.is_finite());
     assert_eq!(count, 0, "the core allocated {count} times");
+}
+
+/// The batched paths the renderer takes, at one shading point: the sum of what they return.
+fn batched(
+    sampler: &ProductSampler<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    sp: &ShadingPoint<'_, dyn Brdf + '_>,
+    points: &[DVec2; 4],
+    vis: &mut impl FnMut(Vec3) -> bool,
+) -> f64 {
+    let mut sink = 0.0;
+    let mut pairs = [[estimator::Contribution::default(); 2]; 4];
+    let brdf_points = points.map(|p| p.as_vec2());
+    estimator::sampled_mis_many(sampler, sp, points, &brdf_points, vis, &mut pairs);
+    sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+    sink += estimator::sampled_mis_split(sampler, sp, &points[..3], &brdf_points[..1], (0.75, 0.25), vis).x;
+    sink += estimator::sampled_mis_split(env, sp, &points[..3], &brdf_points[..1], (0.75, 0.25), vis).x;
+    estimator::sampled_mis_many(env, sp, points, &brdf_points, vis, &mut pairs);
+    sink += pairs.iter().map(|[a, b]| a.value.x + b.value.x).sum::<f64>();
+    let mut singles = [estimator::Contribution::default(); 4];
+    estimator::sampled_many(env, sp, points, vis, &mut singles);
+    sink += singles.iter().map(|c| c.value.x).sum::<f64>();
+    estimator::brdf_many(env, sp, &brdf_points, vis, &mut singles);
+    sink += singles.iter().map(|c| c.value.x).sum::<f64>();
+    let mut many = [None; 4];
+    sampler.sample_many(points, &mut many);
+    sink += many.iter().flatten().map(|s| s.pdf as f64).sum::<f64>();
+    sink
+}
+
+/// A wavefront over one shading point, both techniques, alone and in pairs: the sum of its
+/// candidates.
+fn wavefront(sampler: &ProductSampler<'_, '_>, sp: &ShadingPoint<'_, dyn Brdf + '_>, points: &[DVec2; 4]) -> f64 {
+    use estimator::wavefront::{Candidate, Technique, WaveSample, Weighting};
+    let wave: [WaveSample; 4] = core::array::from_fn(|k| WaveSample {
+        point: 0,
+        technique: if k % 2 == 0 { Technique::Sampler } else { Technique::Brdf },
+        u: points[k],
+    });
+    let mut candidates = [Candidate::default(); 4];
+    let mut sink = 0.0;
+    for w in [Weighting::Single, Weighting::Balance] {
+        estimator::wavefront::wavefront(sampler, core::slice::from_ref(sp), &wave, w, &mut candidates);
+        sink += candidates.iter().map(|c| c.value.x).sum::<f64>();
+    }
+    sink
 }

@@ -58,7 +58,7 @@ fn env_and_product_pdfs_integrate_to_one() {
         // Independent check on directions: a plain grid over the sphere.
         let grid = integrate(Chart::EqualArea, 1024, |d| e.pdf(d) as f64);
         assert!((grid - 1.0).abs() < 1e-3, "env on a grid: {grid}");
-        for kind in [ProductKind::Quadtree, ProductKind::Wavelet] {
+        for kind in [ProductKind::QUADTREE, ProductKind::WAVELET] {
             let params = ProductParams { kind, ..ProductParams::default() };
             for (name, brdf, _) in brdfs() {
                 for (k, normal) in

@@ -2,7 +2,8 @@
 //! extreme geometry. Each case asserts no NaN/Inf (exactly 0 under a black sky and for a
 //! back-facing view) and compares the mean with a reference — quadrature of the sky plus the
 //! sun's excess integrated over its texel — in standard errors, writing the whole table (mean,
-//! reference, z, variance, time) to `target/stability_matrix.md`.
+//! reference, z, variance, time) to `stability_matrix.md` in the target directory's `tmp/`
+//! (`CARGO_TARGET_TMPDIR`, under `CARGO_TARGET_DIR` when that is set).
 //!
 //! * Estimators that cover both a needle lobe and a one-texel sun (product, wavelet, mis,
 //!   product-mis, ris): with ~1000 cases at 3σ, a few exceed 3σ by chance, so the test asserts
@@ -168,6 +169,101 @@ fn reference(
     (value, error)
 }
 
+/// One shading point of the matrix, as every method draws from it.
+struct Point<'p, 'e> {
+    env: &'p EnvHierarchy<'e>,
+    sat: &'p [f64],
+    sp: &'p ShadingPoint<'p, dyn Brdf>,
+    /// The lighting's scale, divided out of every value.
+    scale: f64,
+}
+
+/// One build's 32 values of `method` at `at`, from the points of `seed`, pushed onto `values`.
+fn draw(method: &str, arena: &mut ProductArena, at: &Point<'_, '_>, seed: u64, values: &mut Vec<f64>) {
+    let (env, sp) = (at.env, at.sp);
+    let (brdf, frame, wo) = (sp.brdf, sp.frame, sp.wo);
+    let mut vis = |_: Vec3| true;
+    let mut pts = [DVec2::ZERO; 32];
+    sobol02(seed, 0, &mut pts);
+    let mut qts = [DVec2::ZERO; 32];
+    sobol02(seed ^ 1, 0, &mut qts);
+    let lum = |v: glam::DVec3| luminance64(v) / at.scale;
+    let mut push = |v: f64| values.push(v);
+    match method {
+        "product" | "wavelet" | "product-mis" | "product K=1" => {
+            let kind = if method == "wavelet" {
+                sampler_core::quadtree::ProductKind::WAVELET
+            } else {
+                sampler_core::quadtree::ProductKind::QUADTREE
+            };
+            let brdf_samples = if method == "product K=1" { 1 } else { 256 };
+            // product-MIS with the preset the renderer uses beside BRDF sampling.
+            let params = if method == "product-mis" {
+                ProductParams::for_mis(256)
+            } else {
+                ProductParams { kind, brdf_samples, ..ProductParams::default() }
+            };
+            let s = arena.build(env, brdf, &frame, wo, &params, seed).unwrap();
+            for i in 0..32 {
+                push(if method == "product-mis" {
+                    let [a, c] = estimator::sampled_mis(&s, sp, pts[i], qts[i].as_vec2(), &mut vis);
+                    lum(a.value + c.value)
+                } else {
+                    lum(estimator::sampled(&s, sp, pts[i], &mut vis).value)
+                });
+            }
+        }
+        "two-stage" => {
+            let s: TwoStageSampler<'_, '_> = TwoStageSampler::new(env, at.sat, brdf, &frame, wo);
+            for p in pts {
+                push(lum(estimator::sampled(&s, sp, p, &mut vis).value));
+            }
+        }
+        "ris" => {
+            for (i, q) in qts.iter().enumerate() {
+                let mut cands = [DVec2::ZERO; 8];
+                sobol02(seed ^ (i as u64 + 7), 0, &mut cands);
+                push(lum(estimator::ris(env, sp, &cands, q.x, &mut vis).value));
+            }
+        }
+        _ => {
+            for i in 0..32 {
+                push(match method {
+                    "env" => lum(estimator::sampled(env, sp, pts[i], &mut vis).value),
+                    "brdf" => lum(estimator::brdf(env, sp, pts[i], &mut vis).value),
+                    _ => {
+                        let [a, c] = estimator::sampled_mis(env, sp, pts[i], qts[i].as_vec2(), &mut vis);
+                        lum(a.value + c.value)
+                    }
+                });
+            }
+        }
+    }
+}
+
+/// The mean, its standard error and the per-sample variance of `builds` builds' values (32
+/// each): per-build means are i.i.d. (points within a build are stratified).
+fn statistics(values: &[f64], builds: u64) -> (f64, f64, f64) {
+    let per_build: Vec<f64> = values.chunks(32).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect();
+    let mean = per_build.iter().sum::<f64>() / builds as f64;
+    let var_b = per_build.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (builds - 1) as f64;
+    let se = (var_b / builds as f64).sqrt();
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64;
+    (mean, se, var)
+}
+
+/// How many standard errors `se` the mean lies from the reference beyond its tolerance
+/// (infinite when there is no spread and it lies outside).
+fn z_score(mean: f64, se: f64, reference: f64, tolerance: f64) -> f64 {
+    if se > 0.0 {
+        ((mean - reference).abs() - tolerance).max(0.0) / se
+    } else if (mean - reference).abs() <= tolerance + 1e-12 * reference.abs() {
+        0.0
+    } else {
+        f64::INFINITY
+    }
+}
+
 #[test]
 fn every_estimator_on_every_extreme_case() {
     let mut table = String::from(
@@ -187,74 +283,16 @@ fn every_estimator_on_every_extreme_case() {
                 let sp: ShadingPoint<'_, dyn Brdf> = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
                 let (reference, quad_err) = reference(&env, &light, &sp, width, microfacet);
                 let scale = if light.name == "1e30" { 1e30 } else { 1.0 };
+                let at = Point { env: &env, sat: &sat, sp: &sp, scale };
                 let mut results = Vec::new();
                 for (k, method) in METHODS.iter().enumerate() {
                     let mut rng = Pcg32::new(99, (cases * 8 + k) as u64);
-                    let mut vis = |_: Vec3| true;
                     let t0 = Instant::now();
                     let mut values: Vec<f64> = Vec::with_capacity(4096);
                     let builds = 256u64;
                     for _ in 0..builds {
                         let seed = rng.next_u32() as u64;
-                        let mut pts = [DVec2::ZERO; 32];
-                        sobol02(seed, 0, &mut pts);
-                        let mut qts = [DVec2::ZERO; 32];
-                        sobol02(seed ^ 1, 0, &mut qts);
-                        let lum = |v: glam::DVec3| luminance64(v) / scale;
-                        let mut push = |v: f64| values.push(v);
-                        match *method {
-                            "product" | "wavelet" | "product-mis" | "product K=1" => {
-                                let kind = if *method == "wavelet" {
-                                    sampler_core::quadtree::ProductKind::Wavelet
-                                } else {
-                                    sampler_core::quadtree::ProductKind::Quadtree
-                                };
-                                let brdf_samples = if *method == "product K=1" { 1 } else { 256 };
-                                // product-MIS with the preset the renderer uses beside BRDF sampling.
-                                let params = if *method == "product-mis" {
-                                    ProductParams::for_mis(256)
-                                } else {
-                                    ProductParams { kind, brdf_samples, ..ProductParams::default() }
-                                };
-                                let s = arena.build(&env, brdf.as_ref(), &frame, wo, &params, seed).unwrap();
-                                for i in 0..32 {
-                                    push(if *method == "product-mis" {
-                                        let [a, c] =
-                                            estimator::sampled_mis(&s, &sp, pts[i], qts[i].as_vec2(), &mut vis);
-                                        lum(a.value + c.value)
-                                    } else {
-                                        lum(estimator::sampled(&s, &sp, pts[i], &mut vis).value)
-                                    });
-                                }
-                            }
-                            "two-stage" => {
-                                let s: TwoStageSampler<'_, '_> =
-                                    TwoStageSampler::new(&env, &sat, brdf.as_ref(), &frame, wo);
-                                for p in pts {
-                                    push(lum(estimator::sampled(&s, &sp, p, &mut vis).value));
-                                }
-                            }
-                            "ris" => {
-                                for (i, q) in qts.iter().enumerate() {
-                                    let mut cands = [DVec2::ZERO; 8];
-                                    sobol02(seed ^ (i as u64 + 7), 0, &mut cands);
-                                    push(lum(estimator::ris(&env, &sp, &cands, q.x, &mut vis).value));
-                                }
-                            }
-                            _ => {
-                                for i in 0..32 {
-                                    push(match *method {
-                                        "env" => lum(estimator::sampled(&env, &sp, pts[i], &mut vis).value),
-                                        "brdf" => lum(estimator::brdf(&env, &sp, pts[i], &mut vis).value),
-                                        _ => {
-                                            let [a, c] =
-                                                estimator::sampled_mis(&env, &sp, pts[i], qts[i].as_vec2(), &mut vis);
-                                            lum(a.value + c.value)
-                                        }
-                                    });
-                                }
-                            }
-                        }
+                        draw(method, &mut arena, &at, seed, &mut values);
                     }
                     let micros = t0.elapsed().as_secs_f64() * 1e6 / values.len() as f64;
                     let label = format!("{} / {mname} / {gname} / {method}", light.name);
@@ -262,13 +300,7 @@ fn every_estimator_on_every_extreme_case() {
                         problems.push(format!("{label}: non-finite value {bad}"));
                         continue;
                     }
-                    // Per-build means are i.i.d. (points within a build are stratified).
-                    let per_build: Vec<f64> =
-                        values.chunks(32).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect();
-                    let mean = per_build.iter().sum::<f64>() / builds as f64;
-                    let var_b = per_build.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (builds - 1) as f64;
-                    let se = (var_b / builds as f64).sqrt();
-                    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64;
+                    let (mean, se, var) = statistics(&values, builds);
                     if (light.name == "black" || gname == "back-facing") && values.iter().any(|v| *v != 0.0) {
                         problems.push(format!("{label}: not exactly 0"));
                     }
@@ -289,13 +321,7 @@ fn every_estimator_on_every_extreme_case() {
                 };
                 for (method, mean, se, var, micros, label) in results {
                     let se_all = (se * se + ref_se * ref_se).sqrt();
-                    let z = if se_all > 0.0 {
-                        ((mean - ref_mean).abs() - tol_ref).max(0.0) / se_all
-                    } else if (mean - ref_mean).abs() <= tol_ref + 1e-12 * ref_mean.abs() {
-                        0.0
-                    } else {
-                        f64::INFINITY
-                    };
+                    let z = z_score(mean, se_all, ref_mean, tol_ref);
                     if covers_both(method) && !(grazing_needle && method == "mis") {
                         cases += 1;
                         over3 += usize::from(z > 3.0);
@@ -317,7 +343,7 @@ fn every_estimator_on_every_extreme_case() {
             }
         }
     }
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/stability_matrix.md");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("stability_matrix.md");
     let _ = std::fs::write(&path, &table);
     println!("{cases} cases, {over3} beyond 3σ, worst z = {:.2} ({}); table in {}", worst.0, worst.1, path.display());
     assert!(problems.is_empty(), "{}", problems.join("\n"));

@@ -90,7 +90,7 @@ fn every_bound_holds_over_its_cell() {
                     let d = around.to_world(Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()));
                     let uv = sphere_to_square(d);
                     let cell = |t: f32| ((t * n as f32) as u32).min(n - 1);
-                    check(sampler_core::env::morton2(cell(uv.x), cell(uv.y)), d, &mut worst);
+                    check(sampler_core::cell::morton2(cell(uv.x), cell(uv.y)), d, &mut worst);
                 }
             }
         }

@@ -1,4 +1,4 @@
-//! End-to-end stability on extreme inputs (issue 5): every method renders without
+//! End-to-end stability on extreme inputs: every method renders without
 //! panic and without a non-finite value, and where the answer is analytic it is met.
 
 mod common;

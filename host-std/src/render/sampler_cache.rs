@@ -95,8 +95,8 @@ impl SamplerCache {
             Strategy::Brdf => Sampling::Brdf,
             Strategy::Mis { env_share } => Sampling::Mis { env_share },
             Strategy::Ris => Sampling::Ris,
-            Strategy::Product => Sampling::Product(self.product(ctx, env, ProductKind::Quadtree, lead)),
-            Strategy::Wavelet => Sampling::Product(self.product(ctx, env, ProductKind::Wavelet, lead)),
+            Strategy::Product => Sampling::Product(self.product(ctx, env, ProductKind::QUADTREE, lead)),
+            Strategy::Wavelet => Sampling::Product(self.product(ctx, env, ProductKind::WAVELET, lead)),
             Strategy::ProductMis { product_share } => {
                 Sampling::ProductMis { sampler: self.shared_product(ctx, env, plan, lead), product_share }
             }

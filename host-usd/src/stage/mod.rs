@@ -70,10 +70,12 @@ impl Stage {
         Ok(self.inner.stage_metadata(field).map_err(err)?.map(convert))
     }
 
+    /// The stage's `defaultPrim`, if authored.
     pub fn default_prim(&self) -> Option<String> {
         self.inner.default_prim().map(|t| t.as_str().to_string())
     }
 
+    /// The time code values are read at.
     pub fn time(&self) -> f64 {
         self.time.value()
     }
@@ -96,24 +98,29 @@ impl Stage {
         Ok(out)
     }
 
+    /// The prim's type name (empty for a typeless prim).
     pub fn type_name(&self, prim: &str) -> Result<String> {
         let t = self.inner.prim(path(prim)?).type_name().map_err(err)?;
         Ok(t.map(|t| t.as_str().to_string()).unwrap_or_default())
     }
 
+    /// The paths of the prim's children, in order.
     pub fn children(&self, prim: &str) -> Result<Vec<String>> {
         let children = self.inner.prim(path(prim)?).children().map_err(err)?;
         Ok(children.iter().map(|c| c.path().as_str().to_string()).collect())
     }
 
+    /// True for an instanceable prim's instance.
     pub fn is_instance(&self, prim: &str) -> Result<bool> {
         self.inner.prim(path(prim)?).is_instance().map_err(err)
     }
 
+    /// True for a prim inside an instance (a proxy of the prototype's prim).
     pub fn is_instance_proxy(&self, prim: &str) -> Result<bool> {
         self.inner.prim(path(prim)?).is_instance_proxy().map_err(err)
     }
 
+    /// The prim's applied API schemas (`apiSchemas`).
     pub fn applied_schemas(&self, prim: &str) -> Result<Vec<String>> {
         let s = self.inner.prim(path(prim)?).api_schemas().map_err(err)?;
         Ok(s.iter().map(|t| t.as_str().to_string()).collect())

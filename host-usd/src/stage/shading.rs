@@ -8,16 +8,27 @@ use openusd::sdf;
 /// What a UsdPreviewSurface authors; `None` means unauthored (the schema's fallback applies).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PreviewInputs {
+    /// The Shader prim.
     pub shader: String,
+    /// `inputs:diffuseColor`.
     pub diffuse_color: Input<[f32; 3]>,
+    /// `inputs:specularColor`.
     pub specular_color: Input<[f32; 3]>,
+    /// `inputs:emissiveColor`.
     pub emissive_color: Input<[f32; 3]>,
+    /// `inputs:metallic`.
     pub metallic: Input<f32>,
+    /// `inputs:roughness`.
     pub roughness: Input<f32>,
+    /// `inputs:clearcoat`.
     pub clearcoat: Input<f32>,
+    /// `inputs:clearcoatRoughness`.
     pub clearcoat_roughness: Input<f32>,
+    /// `inputs:ior`.
     pub ior: Input<f32>,
+    /// `inputs:opacity`.
     pub opacity: Input<f32>,
+    /// `inputs:useSpecularWorkflow`.
     pub use_specular_workflow: Option<bool>,
     /// Inputs driven by a texture that is not a plain UsdUVTexture (or a normal map): named.
     pub unsupported: Vec<String>,
@@ -26,8 +37,10 @@ pub struct PreviewInputs {
 /// One UsdPreviewSurface input.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub enum Input<T> {
+    /// Not authored: the schema's fallback applies.
     #[default]
     Unset,
+    /// An authored value.
     Value(T),
     /// Connected to a UsdUVTexture.
     Texture(TextureRef),
@@ -38,9 +51,11 @@ pub enum Input<T> {
 pub struct TextureRef {
     /// `inputs:file` as authored, and resolved against the layer that authored it.
     pub authored: String,
+    /// The resolved path, when the asset resolves.
     pub resolved: Option<String>,
     /// `inputs:scale` and `inputs:bias` (RGBA).
     pub scale: [f32; 4],
+    /// `inputs:bias` (RGBA).
     pub bias: [f32; 4],
     /// The output used: `rgb`, `r`, `g`, `b` or `a`.
     pub channel: String,
@@ -124,6 +139,7 @@ impl Stage {
         Ok(applies)
     }
 
+    /// The Shader prim behind a Material's `outputs:surface`, with its `info:id`.
     pub fn surface_shader(&self, material: &str) -> Result<Option<(String, String)>> {
         // The universal `outputs:surface`, followed through NodeGraph outputs (openusd 0.6
         // stops at a NodeGraph), is what a UsdPreviewSurface renderer reads.

@@ -8,22 +8,32 @@ pub enum Value {
     /// Every numeric scalar, vector, quaternion (w, x, y, z) and matrix, flattened, of any
     /// precision; `shape` is the number of components per element (1 for scalars).
     Numbers {
+        /// The components, flattened.
         values: Vec<f64>,
+        /// Components per element.
         shape: usize,
+        /// True for an array value (even of one element).
         array: bool,
     },
+    /// A token.
     Token(String),
+    /// A token array.
     Tokens(Vec<String>),
+    /// A bool.
     Bool(bool),
     /// An asset path as authored, and resolved against the layer that authored it.
     Asset {
+        /// The path as authored.
         authored: String,
+        /// The resolved path, when the asset resolves.
         resolved: Option<String>,
     },
+    /// Any other type, by its name.
     Other(String),
 }
 
 impl Value {
+    /// The components of a numeric value.
     pub fn numbers(&self) -> Option<&[f64]> {
         match self {
             Value::Numbers { values, .. } => Some(values),
@@ -31,6 +41,7 @@ impl Value {
         }
     }
 
+    /// A numeric scalar (a bool as 0 or 1).
     pub fn scalar(&self) -> Option<f64> {
         match self {
             Value::Numbers { values, shape: 1, array: false } => values.first().copied(),
@@ -39,6 +50,7 @@ impl Value {
         }
     }
 
+    /// A token's text.
     pub fn token(&self) -> Option<&str> {
         match self {
             Value::Token(t) => Some(t),

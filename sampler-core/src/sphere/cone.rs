@@ -2,6 +2,7 @@
 //! level of the environment's pyramid: the two-level product ([`crate::two_level`]) bounds a
 //! BRDF over each cell through its cone ([`crate::brdf::Brdf::cone_bounds`]).
 
+use crate::cell::Cell;
 use crate::mapping::square_to_sphere;
 use glam::{Vec2, Vec3};
 
@@ -82,7 +83,7 @@ pub fn level_of(cells: usize) -> Option<u32> {
     (cells.is_power_of_two() && cells.trailing_zeros().is_multiple_of(2)).then_some(cells.trailing_zeros() / 2)
 }
 
-/// The inverse of [`crate::env::morton2`]: the cell `(x, y)` at Morton index `m`.
+/// The inverse of [`crate::cell::morton2`]: the cell `(x, y)` at Morton index `m`.
 #[inline]
 #[must_use]
 pub fn morton_cell(m: usize) -> (u32, u32) {
@@ -108,12 +109,13 @@ const STRETCH: f32 = 8.0;
 /// Extra half-angle that absorbs the rounding of the bounds computed from a cone.
 const SLACK: f32 = 1e-3;
 
-/// A cone that contains every direction of cell `(x, y)` of `level`. The image of a cell is a
+/// A cone that contains every direction of `cell`. The image of a cell is a
 /// disk-like region that does not reach its axis's antipode, so the angle from the axis is
 /// largest on the cell's boundary: measured there at evenly spaced points, plus what
 /// can hide between them.
 #[must_use]
-pub fn cell_cone(level: u32, x: u32, y: u32) -> Cone {
+pub fn cell_cone(cell: Cell) -> Cone {
+    let Cell { level, x, y } = cell;
     let size = 1.0 / (1u32 << level) as f32;
     let origin = Vec2::new(x as f32, y as f32) * size;
     let axis = square_to_sphere(origin + Vec2::splat(0.5 * size)).normalize();
@@ -135,7 +137,7 @@ pub fn build_cell_cones(out: &mut [Cone]) -> bool {
     let Some(level) = level_of(out.len()) else { return false };
     for (m, cone) in out.iter_mut().enumerate() {
         let (x, y) = morton_cell(m);
-        *cone = cell_cone(level, x, y);
+        *cone = cell_cone(Cell::new(level, x, y));
     }
     true
 }
@@ -143,7 +145,7 @@ pub fn build_cell_cones(out: &mut [Cone]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::env::morton2;
+    use crate::cell::morton2;
     use crate::rng::Pcg32;
 
     #[test]
@@ -180,7 +182,7 @@ mod tests {
             let n = 1u32 << level;
             for y in 0..n {
                 for x in 0..n {
-                    let cone = cell_cone(level, x, y);
+                    let cone = cell_cone(Cell::new(level, x, y));
                     for _ in 0..64 {
                         let p = (Vec2::new(x as f32, y as f32) + Vec2::new(rng.next_f32(), rng.next_f32())) / n as f32;
                         let d = square_to_sphere(p);

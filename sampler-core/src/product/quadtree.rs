@@ -5,7 +5,7 @@
 //!   contiguous run of samples and its four children split that run by the next two bits.
 //! * A leaf with samples takes the mean of their B·cos (luminance) — one sample unless the depth
 //!   cap or the node capacity stopped the split (e.g. coincident samples) — or, with
-//!   `probe_leaves`, B at its centre where that is larger.
+//!   [`Leaves::Probed`], B at its centre where that is larger.
 //! * An empty leaf takes its non-empty siblings' mean shrunk by the sample counts (see
 //!   `TreeBuilder::node`): a guess from its neighbourhood instead of 0, so the product does not
 //!   starve the regions between samples of a smooth lobe, yet small where many samples chose
@@ -16,11 +16,13 @@
 //!   place leaves where B is large, the refinement where B̃·L is (a sun in a lobe's tail).
 //! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
 //!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
-//!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`).
+//!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`). What B̃ is in a leaf is
+//!   [`Leaves`]; the combinations that exist are the variants of [`ProductKind`].
 
+pub use super::params::{Leaves, ProductKind};
 use crate::bilinear::{self, Corners};
+use crate::cell::Cell;
 use crate::env::EnvHierarchy;
-use crate::warp::child_offset;
 use crate::wavelet::haar_product_mean;
 use glam::Vec2;
 use heapless::Vec;
@@ -54,17 +56,6 @@ impl Node {
     pub fn is_leaf(&self) -> bool {
         self.child == 0
     }
-}
-
-/// How internal nodes combine their children.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ProductKind {
-    /// Average of the four children's products (Clarberg & Akenine-Möller 2008).
-    #[default]
-    Quadtree,
-    /// Product of the nonstandard Haar expansions of B̃ and L (wavelet importance sampling,
-    /// Clarberg et al. 2005). Equal to `Quadtree` in exact arithmetic: a cross-check.
-    Wavelet,
 }
 
 /// 24-bit fixed-point coordinates of a point of the square.
@@ -114,7 +105,8 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     pub env: &'b EnvHierarchy<'e>,
     pub nodes: &'b mut Vec<Node, NODES>,
     pub max_depth: u32,
-    pub kind: ProductKind,
+    /// Internal nodes by the Haar wavelet product instead of the average.
+    pub wavelet: bool,
     pub eval: F,
     /// Also probe B at the centre of every leaf that holds samples (see `node`).
     pub probe_leaves: bool,
@@ -140,10 +132,10 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             let w = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE].map(|p| self.eval_at(p));
             let _ = self.corners.push(w);
         }
-        let root_env = self.env.cell_relative(0, 0, 0);
-        let (_, total) = self.node(0, 0, 0, 0, root_env, 0, self.keys.len());
+        let root_env = self.env.cell_relative(Cell::ROOT);
+        let (_, total) = self.node(0, Cell::ROOT, root_env, 0, self.keys.len());
         if self.refine_share > 0.0 && total > 0.0 && total.is_finite() {
-            self.refine(0, 0, 0, 0, root_env, self.refine_share * total);
+            self.refine(0, Cell::ROOT, root_env, self.refine_share * total);
         }
         true
     }
@@ -156,8 +148,8 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     /// sample's value from elsewhere in the leaf, off by orders of magnitude at the sun, and
     /// every product sample of the sun then carries that ratio B/B̃. Splitting the heavy leaves
     /// brings B̃ close to B where the light is.
-    fn refine(&mut self, index: usize, depth: u32, x: u32, y: u32, env: f32, limit: f32) -> f32 {
-        let node = self.nodes[index];
+    fn refine(&mut self, index: usize, cell: Cell, env: f32, limit: f32) -> f32 {
+        let (node, depth) = (self.nodes[index], cell.level);
         // A node's mass: its mean over the cell times the cell's area 4^-depth.
         let mass = node.product * f32::from_bits((127 - 2 * depth.min(63)) << 23);
         // Not below the map's finest level: there L is one texel's, and where B varies faster
@@ -166,15 +158,14 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         if node.is_leaf() && (mass <= limit || depth >= deepest || self.nodes.len() + 4 > NODES) {
             return node.product;
         }
-        let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
+        let l = if depth < self.env.finest_level() { self.env.children_relative(cell) } else { [env; 4] };
         let first = if node.is_leaf() {
-            let first = self.push_children(index, depth, x, y);
+            let first = self.push_children(index, cell);
             for c in 0..4 {
                 let b = if self.bilinear {
                     bilinear::mean(&self.corners[first + c])
                 } else {
-                    let (dx, dy) = child_offset(c);
-                    let probe = self.probe(depth + 1, 2 * x + dx, 2 * y + dy);
+                    let probe = self.probe(cell.child(c));
                     // NaN (unknown) keeps the parent's B̃.
                     if probe.is_finite() { probe } else { node.product / env.max(f32::MIN_POSITIVE) }
                 };
@@ -186,67 +177,33 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         };
         let mut p = [0.0f32; 4];
         for (c, pc) in p.iter_mut().enumerate() {
-            let (dx, dy) = child_offset(c);
-            *pc = self.refine(first + c, depth + 1, 2 * x + dx, 2 * y + dy, l[c], limit);
+            *pc = self.refine(first + c, cell.child(c), l[c], limit);
         }
         let product = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
         set(&mut self.nodes[index], first as u32, product);
         product
     }
 
-    /// Fills node `index` covering cell `(x, y)` at `depth` and samples `lo..hi` (non-empty);
-    /// returns its (B̃ mean, product mean). Fields are written in place: building a `Node` on
-    /// the stack and copying it back costs a failed store-forward per node.
-    /// `env` is the environment's relative mean over the cell (fetched by the parent).
-    #[allow(clippy::too_many_arguments)]
-    fn node(&mut self, index: usize, depth: u32, x: u32, y: u32, env: f32, lo: usize, hi: usize) -> (f32, f32) {
+    /// Fills node `index` covering `cell` and samples `lo..hi` (non-empty); returns its (B̃
+    /// mean, product mean). Fields are written in place: building a `Node` on the stack and
+    /// copying it back costs a failed store-forward per node. `env` is the environment's
+    /// relative mean over the cell (fetched by the parent).
+    fn node(&mut self, index: usize, cell: Cell, env: f32, lo: usize, hi: usize) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
-        if hi - lo == 1 || depth >= self.max_depth || !room {
-            if self.bilinear {
-                let b = bilinear::mean(&self.corners[index]);
-                set(&mut self.nodes[index], 0, b * env);
-                return (b, b * env);
-            }
-            let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
-            let mut b = sum / (hi - lo) as f32;
-            // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
-            // unknown): a sample can sit on the dim side of its leaf, and a B̃ that understates
-            // the leaf makes B/B̃ large wherever the light sends the product's samples in it,
-            // while one that overstates it only spends a few samples (docs/perf.md#product-mis-preset).
-            if self.probe_leaves {
-                let probe = self.probe(depth, x, y);
-                if probe.is_finite() {
-                    b = b.max(probe);
-                }
-            }
-            let product = b * env;
-            set(&mut self.nodes[index], 0, product);
-            return (b, product);
+        if hi - lo == 1 || cell.level >= self.max_depth || !room {
+            return self.leaf(index, cell, env, lo, hi);
         }
-        let first = self.push_children(index, depth, x, y);
-        // Split lo..hi by the next two Morton bits: the run is sorted, so counting each digit
-        // gives the child boundaries (cheaper than three binary searches for the short runs
-        // that make up most of the tree).
-        // Register accumulators (an array of counters would chain through memory).
-        let (mut below1, mut below2, mut below3) = (0usize, 0usize, 0usize);
-        for &k in &self.keys[lo..hi] {
-            let d = digit(k, depth);
-            below1 += usize::from(d < 1);
-            below2 += usize::from(d < 2);
-            below3 += usize::from(d < 3);
-        }
-        let bounds = [lo, lo + below1, lo + below2, lo + below3, hi];
+        let first = self.push_children(index, cell);
+        let bounds = self.split(cell.level, lo, hi);
         // The environment over the four children: one 2×2 block of the pyramid (or the texel
         // containing them, below the finest level).
-        let l = if depth < self.env.finest_level() { self.env.children_relative(depth, x, y) } else { [env; 4] };
+        let l = if cell.level < self.env.finest_level() { self.env.children_relative(cell) } else { [env; 4] };
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
         for c in 0..4 {
             if bounds[c + 1] > bounds[c] {
-                let (dx, dy) = child_offset(c);
-                let (cx, cy) = (2 * x + dx, 2 * y + dy);
-                (b[c], p[c]) = self.node(first + c, depth + 1, cx, cy, l[c], bounds[c], bounds[c + 1]);
+                (b[c], p[c]) = self.node(first + c, cell.child(c), l[c], bounds[c], bounds[c + 1]);
                 sum_b += b[c];
                 filled += 1;
             }
@@ -266,8 +223,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
                 let fill = if self.bilinear {
                     bilinear::mean(&self.corners[first + c])
                 } else if hi - lo >= EVAL_EMPTY_FROM {
-                    let (dx, dy) = child_offset(c);
-                    count_fill.min(self.probe(depth + 1, 2 * x + dx, 2 * y + dy))
+                    count_fill.min(self.probe(cell.child(c)))
                 } else {
                     count_fill
                 };
@@ -277,20 +233,57 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             }
         }
         let mean_b = 0.25 * ((b[0] + b[1]) + (b[2] + b[3]));
-        let product = match self.kind {
-            ProductKind::Quadtree => 0.25 * ((p[0] + p[1]) + (p[2] + p[3])),
-            ProductKind::Wavelet => haar_product_mean(b, l, p),
-        };
+        let product = if self.wavelet { haar_product_mean(b, l, p) } else { 0.25 * ((p[0] + p[1]) + (p[2] + p[3])) };
         set(&mut self.nodes[index], first as u32, product);
         (mean_b, product)
+    }
+
+    /// Makes node `index` (covering `cell`, samples `lo..hi`) a leaf; returns its (B̃, product).
+    fn leaf(&mut self, index: usize, cell: Cell, env: f32, lo: usize, hi: usize) -> (f32, f32) {
+        if self.bilinear {
+            let b = bilinear::mean(&self.corners[index]);
+            set(&mut self.nodes[index], 0, b * env);
+            return (b, b * env);
+        }
+        let sum: f32 = self.keys[lo..hi].iter().map(|k| self.values[(k & 0xFFFF) as usize]).sum();
+        let mut b = sum / (hi - lo) as f32;
+        // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
+        // unknown): a sample can sit on the dim side of its leaf, and a B̃ that understates
+        // the leaf makes B/B̃ large wherever the light sends the product's samples in it,
+        // while one that overstates it only spends a few samples (docs/perf.md#product-mis-preset).
+        if self.probe_leaves {
+            let probe = self.probe(cell);
+            if probe.is_finite() {
+                b = b.max(probe);
+            }
+        }
+        let product = b * env;
+        set(&mut self.nodes[index], 0, product);
+        (b, product)
+    }
+
+    /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
+    /// sorted, so counting each of the next two Morton bits' digits gives them (cheaper than
+    /// three binary searches for the short runs that make up most of the tree).
+    fn split(&self, depth: u32, lo: usize, hi: usize) -> [usize; 5] {
+        // Register accumulators (an array of counters would chain through memory).
+        let (mut below1, mut below2, mut below3) = (0usize, 0usize, 0usize);
+        for &k in &self.keys[lo..hi] {
+            let d = digit(k, depth);
+            below1 += usize::from(d < 1);
+            below2 += usize::from(d < 2);
+            below3 += usize::from(d < 3);
+        }
+        [lo, lo + below1, lo + below2, lo + below3, hi]
     }
 }
 
 impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, NODES, CORNERS> {
-    /// Appends the four children of node `index` (cell `(x, y)` at `depth`) and, for a bilinear
+    /// Appends the four children of node `index` (covering `cell`) and, for a bilinear
     /// B̃, their corner values: the parent's corners, B at the four edge midpoints and at the
     /// centre — five evaluations, shared by the children so that B̃ is continuous across them.
-    fn push_children(&mut self, index: usize, depth: u32, x: u32, y: u32) -> usize {
+    fn push_children(&mut self, index: usize, cell: Cell) -> usize {
+        let Cell { level: depth, x, y } = cell;
         let first = self.nodes.len();
         for _ in 0..4 {
             let _ = self.nodes.push(Node::default());
@@ -314,10 +307,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         if v.is_nan() || v <= 0.0 { 0.0 } else { v.min(f32::MAX) }
     }
 
-    /// B·cos at the centre of cell `(x, y)` at `depth`; where that is 0 (e.g. below the
+    /// B·cos at the centre of `cell`; where that is 0 (e.g. below the
     /// surface), the largest of its four corners (inset by 1/64 of the cell), so that a cell
     /// straddling the horizon is not zeroed. NaN reads as unknown (+∞: keep the count fill).
-    fn probe(&mut self, depth: u32, x: u32, y: u32) -> f32 {
+    fn probe(&mut self, cell: Cell) -> f32 {
+        let Cell { level: depth, x, y } = cell;
         let inv = 1.0 / (1u64 << depth) as f32;
         let at = |s: f32, t: f32| Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv);
         let read = |v: f32| {

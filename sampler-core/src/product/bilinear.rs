@@ -1,11 +1,12 @@
 //! Bilinear densities on a cell: B̃ interpolated between the BRDF's values at a leaf's corners
-//! (`ProductParams::bilinear`), sampled exactly by inverting its marginal and conditional,
+//! ([`Leaves::Bilinear`](super::quadtree::Leaves::Bilinear)), sampled exactly by inverting its marginal and conditional,
 //! both linear.
 //!
 //! Corner values are in child order (see `warp::child_offset`): (0,0), (1,0), (0,1), (1,1), in
 //! the cell's own coordinates s, t ∈ [0, 1].
 
-use crate::warp::{ONE_MINUS_EPSILON, child_offset, inverse_area};
+use crate::cell::Cell;
+use crate::warp::{ONE_MINUS_EPSILON, child_offset};
 use glam::{DVec2, Vec2};
 
 /// The values at a cell's four corners.
@@ -79,12 +80,10 @@ pub(crate) enum Masses<'m> {
     Four([f32; 4]),
 }
 
-/// A cell of the environment's levels inside a bilinear leaf: its position in the pyramid and
-/// its lower corner (s, t) and side in the leaf's own coordinates.
+/// A cell of the environment's levels inside a bilinear leaf: its place in the pyramid and its
+/// lower corner (s, t) and side in the leaf's own coordinates.
 pub(crate) struct BilinearCell {
-    pub level: u32,
-    pub x: u32,
-    pub y: u32,
+    pub cell: Cell,
     pub s: f32,
     pub t: f32,
     pub size: f32,
@@ -97,25 +96,27 @@ impl BilinearCell {
         self.size *= 0.25;
         self.s += gx as f32 * self.size;
         self.t += gy as f32 * self.size;
-        (self.level, self.x, self.y) = (self.level + 2, 4 * self.x + gx, 4 * self.y + gy);
+        self.cell = self.cell.grandchild(gx, gy);
     }
 
+    /// To child `child` (numbered `dx + 2·dy`).
     #[inline(always)]
     pub fn descend(&mut self, child: usize) {
         let (dx, dy) = child_offset(child);
         self.size *= 0.5;
         self.s += dx as f32 * self.size;
         self.t += dy as f32 * self.size;
-        (self.level, self.x, self.y) = (self.level + 1, 2 * self.x + dx, 2 * self.y + dy);
+        self.cell = self.cell.child(child);
     }
 
     /// Density per unit square area at `uv` in this final cell (reached with probability
     /// `path`, B̃ bilinear between `corners` inside it).
     #[inline]
     pub fn density(&self, path: f64, corners: &Corners, uv: Vec2) -> f64 {
-        let scale = (1u64 << self.level) as f64;
-        let p = DVec2::new(uv.x as f64 * scale - self.x as f64, uv.y as f64 * scale - self.y as f64);
-        path * inverse_area(self.level) * pdf(corners, p.clamp(DVec2::ZERO, DVec2::ONE))
+        let Cell { level, x, y } = self.cell;
+        let scale = (1u64 << level) as f64;
+        let p = DVec2::new(uv.x as f64 * scale - x as f64, uv.y as f64 * scale - y as f64);
+        path * self.cell.inverse_area() * pdf(corners, p.clamp(DVec2::ZERO, DVec2::ONE))
     }
 }
 

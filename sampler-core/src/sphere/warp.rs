@@ -150,35 +150,6 @@ fn rescale(xi: &mut DVec2, ox: f64, wx: f64, oy: f64, wy: f64) {
     xi.y = (oy * wx * r).clamp(0.0, ONE_MINUS_EPSILON);
 }
 
-/// 4^depth exactly (no_std has no powi): the inverse of a depth-`depth` cell's area.
-#[inline(always)]
-pub(crate) fn inverse_area(depth: u32) -> f64 {
-    f64::from_bits((1023 + 2 * depth as u64) << 52)
-}
-
-/// Places a uniform point `xi` ∈ [0,1)² inside cell `(x, y)` of a `2^level` grid, returning
-/// square coordinates that are guaranteed to lie in that cell (f32 rounding could otherwise
-/// push a point onto the next cell's edge).
-#[inline]
-#[must_use]
-pub fn point_in_cell(x: u32, y: u32, level: u32, xi: DVec2) -> glam::Vec2 {
-    // 2^−level exactly, without a division.
-    let inv = f64::from_bits((1023 - level as u64) << 52);
-    let coord = |i: u32, f: f64| -> f32 {
-        let lo = (i as f64 * inv) as f32; // exact: dyadic
-        let hi = ((i + 1) as f64 * inv) as f32;
-        let c = ((i as f64 + f) * inv) as f32;
-        if c >= hi { next_down(hi).max(lo) } else { c.max(lo) }
-    };
-    glam::Vec2::new(coord(x, xi.x), coord(y, xi.y))
-}
-
-/// The largest f32 below a positive finite `x`.
-#[inline]
-fn next_down(x: f32) -> f32 {
-    if x <= 0.0 { x } else { f32::from_bits(x.to_bits() - 1) }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,14 +196,5 @@ mod tests {
         let c = choose_child([1.0, 1.0, 1.0, 1.0], &mut xi).unwrap();
         assert_eq!(c, 1 + 2);
         assert!((xi - DVec2::new(0.5, 0.0)).abs().max_element() < 1e-15);
-    }
-
-    #[test]
-    fn points_stay_inside_their_cell() {
-        let p = point_in_cell(8191, 8191, 13, DVec2::splat(ONE_MINUS_EPSILON));
-        assert!(p.x < 1.0 && p.y < 1.0);
-        assert_eq!(crate::mapping::texel_of(p, 8192), (8191, 8191));
-        let p = point_in_cell(5, 0, 3, DVec2::new(ONE_MINUS_EPSILON, 0.0));
-        assert_eq!(crate::mapping::texel_of(p, 8), (5, 0));
     }
 }

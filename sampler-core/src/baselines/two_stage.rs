@@ -18,11 +18,12 @@
 //! this method).
 
 use crate::brdf::Brdf;
+use crate::cell::Cell;
 use crate::env::{EnvHierarchy, luminance};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
 use crate::sampler::DirectionSample;
-use crate::warp::{ONE_MINUS_EPSILON, point_in_cell};
+use crate::warp::ONE_MINUS_EPSILON;
 use glam::{DVec2, Vec2, Vec3};
 use heapless::Vec;
 
@@ -47,7 +48,7 @@ pub fn build_sat(env: &EnvHierarchy<'_>, sat: &mut [f64]) -> bool {
         let mut row = 0.0f64;
         sat[(y + 1) * stride] = 0.0;
         for x in 0..n {
-            row += env.node_relative(level, x as u32, y as u32) as f64;
+            row += env.node_relative(Cell::new(level, x as u32, y as u32)) as f64;
             sat[(y + 1) * stride + x + 1] = sat[y * stride + x + 1] + row;
         }
     }
@@ -214,7 +215,7 @@ impl<'a, 'e, const R: usize> TwoStageSampler<'a, 'e, R> {
         let below = self.sum(x, r.y0, x + 1, y);
         let cell = self.sum(x, y, x + 1, y + 1);
         xi.y = if cell > 0.0 { ((target_y - below) / cell).clamp(0.0, ONE_MINUS_EPSILON) } else { 0.5 };
-        let uv = point_in_cell(x, y, self.env.finest_level(), xi);
+        let uv = Cell::new(self.env.finest_level(), x, y).point(xi);
         let pdf = self.pdf_texel(k, x, y) / SPHERE_AREA;
         (pdf > 0.0).then(|| DirectionSample { dir: self.env.dir_of(uv), uv, pdf })
     }
@@ -228,7 +229,7 @@ impl<'a, 'e, const R: usize> TwoStageSampler<'a, 'e, R> {
         }
         let weight = r.btilde as f64 * r.integral / total;
         let n = self.env.resolution() as f64;
-        (weight * self.env.node_relative(self.env.finest_level(), x, y) as f64 / r.integral * n * n) as f32
+        (weight * self.env.node_relative(Cell::new(self.env.finest_level(), x, y)) as f64 / r.integral * n * n) as f32
     }
 
     /// Density per unit area of the square at `uv`.

@@ -19,12 +19,13 @@
 //! out.
 
 use crate::brdf::Brdf;
+use crate::cell::Cell;
 use crate::cone::{Cone, cell_count, level_of, morton_cell};
-use crate::env::{EnvHierarchy, level_offset, luminance, morton2};
+use crate::env::{EnvHierarchy, level_offset, luminance};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
 use crate::sampler::DirectionSample;
-use crate::warp::{ONE_MINUS_EPSILON, point_in_cell};
+use crate::warp::ONE_MINUS_EPSILON;
 use glam::{DVec2, Vec2, Vec3};
 
 /// Where B̃ is estimated by evaluation, each cell's weight is at least this fraction of the
@@ -220,9 +221,9 @@ impl<'e> TwoLevelSampler<'_, 'e> {
         }
         xi.x = ((t - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
         let (cx, cy) = morton_cell(c);
-        let (x, y) = self.env.warp_down(self.level, cx, cy, &mut xi)?;
-        let uv = point_in_cell(x, y, self.env.finest_level(), xi);
-        let pdf = self.pdf_texel(c, x, y) / SPHERE_AREA;
+        let texel = self.env.warp_down(Cell::new(self.level, cx, cy), &mut xi)?;
+        let uv = texel.point(xi);
+        let pdf = self.pdf_texel(c, texel) / SPHERE_AREA;
         (pdf > 0.0).then(|| DirectionSample { dir: self.env.dir_of(uv), uv, pdf })
     }
 
@@ -232,16 +233,16 @@ impl<'e> TwoLevelSampler<'_, 'e> {
         (if c == 0 { 0.0 } else { self.cumulative[c - 1] }, self.cumulative[c])
     }
 
-    /// Density per unit area of the square in finest-level texel (x, y) of cell `c`.
-    fn pdf_texel(&self, c: usize, x: u32, y: u32) -> f32 {
+    /// Density per unit area of the square in a finest-level texel of cell `c`.
+    fn pdf_texel(&self, c: usize, texel: Cell) -> f32 {
         let total = self.total();
         let (lo, hi) = self.bounds(c);
         let (cx, cy) = morton_cell(c);
-        let cell = f64::from(self.env.node_relative(self.level, cx, cy));
+        let cell = f64::from(self.env.node_relative(Cell::new(self.level, cx, cy)));
         if !(total > 0.0 && cell > 0.0) {
             return 0.0;
         }
-        let texel = f64::from(self.env.node_relative(self.env.finest_level(), x, y));
+        let texel = f64::from(self.env.node_relative(texel));
         ((hi - lo) / total * cell_count(self.level) as f64 * texel / cell) as f32
     }
 
@@ -249,8 +250,8 @@ impl<'e> TwoLevelSampler<'_, 'e> {
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
         let (x, y) = self.env.texel_at(uv);
-        let shift = self.env.finest_level() - self.level;
-        self.pdf_texel(morton2(x >> shift, y >> shift), x, y)
+        let texel = Cell::new(self.env.finest_level(), x, y);
+        self.pdf_texel(texel.ancestor(self.level).morton(), texel)
     }
 
     /// Density with respect to solid angle of world direction `dir`.

@@ -1,0 +1,131 @@
+//! One gprim into the scene: a sphere kept as a sphere when its transform is a uniform scale,
+//! anything else as triangles in world space, one mesh per material of its faces.
+
+use super::Importer;
+use crate::mesh::{self, LocalMesh};
+use crate::scene::{Mesh, Sphere};
+use crate::shapes;
+use crate::xform::uniform_scale;
+use glam::{DMat3, DMat4, DVec3, Vec3};
+use std::collections::HashMap;
+
+impl Importer<'_> {
+    /// One gprim with its local-to-renderer transform `m`.
+    pub(super) fn gprim(&mut self, prim: &str, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
+        let stage = self.stage;
+        let double_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
+        let material = self.material_for(prim)?;
+        self.scene.counts.gprims += 1;
+        if type_name == "Sphere"
+            && let Some(s) = uniform_scale(m)
+        {
+            let r = shapes::number(stage, prim, "radius", 1.0)? * s;
+            let center = m.transform_point3(DVec3::ZERO);
+            if !(r.is_finite() && center.is_finite()) {
+                return Err("the sphere's transform or radius is not finite".into());
+            }
+            let (c, r) = (center.as_vec3(), r as f32);
+            self.grow(c - Vec3::splat(r));
+            self.grow(c + Vec3::splat(r));
+            let path = label.to_string();
+            self.scene.spheres.push(Sphere { path, center: c, radius: r, material, double_sided });
+            return Ok(());
+        }
+        // Per-face materials from GeomSubsets of the materialBind family.
+        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
+        let local = if type_name == "Mesh" {
+            self.scene.counts.meshes += 1;
+            // Texture coordinates only for a mesh whose materials read textures.
+            let uv = std::iter::once(material)
+                .chain(face_materials.iter().map(|f| f.1))
+                .find_map(|m| self.scene.materials[m].textures.first().map(|t| t.source.varname.clone()));
+            mesh::read(stage, prim, uv.as_deref())?
+        } else {
+            shapes::tessellate(stage, prim, type_name)?.unwrap_or_default()
+        };
+        let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
+        for (i, &face) in local.faces.iter().enumerate() {
+            let mat = face_materials.iter().find(|(faces, _)| faces.contains(&(face as i64))).map_or(material, |f| f.1);
+            groups.entry(mat).or_default().push(i);
+        }
+        let mut keys: Vec<usize> = groups.keys().copied().collect();
+        keys.sort_unstable();
+        let m3 = DMat3::from_mat4(*m);
+        let det = m3.determinant();
+        if !(det.is_finite() && det != 0.0) {
+            self.skip(label, "its world transform is singular (the gprim has no area)");
+            return Ok(());
+        }
+        let normal_matrix = m3.inverse().transpose();
+        for mat in keys {
+            let mesh = transform(&local, &groups[&mat], m, &normal_matrix, det < 0.0, label, mat, double_sided)?;
+            self.scene.counts.triangles += mesh.triangles.len();
+            for &p in &mesh.positions {
+                self.grow(p);
+            }
+            self.scene.meshes.push(mesh);
+        }
+        Ok(())
+    }
+
+    /// Grows the scene's bounds to hold `p`.
+    pub(super) fn grow(&mut self, p: Vec3) {
+        let b = self.scene.bounds.get_or_insert((p, p));
+        *b = (b.0.min(p), b.1.max(p));
+    }
+}
+
+/// The triangles `which` of a local mesh, transformed by `m` (non-singular; normals by
+/// `normal_matrix`, its inverse transpose; winding reversed when it `mirror`s).
+#[allow(clippy::too_many_arguments)]
+fn transform(
+    local: &LocalMesh,
+    which: &[usize],
+    m: &DMat4,
+    normal_matrix: &DMat3,
+    mirror: bool,
+    label: &str,
+    material: usize,
+    double_sided: bool,
+) -> Result<Mesh, String> {
+    let mut remap: HashMap<u32, u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::with_capacity(which.len());
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    for &i in which {
+        let mut t = local.triangles[i];
+        let mut n = local.normals.get(i).copied();
+        let mut uv = local.uvs.get(i).copied();
+        if mirror {
+            t.swap(1, 2);
+            if let Some(n) = n.as_mut() {
+                n.swap(1, 2);
+            }
+            if let Some(uv) = uv.as_mut() {
+                uv.swap(1, 2);
+            }
+        }
+        uvs.extend(uv);
+        let t = t.map(|v| {
+            *remap.entry(v).or_insert_with(|| {
+                positions.push(m.transform_point3(local.positions[v as usize]).as_vec3());
+                (positions.len() - 1) as u32
+            })
+        });
+        triangles.push(t);
+        if let Some(n) = n {
+            normals.push(n.map(|n| (*normal_matrix * n).normalize_or_zero().as_vec3()));
+        }
+    }
+    if normals.len() != triangles.len() {
+        normals.clear();
+    }
+    if uvs.len() != triangles.len() {
+        uvs.clear();
+    }
+    if positions.iter().any(|p: &Vec3| !p.is_finite()) {
+        return Err("a transformed point is not finite".into());
+    }
+    Ok(Mesh { path: label.to_string(), positions, triangles, normals, uvs, material, double_sided })
+}

@@ -1,0 +1,89 @@
+//! The materials of a gprim: the UsdPreviewSurface bound to it (imported on first use), its
+//! displayColor when nothing is bound, or a fallback; and per-face materials from its
+//! `materialBind` GeomSubsets.
+
+use super::Importer;
+use crate::material::Material;
+use crate::stage::Value;
+use glam::Vec3;
+use std::collections::HashSet;
+
+impl Importer<'_> {
+    /// (faces, material) of the mesh's `materialBind` GeomSubsets that bind a material.
+    pub(super) fn subset_materials(&mut self, prim: &str) -> Result<Vec<(HashSet<i64>, usize)>, String> {
+        let mut out = Vec::new();
+        for child in self.stage.children(prim)? {
+            if self.stage.type_name(&child)? != "GeomSubset" {
+                continue;
+            }
+            let family = self.stage.value(&child, "familyName")?;
+            if family.as_ref().and_then(Value::token) != Some("materialBind") {
+                continue;
+            }
+            if self.stage.bound_material(&child)?.is_none() {
+                continue;
+            }
+            let faces = match self.stage.value(&child, "indices")? {
+                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
+                _ => Default::default(),
+            };
+            let mat = self.material_for(&child)?;
+            out.push((faces, mat));
+        }
+        Ok(out)
+    }
+
+    /// The index of the material bound to `prim` (imported on first use), or of a fallback.
+    pub(super) fn material_for(&mut self, prim: &str) -> Result<usize, String> {
+        let bound = self.stage.bound_material(prim)?;
+        // Unbound gprims show their displayColor (its mean over the elements), as viewers do.
+        let display = match &bound {
+            Some(_) => None,
+            None => crate::primvar::Primvar::read(self.stage, prim, "displayColor", None)?
+                .filter(|p| p.width == 3 && !p.is_empty())
+                .map(|p| {
+                    let n = p.len();
+                    let sum = (0..n)
+                        .filter_map(|i| p.element(i))
+                        .fold([0.0; 3], |a, e| [a[0] + e[0], a[1] + e[1], a[2] + e[2]]);
+                    Vec3::new((sum[0] / n as f64) as f32, (sum[1] / n as f64) as f32, (sum[2] / n as f64) as f32)
+                }),
+        };
+        let key = match (&bound, display) {
+            (Some(m), _) => m.clone(),
+            (None, Some(c)) => format!("<displayColor {} {} {}>", c.x, c.y, c.z),
+            (None, None) => "<fallback>".to_string(),
+        };
+        if let Some(&i) = self.materials.get(&key) {
+            return Ok(i);
+        }
+        let material = match &bound {
+            None => {
+                let mut m = Material::fallback(&key);
+                if let Some(c) = display {
+                    m.diffuse_color = c;
+                }
+                m
+            }
+            Some(path) => match self.stage.surface_shader(path)? {
+                Some((shader, id)) if id == "UsdPreviewSurface" => {
+                    let (m, notes) = Material::read(self.stage, path, &shader)?;
+                    notes.into_iter().for_each(|n| self.skip(path, n));
+                    m
+                }
+                Some((shader, id)) => {
+                    self.skip(path, format!("surface shader {shader} ({id}) is not a UsdPreviewSurface (MaterialX?); fallback material used"));
+                    Material::fallback(path)
+                }
+                None => {
+                    self.skip(path, "no surface shader; fallback material used");
+                    Material::fallback(path)
+                }
+            },
+        };
+        self.scene.materials.push(material);
+        let i = self.scene.materials.len() - 1;
+        self.materials.insert(key, i);
+        Ok(i)
+    }
+}

@@ -1,0 +1,332 @@
+//! The borrowed view over a caller-owned pyramid: the map's orientation and tint, its nodes
+//! relative to the mean, radiance lookups and the env-only density.
+
+use super::pyramid::{EnvError, check_lengths, level_offset, pyramid_index};
+use crate::cell::Cell;
+use crate::mapping::{
+    SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
+};
+use glam::{Mat3, Vec2, Vec3};
+
+/// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
+#[derive(Clone, Copy, Debug)]
+pub struct EnvHierarchy<'a> {
+    pub(crate) finest: u32,
+    pub(crate) pyramid: &'a [f32],
+    radiance: &'a [[f32; 3]],
+    /// 1 / mean importance, or 0 for a black map.
+    inv_mean: f32,
+    tint: Vec3,
+    world_to_map: Mat3,
+    map_to_world: Mat3,
+}
+
+impl<'a> EnvHierarchy<'a> {
+    /// A view over `pyramid` (filled by [`build_pyramid`](super::build_pyramid)) and the finest-level `radiance`.
+    pub fn new(finest: u32, pyramid: &'a [f32], radiance: &'a [[f32; 3]]) -> Result<Self, EnvError> {
+        check_lengths(finest, radiance.len(), pyramid.len())?;
+        let mean = pyramid[0];
+        if !mean.is_finite() || mean < 0.0 {
+            return Err(EnvError::NotSanitized);
+        }
+        let inv_mean = if mean > 0.0 { 1.0 / mean } else { 0.0 };
+        let inv_mean = if inv_mean.is_finite() { inv_mean } else { 0.0 };
+        Ok(Self {
+            finest,
+            pyramid,
+            radiance,
+            inv_mean,
+            tint: Vec3::ONE,
+            world_to_map: Mat3::IDENTITY,
+            map_to_world: Mat3::IDENTITY,
+        })
+    }
+
+    /// Orients the map: `map_to_world` takes directions of the map's own frame (the frame
+    /// [`square_to_sphere`] works in) to world space. Must be a rotation.
+    #[must_use]
+    pub fn with_rotation(mut self, map_to_world: Mat3) -> Self {
+        self.map_to_world = map_to_world;
+        self.world_to_map = map_to_world.transpose();
+        self
+    }
+
+    /// Multiplies every radiance lookup (e.g. a light's colour × intensity). Sampling
+    /// densities are unaffected.
+    #[must_use]
+    pub fn with_tint(mut self, tint: Vec3) -> Self {
+        self.tint = tint;
+        self
+    }
+
+    /// Finest level `K` (the map is `2^K × 2^K`).
+    #[inline]
+    #[must_use]
+    pub fn finest_level(&self) -> u32 {
+        self.finest
+    }
+
+    /// Side length of the finest level in texels.
+    #[inline]
+    #[must_use]
+    pub fn resolution(&self) -> u32 {
+        1 << self.finest
+    }
+
+    /// True when the map is black everywhere: nothing to sample, every estimate is 0.
+    #[inline]
+    #[must_use]
+    pub fn is_black(&self) -> bool {
+        self.inv_mean == 0.0
+    }
+
+    /// Mean importance of a node (a cell of level ≤ K), relative to the whole map's mean (so
+    /// the map averages to 1 whatever its absolute scale).
+    #[inline]
+    #[must_use]
+    pub fn node_relative(&self, node: Cell) -> f32 {
+        self.pyramid[pyramid_index(node)] * self.inv_mean
+    }
+
+    /// The 16 grandchildren of a node of level < K − 1, as stored
+    /// (not relative to the mean: for ratios), in the Morton order of
+    /// [`crate::warp::choose_grandchild`] — one cache line.
+    #[inline]
+    #[must_use]
+    pub fn grandchildren_raw(&self, node: Cell) -> &[f32; 16] {
+        let base = level_offset(node.level + 2) + 16 * node.morton();
+        self.pyramid[base..base + 16].try_into().expect("16 grandchildren")
+    }
+
+    /// The four children of a node of level < K, relative to the mean,
+    /// in [`child_offset`](crate::warp::child_offset) order.
+    #[inline]
+    #[must_use]
+    pub fn children_relative(&self, node: Cell) -> [f32; 4] {
+        let base = level_offset(node.level + 1) + 4 * node.morton();
+        let q = &self.pyramid[base..base + 4];
+        let s = self.inv_mean;
+        [q[0] * s, q[1] * s, q[2] * s, q[3] * s]
+    }
+
+    /// How peaked the lighting is at a scale: the largest node of `level` (clamped to the
+    /// finest) relative to the mean — 1 for a constant map, ~700 for a sky with a sun at
+    /// level 5 (cells ~6.4° wide). A cheap test of whether sampling the lighting can pay.
+    #[must_use]
+    pub fn peak(&self, level: u32) -> f32 {
+        let level = level.min(self.finest);
+        let n = 1u32 << level;
+        let mut max = 0.0f32;
+        for y in 0..n {
+            for x in 0..n {
+                max = max.max(self.node_relative(Cell::new(level, x, y)));
+            }
+        }
+        if max.is_finite() { max } else { f32::MAX }
+    }
+
+    /// Mean importance (relative) of the region covered by a quadtree cell at any depth:
+    /// below the finest level a cell lies inside one texel.
+    #[inline]
+    #[must_use]
+    pub fn cell_relative(&self, cell: Cell) -> f32 {
+        if cell.level <= self.finest {
+            self.node_relative(cell)
+        } else {
+            self.node_relative(cell.ancestor(self.finest))
+        }
+    }
+
+    /// The rotation taking world directions to the map's frame.
+    #[inline]
+    #[must_use]
+    pub fn world_to_map(&self) -> Mat3 {
+        self.world_to_map
+    }
+
+    /// World direction → map direction.
+    #[inline]
+    #[must_use]
+    pub fn to_map(&self, world: Vec3) -> Vec3 {
+        self.world_to_map * world
+    }
+
+    /// Map direction → world direction.
+    #[inline]
+    #[must_use]
+    pub fn to_world(&self, map: Vec3) -> Vec3 {
+        self.map_to_world * map
+    }
+
+    /// Point of the equal-area square seen in world direction `dir`.
+    #[inline]
+    #[must_use]
+    pub fn square_of(&self, dir: Vec3) -> Vec2 {
+        sphere_to_square(self.to_map(dir))
+    }
+
+    /// World direction of a point of the square.
+    #[inline]
+    #[must_use]
+    pub fn dir_of(&self, uv: Vec2) -> Vec3 {
+        self.to_world(square_to_sphere(uv))
+    }
+
+    /// [`dir_of`](Self::dir_of) for every point of `uv` (as many as both hold), four lanes at a
+    /// time, bit for bit.
+    pub fn dirs_of(&self, uv: &[Vec2], out: &mut [Vec3]) {
+        let n = uv.len().min(out.len());
+        square_to_sphere_batch(&uv[..n], &mut out[..n]);
+        for d in &mut out[..n] {
+            *d = self.to_world(*d);
+        }
+    }
+
+    /// [`square_of`](Self::square_of) for every direction of `dirs` (as many as both hold), four
+    /// lanes at a time, bit for bit.
+    pub fn squares_of(&self, dirs: &[Vec3], out: &mut [Vec2]) {
+        for (ds, os) in dirs.chunks(16).zip(out.chunks_mut(16)) {
+            let n = ds.len().min(os.len());
+            let mut local = [Vec3::ZERO; 16];
+            for (l, d) in local.iter_mut().zip(ds) {
+                *l = self.to_map(*d);
+            }
+            sphere_to_square_batch(&local[..n], &mut os[..n]);
+        }
+    }
+
+    /// Finest-level texel containing a point of the square.
+    #[inline]
+    #[must_use]
+    pub fn texel_at(&self, uv: Vec2) -> (u32, u32) {
+        texel_of(uv, self.resolution())
+    }
+
+    /// RGB radiance of a finest-level texel (tint applied).
+    #[inline]
+    #[must_use]
+    pub fn radiance_texel(&self, x: u32, y: u32) -> Vec3 {
+        let i = y as usize * self.resolution() as usize + x as usize;
+        Vec3::from_array(self.radiance[i]) * self.tint
+    }
+
+    /// RGB radiance arriving from world direction `dir` (nearest texel).
+    #[inline]
+    #[must_use]
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        self.radiance_at(self.square_of(dir))
+    }
+
+    /// RGB radiance at a point of the square (nearest texel): for samplers that drew the point,
+    /// no round trip through the direction.
+    #[inline]
+    #[must_use]
+    pub fn radiance_at(&self, uv: Vec2) -> Vec3 {
+        let (x, y) = self.texel_at(uv);
+        self.radiance_texel(x, y)
+    }
+
+    /// Env-only density per unit area of the square at `uv` (mean 1 over the square).
+    #[inline]
+    #[must_use]
+    pub fn pdf_square(&self, uv: Vec2) -> f32 {
+        let (x, y) = self.texel_at(uv);
+        self.node_relative(Cell::new(self.finest, x, y))
+    }
+
+    /// Env-only density with respect to solid angle of world direction `dir`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        self.pdf_square(self.square_of(dir)) / SPHERE_AREA
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::{build_pyramid, luminance};
+
+    #[test]
+    fn batched_directions_and_points_are_bit_identical() {
+        let rgb = [[1.0f32; 3]; 16];
+        let mut p = [0.0f32; 21];
+        build_pyramid(2, &rgb, &mut p).unwrap();
+        let e = EnvHierarchy::new(2, &p, &rgb)
+            .unwrap()
+            .with_rotation(Mat3::from_rotation_y(0.7) * Mat3::from_rotation_x(-0.3));
+        let mut uv = [Vec2::ZERO; 67];
+        for (k, u) in uv.iter_mut().enumerate() {
+            *u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.754_877_7).fract());
+        }
+        let mut dirs = [Vec3::ZERO; 67];
+        e.dirs_of(&uv, &mut dirs);
+        let mut back = [Vec2::ZERO; 67];
+        e.squares_of(&dirs, &mut back);
+        for k in 0..uv.len() {
+            assert_eq!(dirs[k].to_array().map(f32::to_bits), e.dir_of(uv[k]).to_array().map(f32::to_bits));
+            assert_eq!(back[k].to_array().map(f32::to_bits), e.square_of(dirs[k]).to_array().map(f32::to_bits));
+        }
+    }
+
+    #[test]
+    fn children_are_the_next_level_and_average_to_the_parent() {
+        let mut rgb = [[0.0f32; 3]; 64];
+        for (i, t) in rgb.iter_mut().enumerate() {
+            *t = [(i * 7 % 11) as f32, 1.0, (i % 5) as f32];
+        }
+        let mut p = [0.0f32; 85];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        let e = EnvHierarchy::new(3, &p, &rgb).unwrap();
+        for l in 0..3u32 {
+            for y in 0..(1u32 << l) {
+                for x in 0..(1u32 << l) {
+                    let c = e.children_relative(Cell::new(l, x, y));
+                    let at = |dx, dy| e.node_relative(Cell::new(l + 1, 2 * x + dx, 2 * y + dy));
+                    assert_eq!(c, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)]);
+                    let mean = 0.25 * c.iter().sum::<f32>();
+                    assert!((mean - e.node_relative(Cell::new(l, x, y))).abs() <= 1e-6 * mean);
+                }
+            }
+        }
+        // The finest level reads back the row-major input.
+        assert_eq!(e.node_relative(Cell::new(3, 5, 2)) / e.inv_mean, luminance(Vec3::from_array(rgb[2 * 8 + 5])));
+    }
+
+    #[test]
+    fn huge_radiance_does_not_overflow_the_mean() {
+        let rgb = [[3.0e38f32; 3]; 4];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &rgb, &mut p).unwrap();
+        assert!(p[0].is_finite());
+        let env = EnvHierarchy::new(1, &p, &rgb).unwrap();
+        assert!((env.node_relative(Cell::new(1, 1, 1)) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn peak_measures_how_concentrated_the_light_is() {
+        // 8×8 map: constant → 1; one texel 64× brighter than the others.
+        let mut rgb = [[1.0f32; 3]; 64];
+        let mut p = [0.0f32; 85];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        assert!((EnvHierarchy::new(3, &p, &rgb).unwrap().peak(5) - 1.0).abs() < 1e-6);
+        rgb[9] = [64.0; 3];
+        build_pyramid(3, &rgb, &mut p).unwrap();
+        let env = EnvHierarchy::new(3, &p, &rgb).unwrap();
+        // Mean (63 + 64)/64; at level 3 the bright texel is its own block, at level 1 it
+        // shares a block with 15 others.
+        let mean = 127.0 / 64.0;
+        assert!((env.peak(5) - 64.0 / mean).abs() < 1e-4);
+        assert!((env.peak(1) - (15.0 + 64.0) / 16.0 / mean).abs() < 1e-4);
+        assert!((env.peak(0) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn wrong_lengths_are_errors() {
+        let rgb = [[0.0f32; 3]; 4];
+        let p = [0.0f32; 4];
+        assert!(matches!(EnvHierarchy::new(1, &p, &rgb), Err(EnvError::WrongLength { .. })));
+        let p = [f32::NAN; 5];
+        assert_eq!(EnvHierarchy::new(1, &p, &rgb).unwrap_err(), EnvError::NotSanitized);
+    }
+}

@@ -1,0 +1,150 @@
+//! Env-only descents side by side: many points warped [`LANES`] at a time, branch-free within a
+//! level, so that one descent's loads and arithmetic overlap the others' instead of each
+//! waiting on its own mispredicted branches (one per level and axis, each a coin flip). The
+//! product's lanes (`product/lanes.rs`) continue below their leaves with the same
+//! [`WarpLane`]s.
+
+use super::EnvHierarchy;
+use super::pyramid::level_offset;
+use crate::cell::Cell;
+use crate::direction::DirectionSample;
+use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
+use glam::{DVec2, Vec2, Vec3};
+
+/// Descents advanced side by side: enough that the loads of the map's deep levels, which miss
+/// the caches, overlap.
+pub(crate) const LANES: usize = 8;
+
+/// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WarpLane {
+    pub cell: Cell,
+    /// Morton index of the cell within its level.
+    morton: usize,
+    pub xi: DVec2,
+    /// False once the descent met a node without mass (or never started).
+    pub alive: bool,
+}
+
+impl WarpLane {
+    /// A descent from `node` with the point `u` (clamped into [0, 1)²).
+    pub(crate) fn new(node: Cell, u: DVec2) -> Self {
+        let xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
+        Self { cell: node, morton: node.morton(), xi, alive: true }
+    }
+
+    #[inline(always)]
+    fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
+        let c = &mut self.cell;
+        (c.level, c.x, c.y) = (c.level + levels, (c.x << levels) + dx, (c.y << levels) + dy);
+        self.morton = (self.morton << (2 * levels)) + child;
+    }
+}
+
+impl EnvHierarchy<'_> {
+    /// Env samples for many points, [`LANES`] descents side by side (each level's loads and
+    /// arithmetic of the lanes are independent, so they overlap), branch-free within a level.
+    /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
+    /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
+    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
+        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let n = us.len().min(os.len());
+            let mut lanes = [WarpLane::default(); LANES];
+            for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
+                *lane = WarpLane::new(Cell::ROOT, *u);
+            }
+            self.warp_down_lanes(&mut lanes[..n]);
+            // The points and densities, then the directions at once.
+            let mut points = [(Vec2::ZERO, 0.0); LANES];
+            for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
+                *p = self.point_in_texel(lane.cell, lane.xi);
+            }
+            let mut dirs = [Vec3::ZERO; LANES];
+            self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
+            for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
+                let (uv, pdf) = points[k];
+                *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv, pdf });
+            }
+        }
+    }
+
+    /// [`warp_down`](Self::warp_down) for up to a few descents at once, each from its own node,
+    /// advanced level by level side by side. A lane that meets a node without mass dies.
+    pub(crate) fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
+        if self.is_black() {
+            lanes.iter_mut().for_each(|l| l.alive = false);
+            return;
+        }
+        loop {
+            let mut busy = false;
+            for lane in lanes.iter_mut().filter(|l| l.alive && l.cell.level < self.finest) {
+                busy = true;
+                if lane.cell.level + 2 <= self.finest {
+                    let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
+                    let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().unwrap();
+                    match choose_grandchild_branchless(g, &mut lane.xi) {
+                        Some((c, gx, gy)) => lane.step(2, gx, gy, c),
+                        None => lane.alive = false,
+                    }
+                } else {
+                    let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
+                    let q = &self.pyramid[base..base + 4];
+                    match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
+                        Some(c) => {
+                            let (dx, dy) = child_offset(c);
+                            lane.step(1, dx, dy, c);
+                        }
+                        None => lane.alive = false,
+                    }
+                }
+            }
+            if !busy {
+                return;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::{build_pyramid, pyramid_len};
+    use crate::mapping::SPHERE_AREA;
+
+    #[test]
+    fn sample_many_draws_what_sample_draws() {
+        let mut rgb = [[0.0f32; 3]; 32 * 32];
+        for (i, t) in rgb.iter_mut().enumerate() {
+            *t = [(i * 7 % 13) as f32, (i % 3) as f32, if i == 300 { 1e6 } else { 0.5 }];
+        }
+        rgb[17] = [0.0; 3];
+        for level in [4u32, 5] {
+            let n = 1usize << level;
+            let texels = &rgb[..n * n];
+            let mut p = [0.0f32; 1365];
+            let p = &mut p[..pyramid_len(level)];
+            build_pyramid(level, texels, p).unwrap();
+            let e = EnvHierarchy::new(level, p, texels).unwrap();
+            let mut u = [DVec2::ZERO; 4099];
+            crate::points::sobol02(level as u64, 0, &mut u);
+            u[3] = DVec2::new(1.0, 0.0); // clamped like `sample` clamps
+            let mut out = [None; 4099];
+            e.sample_many(&u, &mut out);
+            let mut moved = 0;
+            for (a, b) in u.iter().zip(&out) {
+                let (a, b) = (e.sample(*a).unwrap(), b.unwrap());
+                // Same cell; the point inside may differ in the last bits.
+                moved += usize::from(e.texel_at(a.uv) != e.texel_at(b.uv));
+                assert!((a.uv - b.uv).abs().max_element() < 1e-5, "{a:?} {b:?}");
+                assert_eq!(b.pdf, e.pdf_square(b.uv) / SPHERE_AREA);
+            }
+            assert!(moved <= 2, "{moved} of 4099 in another texel");
+        }
+        let black = [[0.0f32; 3]; 4];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &black, &mut p).unwrap();
+        let mut out = [Some(DirectionSample { dir: Vec3::Z, uv: Vec2::ZERO, pdf: 1.0 }); 5];
+        EnvHierarchy::new(1, &p, &black).unwrap().sample_many(&[DVec2::splat(0.5); 5], &mut out);
+        assert!(out.iter().all(Option::is_none));
+    }
+}

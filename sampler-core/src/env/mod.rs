@@ -1,0 +1,28 @@
+//! The environment hierarchy: a borrowed view over a caller-owned mip pyramid of the
+//! equal-area map.
+//!
+//! Level `k` is a `2^k × 2^k` grid of scalar importance (luminance) with `x` along `u` and `y`
+//! along `v`, stored in Morton (Z) order so that a node's four children are one contiguous
+//! 16-byte block and a subtree stays together in memory — the warp touches one cache line per
+//! level. Levels are packed from the 1×1 root down to the finest level `K`: level `k` starts at
+//! [`level_offset`]`(k)`, node `(x, y)` of level `k` (a [`Cell`](crate::cell::Cell)) sits at [`pyramid_index`]; the whole pyramid holds
+//! [`pyramid_len`]`(K)` values (4/3 of the finest level). Because every texel of the equal-area
+//! map covers the same solid angle, each coarser texel is the plain mean of its four children.
+//! RGB radiance for shading is kept at the finest level only, row-major. Lookups are
+//! nearest-texel, the same piecewise-constant function the sampling densities are built from, so
+//! radiance cancels exactly in the product estimator.
+//!
+//! The pyramid's layout and builders are in `pyramid.rs`, the view over it in `hierarchy.rs`,
+//! env-only sampling in `sample.rs` and the same four descents at a time in `lanes.rs`.
+
+mod hierarchy;
+mod lanes;
+mod pyramid;
+mod sample;
+
+pub use hierarchy::EnvHierarchy;
+pub(crate) use lanes::{LANES, WarpLane};
+pub use pyramid::{
+    EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, pyramid_index,
+    pyramid_len, sanitize_rgb,
+};

@@ -1,0 +1,213 @@
+//! The caller-owned scratch memory of the product and its build: K BRDF samples drawn from a
+//! randomised (0,2)-sequence, the quadtree over their points with the product computed in the
+//! same traversal, then each node's path probability.
+
+use super::bilinear::Corners;
+use super::params::{ProductError, ProductParams};
+use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder, sort_key};
+use super::sampler::ProductSampler;
+use crate::brdf::{Brdf, BrdfDraw};
+use crate::env::{EnvHierarchy, luminance};
+use crate::frame::Frame;
+use crate::mapping::{sphere_to_square_batch, square_to_sphere};
+use crate::points::sobol02_shifted;
+use glam::{Mat3, Vec2, Vec3};
+use heapless::Vec;
+
+/// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
+/// Reused from point to point; never allocates. `size_of::<ProductArena<K, NODES>>()` is about
+/// 48·K + 16·NODES bytes: each node's 8 bytes and its path probability's 8. The default NODES
+/// holds the largest trees that 256 samples make (docs/perf.md#tree-size-and-memory); when
+/// NODES is exhausted, splitting stops and leaves keep the mean of their samples (still exact
+/// sampling). A bilinear B̃ ([`Leaves::Bilinear`]) also stores four corner values per node and
+/// needs CORNERS ≥ NODES (+16·NODES bytes); with the default CORNERS = 0 nobody pays for it and
+/// B̃ stays piecewise constant ([`ProductSampler::kind`] says what was built).
+pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const CORNERS: usize = 0> {
+    /// BRDF sample points, then the samples' points of the equal-area square.
+    points: [Vec2; K],
+    /// The BRDF's draws (shading frame).
+    draws: [BrdfDraw; K],
+    /// Usable samples' directions in the map frame.
+    dirs: [Vec3; K],
+    /// Usable samples' B·cos (luminance).
+    values: [f32; K],
+    keys: Vec<u64, K>,
+    nodes: Vec<Node, NODES>,
+    /// Per node, the probability that the warp reaches it (see `path_probabilities`).
+    paths: Vec<f64, NODES>,
+    /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
+    corners: Vec<Corners, CORNERS>,
+    /// What the last build made (`None` before the first).
+    built: Option<Built>,
+}
+
+/// What a build made, kept for [`ProductArena::last_built`].
+#[derive(Clone, Copy, Debug)]
+struct Built {
+    /// The effective defensive fraction.
+    defensive: f32,
+    /// The usable BRDF samples.
+    brdf_samples: usize,
+    /// The kind as built ([`ProductArena::buildable`]).
+    kind: ProductKind,
+}
+
+impl<const K: usize, const NODES: usize, const CORNERS: usize> Default for ProductArena<K, NODES, CORNERS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, NODES, CORNERS> {
+    const CAPACITY_OK: () = assert!(K >= 1 && K <= 1 << 16 && NODES >= 1);
+
+    /// An empty arena (large: place it in a `static`, a `Box` or a thread's stack).
+    #[must_use]
+    pub const fn new() -> Self {
+        let () = Self::CAPACITY_OK;
+        Self {
+            points: [Vec2::ZERO; K],
+            draws: [BrdfDraw { wi: Vec3::ZERO, value: 0.0 }; K],
+            dirs: [Vec3::ZERO; K],
+            values: [0.0; K],
+            keys: Vec::new(),
+            nodes: Vec::new(),
+            paths: Vec::new(),
+            corners: Vec::new(),
+            built: None,
+        }
+    }
+
+    /// Builds the product sampler of one shading point. `wo` is the world-space direction
+    /// towards the viewer, `frame` the shading frame, `seed` randomises the BRDF samples. More
+    /// BRDF samples than the arena's `K` is an error, never a silent clamp.
+    pub fn build<'a, 'e, B: Brdf + ?Sized>(
+        &'a mut self,
+        env: &'a EnvHierarchy<'e>,
+        brdf: &B,
+        frame: &Frame,
+        wo: Vec3,
+        params: &ProductParams,
+        seed: u64,
+    ) -> Result<ProductSampler<'a, 'e>, ProductError> {
+        if params.brdf_samples > K {
+            return Err(ProductError::AboveCapacity { asked: params.brdf_samples, capacity: K });
+        }
+        let kind = Self::buildable(params.kind);
+        let wo_local = frame.to_local(wo);
+        let k = params.brdf_samples;
+        self.keys.clear();
+        let mut count = 0;
+        if !env.is_black() && k > 0 {
+            // K BRDF samples from a randomised (0,2)-sequence, in one call.
+            sobol02_shifted(seed, 0, &mut self.points[..k]);
+            let drawn = brdf.sample_batch(wo_local, &self.points[..k], &mut self.draws[..k]);
+            // Shading frame → map frame in one matrix.
+            let local_to_map = env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n);
+            for d in &self.draws[..drawn.min(k)] {
+                let ok = |v: f32| v.is_finite() && v >= 0.0;
+                if ok(d.value) && d.wi.is_finite() {
+                    self.dirs[count] = local_to_map * d.wi;
+                    self.values[count] = d.value;
+                    count += 1;
+                }
+            }
+            let uvs = &mut self.points[..count];
+            sphere_to_square_batch(&self.dirs[..count], uvs);
+            for (idx, uv) in uvs.iter().enumerate() {
+                let _ = self.keys.push(sort_key(uv.x, uv.y, idx));
+            }
+            self.keys.sort_unstable();
+        }
+        // B·cos at a point of the square, for the empty cells that need it.
+        let map_to_local = (env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n)).transpose();
+        let eval = |uv: Vec2| luminance(brdf.eval(wo_local, map_to_local * square_to_sphere(uv)));
+        let mut builder = TreeBuilder {
+            keys: &self.keys,
+            values: &self.values[..count],
+            env,
+            nodes: &mut self.nodes,
+            max_depth: params.max_depth.min(COORD_BITS),
+            wavelet: kind.is_wavelet(),
+            eval,
+            probe_leaves: kind.leaves() == Leaves::Probed,
+            refine_share: kind.refine_share(),
+            bilinear: kind.leaves() == Leaves::Bilinear,
+            corners: &mut self.corners,
+        };
+        builder.build();
+        path_probabilities(&self.nodes, &mut self.paths);
+        let root = self.nodes.first().map_or(0.0, |n| n.product);
+        let has_product = root > 0.0 && root.is_finite();
+        let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
+        self.built = Some(Built { defensive, brdf_samples: count, kind });
+        let built: &'a Self = self;
+        Ok(built.last_built(env).expect("just built"))
+    }
+
+    /// The kind this arena builds when asked for `kind`: bilinear leaves need the corners'
+    /// storage (CORNERS ≥ NODES), and without it the leaves are built from the samples.
+    #[must_use]
+    pub const fn buildable(kind: ProductKind) -> ProductKind {
+        match kind {
+            ProductKind::Quadtree { leaves: Leaves::Bilinear, refine_share } if CORNERS < NODES => {
+                ProductKind::Quadtree { leaves: Leaves::Sampled, refine_share }
+            }
+            kind => kind,
+        }
+    }
+
+    /// The sampler the last [`build`](Self::build) made, again, without rebuilding it (the arena
+    /// holds it until the next build): for hosts that reuse one B̃ at nearby shading points.
+    /// `env` must be the environment it was built on. `None` before the first build.
+    #[must_use]
+    pub fn last_built<'a, 'e>(&'a self, env: &'a EnvHierarchy<'e>) -> Option<ProductSampler<'a, 'e>> {
+        let Built { defensive, brdf_samples, kind } = self.built?;
+        Some(ProductSampler {
+            env,
+            nodes: &self.nodes,
+            paths: &self.paths,
+            corners: &self.corners,
+            defensive,
+            brdf_samples,
+            kind,
+        })
+    }
+}
+
+/// Each node's path probability: the product of the branch probabilities from the root down to
+/// it, multiplied in the warp's order (so bit for bit what a descent would multiply). Computed
+/// once per build, top-down (children always follow their parent in `nodes`), so that the warp
+/// and the density read it at the leaf instead of dividing at every level.
+fn path_probabilities<const N: usize>(nodes: &[Node], paths: &mut Vec<f64, N>) {
+    paths.clear();
+    let _ = paths.resize(nodes.len(), 0.0);
+    if let Some(root) = paths.first_mut() {
+        *root = 1.0;
+    }
+    for (i, n) in nodes.iter().enumerate() {
+        if n.is_leaf() {
+            continue;
+        }
+        let first = n.child as usize;
+        let c = &nodes[first..first + 4];
+        let mass = [c[0].product, c[1].product, c[2].product, c[3].product];
+        for k in 0..4 {
+            paths[first + k] = paths[i] * branch_probability(mass, k);
+        }
+    }
+}
+
+/// Probability that the warp picks child `k` among four of masses `mass`: the column, then the
+/// row — m_k / Σm, computed as the warp's own two ratios.
+#[inline]
+pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
+    let m = mass.map(f64::from);
+    let (dx, dy) = (k & 1, k >> 1);
+    let total = m[0] + m[1] + m[2] + m[3];
+    let column = m[dx] + m[dx + 2];
+    if total <= 0.0 || column <= 0.0 {
+        return 0.0;
+    }
+    (column / total) * (m[dx + 2 * dy] / column)
+}
