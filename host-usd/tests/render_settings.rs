@@ -42,11 +42,11 @@ fn the_layer_names_the_settings_and_they_name_the_camera() {
     assert_eq!(s.camera.as_ref().unwrap().path, "/Second");
     assert!(s.skipped.is_empty(), "{:?}", s.skipped);
     // --render-settings chooses another; --camera overrides the settings' camera.
-    let options = Options { render_settings: Some("/Render/Preview".into()), camera: None };
+    let options = Options { render_settings: Some("/Render/Preview".into()), camera: None, ..Default::default() };
     let s = import_with("", TWO_SETTINGS, &options).unwrap();
     assert_eq!(s.render_settings.as_ref().unwrap().resolution, (320, 180));
     assert_eq!(s.camera.as_ref().unwrap().path, "/First");
-    let options = Options { render_settings: None, camera: Some("/First".into()) };
+    let options = Options { render_settings: None, camera: Some("/First".into()), ..Default::default() };
     let s = import_with("    renderSettingsPrimPath = \"/Render/Final\"", TWO_SETTINGS, &options).unwrap();
     assert_eq!(s.camera.as_ref().unwrap().path, "/First");
 }
@@ -100,7 +100,7 @@ fn bad_settings_are_errors_or_notes_naming_the_prim() {
     assert!(e.contains("aspectRatioConformPolicy"), "{e}");
     let e = err("", "def RenderSettings \"S\" { rel camera = </Nowhere> }", &Options::default());
     assert!(e.contains("/Nowhere") && e.contains("named by /S"), "{e}");
-    let options = Options { render_settings: Some("/First".into()), camera: None };
+    let options = Options { render_settings: Some("/First".into()), camera: None, ..Default::default() };
     let e = err("", "", &options);
     assert!(e.contains("/First") && e.contains("no such RenderSettings"), "{e}");
     // Metadata naming nothing is a note, and no settings apply.

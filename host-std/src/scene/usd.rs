@@ -38,11 +38,18 @@ pub struct Options {
     pub width: Option<u32>,
     /// Image height, overriding the render settings' resolution.
     pub height: Option<u32>,
+    /// Leave the composed stage allocated after the import (host-usd's
+    /// `Options::leak_stage`): for a process that exits once it has shown the import.
+    pub leak_stage: bool,
 }
 
 /// Imports `path` and converts it.
 pub fn load(path: &Path, options: &Options) -> anyhow::Result<Converted> {
-    let import = host_usd::Options { camera: options.camera.clone(), render_settings: options.render_settings.clone() };
+    let import = host_usd::Options {
+        camera: options.camera.clone(),
+        render_settings: options.render_settings.clone(),
+        leak_stage: options.leak_stage,
+    };
     let usd = host_usd::load_with(path, &import)?;
     Ok(convert(usd, (options.width, options.height)))
 }

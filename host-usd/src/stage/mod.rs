@@ -38,6 +38,8 @@ pub struct Stage {
     binding_api: RefCell<HashMap<String, bool>>,
     /// The composed property names of the prim asked about last (see [`Stage::authors`]).
     properties: RefCell<(String, Vec<openusd::tf::Token>)>,
+    /// The path of the prim asked about last (see [`Stage::path`]).
+    last_path: RefCell<Option<sdf::Path>>,
 }
 
 type Result<T> = std::result::Result<T, String>;
@@ -57,7 +59,26 @@ impl Stage {
         let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
         let inner = usd::Stage::open(name).map_err(err)?;
         let time = usd::TimeCode::new(inner.start_time_code());
-        Ok(Self { inner, time, binding_api: RefCell::default(), properties: RefCell::default() })
+        Ok(Self {
+            inner,
+            time,
+            binding_api: RefCell::default(),
+            properties: RefCell::default(),
+            last_path: RefCell::default(),
+        })
+    }
+
+    /// `prim`'s path. The importer asks about one prim many times in a row, and making a
+    /// path hashes and copies its whole text (as long as the prim is deep): the last one
+    /// made is kept.
+    fn path(&self, prim: &str) -> Result<sdf::Path> {
+        let mut last = self.last_path.borrow_mut();
+        if let Some(p) = last.as_ref().filter(|p| p.as_str() == prim) {
+            return Ok(p.clone());
+        }
+        let p = path(prim)?;
+        *last = Some(p.clone());
+        Ok(p)
     }
 
     /// Recoverable composition problems (a missing reference, payload or sublayer).
@@ -100,35 +121,35 @@ impl Stage {
 
     /// The prim's type name (empty for a typeless prim).
     pub fn type_name(&self, prim: &str) -> Result<String> {
-        let t = self.inner.prim(path(prim)?).type_name().map_err(err)?;
+        let t = self.inner.prim(self.path(prim)?).type_name().map_err(err)?;
         Ok(t.map(|t| t.as_str().to_string()).unwrap_or_default())
     }
 
     /// The paths of the prim's children, in order.
     pub fn children(&self, prim: &str) -> Result<Vec<String>> {
-        let children = self.inner.prim(path(prim)?).children().map_err(err)?;
+        let children = self.inner.prim(self.path(prim)?).children().map_err(err)?;
         Ok(children.iter().map(|c| c.path().as_str().to_string()).collect())
     }
 
     /// True for an instanceable prim's instance.
     pub fn is_instance(&self, prim: &str) -> Result<bool> {
-        self.inner.prim(path(prim)?).is_instance().map_err(err)
+        self.inner.prim(self.path(prim)?).is_instance().map_err(err)
     }
 
     /// True for a prim inside an instance (a proxy of the prototype's prim).
     pub fn is_instance_proxy(&self, prim: &str) -> Result<bool> {
-        self.inner.prim(path(prim)?).is_instance_proxy().map_err(err)
+        self.inner.prim(self.path(prim)?).is_instance_proxy().map_err(err)
     }
 
     /// The prim's applied API schemas (`apiSchemas`).
     pub fn applied_schemas(&self, prim: &str) -> Result<Vec<String>> {
-        let s = self.inner.prim(path(prim)?).api_schemas().map_err(err)?;
+        let s = self.inner.prim(self.path(prim)?).api_schemas().map_err(err)?;
         Ok(s.iter().map(|t| t.as_str().to_string()).collect())
     }
 
     /// Names of the prim's properties.
     pub fn property_names(&self, prim: &str) -> Result<Vec<String>> {
-        let names = self.inner.prim(path(prim)?).property_names().map_err(err)?;
+        let names = self.inner.prim(self.path(prim)?).property_names().map_err(err)?;
         Ok(names.iter().map(|t| t.as_str().to_string()).collect())
     }
 
@@ -140,7 +161,7 @@ impl Stage {
     fn authors(&self, prim: &str, name: &str) -> Result<bool> {
         let mut memo = self.properties.borrow_mut();
         if memo.0 != prim {
-            let names = self.inner.prim(path(prim)?).property_names().map_err(err)?;
+            let names = self.inner.prim(self.path(prim)?).property_names().map_err(err)?;
             *memo = (prim.to_string(), names);
         }
         Ok(memo.1.iter().any(|n| n.as_str() == name))
@@ -152,7 +173,7 @@ impl Stage {
         if !self.authors(prim, attr)? {
             return Ok(None);
         }
-        let a = self.inner.prim(path(prim)?).attribute(attr);
+        let a = self.inner.prim(self.path(prim)?).attribute(attr);
         let v = a.get_at::<sdf::Value>(self.time).map_err(|e| format!("{prim}.{attr}: {}", err(e)))?;
         let v = match v {
             Some(v) => Some(v),
@@ -166,7 +187,7 @@ impl Stage {
         if !self.authors(prim, attr)? {
             return Ok(None);
         }
-        let a = self.inner.prim(path(prim)?).attribute(attr);
+        let a = self.inner.prim(self.path(prim)?).attribute(attr);
         Ok(a.get_metadata::<sdf::Value>(key).map_err(err)?.map(convert))
     }
 
@@ -175,7 +196,7 @@ impl Stage {
         if !self.authors(prim, rel)? {
             return Ok(Vec::new());
         }
-        let r = self.inner.prim(path(prim)?).relationship(rel);
+        let r = self.inner.prim(self.path(prim)?).relationship(rel);
         Ok(r.targets().map_err(err)?.iter().map(|p| p.as_str().to_string()).collect())
     }
 
@@ -184,12 +205,12 @@ impl Stage {
         if !self.authors(prim, "xformOpOrder")? {
             return Ok(None);
         }
-        AnyXformable(self.inner.prim(path(prim)?)).xform_op_order().map_err(err)
+        AnyXformable(self.inner.prim(self.path(prim)?)).xform_op_order().map_err(err)
     }
 
     /// True when the prim or an ancestor is `invisible`.
     pub fn is_invisible(&self, prim: &str) -> Result<bool> {
-        let x = AnyXformable(self.inner.prim(path(prim)?));
+        let x = AnyXformable(self.inner.prim(self.path(prim)?));
         Ok(x.compute_visibility().map_err(err)? == openusd::schemas::geom::Visibility::Invisible)
     }
 
@@ -214,7 +235,7 @@ impl Stage {
 
     /// The computed purpose token (`default`, `render`, `proxy`, `guide`).
     pub fn purpose(&self, prim: &str) -> Result<String> {
-        let x = AnyXformable(self.inner.prim(path(prim)?));
+        let x = AnyXformable(self.inner.prim(self.path(prim)?));
         Ok(x.compute_purpose().map_err(err)?.as_token().to_string())
     }
 

@@ -77,7 +77,7 @@ impl Stage {
     /// collection bindings go through openusd's resolver.
     pub fn bound_material(&self, prim: &str) -> Result<Option<String>> {
         let mut chain = Vec::new();
-        let mut p = Some(path(prim)?);
+        let mut p = Some(self.path(prim)?);
         while let Some(here) = p {
             if here.is_abs_root() {
                 break;
@@ -191,7 +191,7 @@ impl Stage {
     /// The attribute a connection of `prim.attr` points at, following interface
     /// connections (NodeGraph / Material inputs) to the end; `None` when unconnected.
     fn connection(&self, prim: &str, attr: &str) -> Result<Option<sdf::Path>> {
-        let mut current = path(prim)?.append_property(attr).map_err(err)?;
+        let mut current = self.path(prim)?.append_property(attr).map_err(err)?;
         let mut connected = None;
         for _ in 0..16 {
             let next = self.inner.attribute(current.clone()).connections().map_err(err)?.into_iter().next();

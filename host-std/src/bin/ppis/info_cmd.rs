@@ -32,7 +32,7 @@ pub(crate) fn info_command(args: InfoArgs) -> Result<()> {
     if let Some(dir) = &args.expected {
         return conformance(dir);
     }
-    let loaded = load_scene(&args.scene, (None, None))?;
+    let loaded = load_scene(&args.scene, (None, None), true)?;
     #[cfg(feature = "usd")]
     if let Some(usd) = &loaded.usd {
         host_std::scene::usd_info::print_import(usd);

@@ -119,7 +119,7 @@ fn output_paths(args: &RenderArgs) -> Result<(PathBuf, PathBuf)> {
 /// Loads the scene and builds (only what this render uses) on the pool's threads.
 fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
     let t_load = Instant::now();
-    let loaded = load_scene(&args.scene, args.sampling.size())?;
+    let loaded = load_scene(&args.scene, args.sampling.size(), false)?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);

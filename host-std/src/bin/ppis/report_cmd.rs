@@ -64,7 +64,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         None if args.methods.contains(&Method::Product) => Method::Product,
         None => args.methods[0],
     };
-    let loaded = load_scene(&args.scene, args.sampling.size())?;
+    let loaded = load_scene(&args.scene, args.sampling.size(), false)?;
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);

@@ -961,7 +961,7 @@ mod tests {
         let mut set = HashMap::new();
         set.insert(
             keys::TEMPLATE_ASSET_PATH.to_string(),
-            Value::AssetPath("clip.##.usd".into()),
+            Value::AssetPath(Box::new("clip.##.usd".into())),
         );
         set.insert(keys::TEMPLATE_START_TIME.to_string(), Value::Double(101.0));
         set.insert(keys::TEMPLATE_END_TIME.to_string(), Value::Double(103.0));
@@ -986,7 +986,7 @@ mod tests {
         let mut set = HashMap::new();
         set.insert(
             keys::TEMPLATE_ASSET_PATH.to_string(),
-            Value::AssetPath("c.#.usd".into()),
+            Value::AssetPath(Box::new("c.#.usd".into())),
         );
         set.insert(keys::TEMPLATE_START_TIME.to_string(), Value::Double(0.0));
         set.insert(keys::TEMPLATE_END_TIME.to_string(), Value::Double(2.0));
@@ -1010,7 +1010,7 @@ mod tests {
             let mut set = HashMap::new();
             set.insert(
                 keys::TEMPLATE_ASSET_PATH.to_string(),
-                Value::AssetPath("c.#.usd".into()),
+                Value::AssetPath(Box::new("c.#.usd".into())),
             );
             set.insert(keys::TEMPLATE_START_TIME.to_string(), Value::Double(0.0));
             set.insert(keys::TEMPLATE_END_TIME.to_string(), Value::Double(2.0));
@@ -1034,7 +1034,7 @@ mod tests {
         );
         set.insert(
             keys::TEMPLATE_ASSET_PATH.to_string(),
-            Value::AssetPath("c.#.usd".into()),
+            Value::AssetPath(Box::new("c.#.usd".into())),
         );
         set.insert(keys::TEMPLATE_START_TIME.to_string(), Value::Double(0.0));
         set.insert(keys::TEMPLATE_END_TIME.to_string(), Value::Double(2.0));

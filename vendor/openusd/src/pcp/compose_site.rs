@@ -88,10 +88,10 @@ pub(super) fn collect_payloads_in(
         |v| match v {
             Value::Payload(p) => Some(PayloadListOp {
                 explicit: true,
-                explicit_items: vec![p],
+                explicit_items: vec![*p],
                 ..Default::default()
             }),
-            Value::PayloadListOp(op) => Some(op),
+            Value::PayloadListOp(op) => Some(*op),
             _ => None,
         },
         // Fold the retiming only when it is not identity, so a payload with no

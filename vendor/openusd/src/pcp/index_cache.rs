@@ -1089,12 +1089,12 @@ impl IndexCache {
             Value::AssetPath(asset) => {
                 let needs_expr = sdf::expr::is_expression(asset.as_str());
                 let (anchor, vars) = self.asset_context(graph, prim_path, field, prop_suffix, needs_expr);
-                Some(Value::AssetPath(Self::resolve_asset_path(
+                Some(Value::AssetPath(Box::new(Self::resolve_asset_path(
                     graph,
-                    asset,
+                    *asset,
                     anchor.as_ref(),
                     vars,
-                )))
+                ))))
             }
             Value::AssetPathVec(assets) => {
                 let needs_expr = assets.iter().any(|a| sdf::expr::is_expression(a.as_str()));
@@ -1465,7 +1465,7 @@ impl IndexCache {
                         continue;
                     };
                     let list_op = match value.into_owned() {
-                        Value::PathListOp(op) => op,
+                        Value::PathListOp(op) => *op,
                         Value::PathVec(paths) => sdf::PathListOp::explicit(paths),
                         _ => continue,
                     };
@@ -3521,7 +3521,7 @@ def "Scope"
                 prim_path: sdf::path("/Class").unwrap(),
                 ..Default::default()
             }]);
-            data.set_field(&inst, sdf::FieldKey::References.as_str(), Value::ReferenceListOp(refs));
+            data.set_field(&inst, sdf::FieldKey::References.as_str(), Value::ReferenceListOp(Box::new(refs)));
             Ok(())
         })
         .unwrap();

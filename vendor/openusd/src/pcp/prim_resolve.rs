@@ -167,7 +167,7 @@ impl PrimIndex {
             // list-op fields are simply ignored rather than coerced.
             let list_op = match value.into_owned() {
                 Value::ValueBlock => break,
-                Value::TokenListOp(op) => op,
+                Value::TokenListOp(op) => *op,
                 _ => continue,
             };
             ops.push(list_op);
@@ -213,7 +213,7 @@ impl PrimIndex {
             } = opinion?;
             let list_op = match value.into_owned() {
                 Value::ValueBlock => break,
-                Value::PathListOp(op) => op,
+                Value::PathListOp(op) => *op,
                 Value::PathVec(paths) => sdf::PathListOp::explicit(paths),
                 _ => continue,
             };
@@ -306,7 +306,7 @@ impl PrimIndex {
             } = opinion?;
             let list_op = match value.into_owned() {
                 Value::ValueBlock => break,
-                Value::PathListOp(op) => op,
+                Value::PathListOp(op) => *op,
                 Value::PathVec(paths) => sdf::PathListOp::explicit(paths),
                 _ => continue,
             };
@@ -673,7 +673,7 @@ impl PrimIndex {
             match opinion?.value.into_owned() {
                 // Stop weaker opinions while keeping any stronger composed edits.
                 Value::ValueBlock => break,
-                Value::StringListOp(op) => ops.push(op),
+                Value::StringListOp(op) => ops.push(*op),
                 Value::TokenListOp(op) => ops.push(op.map(String::from)),
                 Value::StringVec(names) => ops.push(sdf::StringListOp::explicit(names)),
                 Value::TokenVec(names) => ops.push(sdf::StringListOp::explicit(

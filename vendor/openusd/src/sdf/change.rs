@@ -428,7 +428,7 @@ mod tests {
         cow.set_field(
             path,
             FieldKey::References.as_str(),
-            Value::ReferenceListOp(ReferenceListOp::default()),
+            Value::ReferenceListOp(Box::new(ReferenceListOp::default())),
         );
     }
 
@@ -517,7 +517,7 @@ mod tests {
         base.set_field(
             &p("/X"),
             FieldKey::References.as_str(),
-            Value::ReferenceListOp(ReferenceListOp::default()),
+            Value::ReferenceListOp(Box::new(ReferenceListOp::default())),
         );
 
         let cl = derive(base, |c| c.erase_spec(&p("/X")));
@@ -537,7 +537,7 @@ mod tests {
         base.set_field(
             &p("/P.rel"),
             FieldKey::TargetPaths.as_str(),
-            Value::PathListOp(PathListOp::default()),
+            Value::PathListOp(Box::new(PathListOp::default())),
         );
 
         let cl = derive(base, |c| c.erase_spec(&p("/P.rel")));
@@ -563,7 +563,7 @@ mod tests {
         base.set_field(
             &p("/X"),
             FieldKey::References.as_str(),
-            Value::ReferenceListOp(ReferenceListOp::default()),
+            Value::ReferenceListOp(Box::new(ReferenceListOp::default())),
         );
 
         // Re-create /X as a plain `over` with no references, in one window.
@@ -623,12 +623,12 @@ mod tests {
             c.set_field(
                 &p("/P.rel"),
                 FieldKey::TargetPaths.as_str(),
-                Value::PathListOp(PathListOp::default()),
+                Value::PathListOp(Box::new(PathListOp::default())),
             );
             c.set_field(
                 &p("/P.attr"),
                 FieldKey::ConnectionPaths.as_str(),
-                Value::PathListOp(PathListOp::default()),
+                Value::PathListOp(Box::new(PathListOp::default())),
             );
         });
         let rel = cl.iter().find(|(path, _)| path == &p("/P.rel")).expect("rel entry");

@@ -144,16 +144,16 @@ impl SpecData {
         };
         use sdf::Value::*;
         match (slot, value) {
-            (TokenListOp(existing), TokenListOp(incoming)) => existing.merge_op(incoming),
-            (StringListOp(existing), StringListOp(incoming)) => existing.merge_op(incoming),
-            (PathListOp(existing), PathListOp(incoming)) => existing.merge_op(incoming),
-            (ReferenceListOp(existing), ReferenceListOp(incoming)) => existing.merge_op(incoming),
-            (PayloadListOp(existing), PayloadListOp(incoming)) => existing.merge_op(incoming),
-            (IntListOp(existing), IntListOp(incoming)) => existing.merge_op(incoming),
-            (Int64ListOp(existing), Int64ListOp(incoming)) => existing.merge_op(incoming),
-            (UIntListOp(existing), UIntListOp(incoming)) => existing.merge_op(incoming),
-            (UInt64ListOp(existing), UInt64ListOp(incoming)) => existing.merge_op(incoming),
-            (UnregisteredValueListOp(existing), UnregisteredValueListOp(incoming)) => existing.merge_op(incoming),
+            (TokenListOp(existing), TokenListOp(incoming)) => existing.merge_op(*incoming),
+            (StringListOp(existing), StringListOp(incoming)) => existing.merge_op(*incoming),
+            (PathListOp(existing), PathListOp(incoming)) => existing.merge_op(*incoming),
+            (ReferenceListOp(existing), ReferenceListOp(incoming)) => existing.merge_op(*incoming),
+            (PayloadListOp(existing), PayloadListOp(incoming)) => existing.merge_op(*incoming),
+            (IntListOp(existing), IntListOp(incoming)) => existing.merge_op(*incoming),
+            (Int64ListOp(existing), Int64ListOp(incoming)) => existing.merge_op(*incoming),
+            (UIntListOp(existing), UIntListOp(incoming)) => existing.merge_op(*incoming),
+            (UInt64ListOp(existing), UInt64ListOp(incoming)) => existing.merge_op(*incoming),
+            (UnregisteredValueListOp(existing), UnregisteredValueListOp(incoming)) => existing.merge_op(*incoming),
             (slot, value) => *slot = value,
         }
     }
@@ -533,7 +533,7 @@ where
             None => {
                 self.set(
                     sdf::FieldKey::ApiSchemas.as_str(),
-                    sdf::Value::TokenListOp(sdf::TokenListOp::prepended([name])),
+                    sdf::Value::TokenListOp(Box::new(sdf::TokenListOp::prepended([name]))),
                 );
                 Ok(true)
             }
@@ -1005,7 +1005,7 @@ where
         let paths: Vec<sdf::Path> = paths.into_iter().collect();
         self.set(
             sdf::FieldKey::ConnectionPaths.as_str(),
-            sdf::Value::PathListOp(sdf::PathListOp::explicit(paths)),
+            sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit(paths))),
         );
     }
 
@@ -1061,7 +1061,7 @@ where
                 } else {
                     sdf::PathListOp::appended([path])
                 };
-                self.set(key, sdf::Value::PathListOp(op));
+                self.set(key, sdf::Value::PathListOp(Box::new(op)));
                 true
             }
             None => {
@@ -1072,7 +1072,7 @@ where
                 } else {
                     sdf::PathListOp::appended([path])
                 };
-                self.set(key, sdf::Value::PathListOp(op));
+                self.set(key, sdf::Value::PathListOp(Box::new(op)));
                 true
             }
         }
@@ -1088,7 +1088,7 @@ where
             | remove_path(&mut op.added_items, path)
             | remove_path(&mut op.prepended_items, path)
             | remove_path(&mut op.appended_items, path);
-        self.set(key, sdf::Value::PathListOp(op));
+        self.set(key, sdf::Value::PathListOp(Box::new(op)));
         removed
     }
 
@@ -1117,11 +1117,11 @@ where
             }
             Some(other) => {
                 debug_assert!(false, "connectionPaths field is not a sdf::PathListOp (got {other:?})");
-                self.set(key, sdf::Value::PathListOp(sdf::PathListOp::deleted([path.clone()])));
+                self.set(key, sdf::Value::PathListOp(Box::new(sdf::PathListOp::deleted([path.clone()]))));
                 true
             }
             None => {
-                self.set(key, sdf::Value::PathListOp(sdf::PathListOp::deleted([path.clone()])));
+                self.set(key, sdf::Value::PathListOp(Box::new(sdf::PathListOp::deleted([path.clone()]))));
                 true
             }
         }
@@ -1219,7 +1219,7 @@ where
         let paths: Vec<sdf::Path> = paths.into_iter().collect();
         self.set(
             sdf::FieldKey::TargetPaths.as_str(),
-            sdf::Value::PathListOp(sdf::PathListOp::explicit(paths)),
+            sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit(paths))),
         );
     }
 
@@ -1244,10 +1244,10 @@ where
             }
             Some(other) => {
                 debug_assert!(false, "targetPaths field is not a sdf::PathListOp (got {other:?})");
-                self.set(key, sdf::Value::PathListOp(sdf::PathListOp::explicit([path])));
+                self.set(key, sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit([path]))));
             }
             None => {
-                self.set(key, sdf::Value::PathListOp(sdf::PathListOp::explicit([path])));
+                self.set(key, sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit([path]))));
             }
         }
     }
@@ -1276,7 +1276,7 @@ where
             None => {
                 // No authored targets here yet: record a deletion so the same
                 // target from a weaker layer is suppressed through composition.
-                self.set(key, sdf::Value::PathListOp(sdf::PathListOp::deleted([path.clone()])));
+                self.set(key, sdf::Value::PathListOp(Box::new(sdf::PathListOp::deleted([path.clone()]))));
                 true
             }
         }
@@ -1837,7 +1837,7 @@ mod tests {
         data.set_field(
             &path,
             sdf::FieldKey::ApiSchemas.as_str(),
-            sdf::Value::TokenListOp(sdf::TokenListOp::explicit([tf::Token::from("ExistingAPI")])),
+            sdf::Value::TokenListOp(Box::new(sdf::TokenListOp::explicit([tf::Token::from("ExistingAPI")]))),
         );
         let mut prim = PrimSpecMut::get(&mut data, path).expect("prim spec");
 
@@ -1858,10 +1858,10 @@ mod tests {
         data.set_field(
             &path,
             sdf::FieldKey::ApiSchemas.as_str(),
-            sdf::Value::TokenListOp(sdf::TokenListOp {
+            sdf::Value::TokenListOp(Box::new(sdf::TokenListOp {
                 added_items: vec![tf::Token::from("ExistingAPI")],
                 ..Default::default()
-            }),
+            })),
         );
         let mut prim = PrimSpecMut::get(&mut data, path).expect("prim spec");
 
@@ -1879,10 +1879,10 @@ mod tests {
         data.set_field(
             &path,
             sdf::FieldKey::ApiSchemas.as_str(),
-            sdf::Value::TokenListOp(sdf::TokenListOp {
+            sdf::Value::TokenListOp(Box::new(sdf::TokenListOp {
                 deleted_items: vec![tf::Token::from("RemovedAPI")],
                 ..Default::default()
-            }),
+            })),
         );
         let mut prim = PrimSpecMut::get(&mut data, path).expect("prim spec");
 
@@ -1902,11 +1902,11 @@ mod tests {
         data.set_field(
             &path,
             sdf::FieldKey::ApiSchemas.as_str(),
-            sdf::Value::TokenListOp(sdf::TokenListOp {
+            sdf::Value::TokenListOp(Box::new(sdf::TokenListOp {
                 explicit: true,
                 added_items: vec![tf::Token::from("StaleAPI")],
                 ..Default::default()
-            }),
+            })),
         );
         let mut prim = PrimSpecMut::get(&mut data, path).expect("prim spec");
 
@@ -1926,10 +1926,10 @@ mod tests {
         data.set_field(
             &path,
             sdf::FieldKey::ApiSchemas.as_str(),
-            sdf::Value::TokenListOp(sdf::TokenListOp {
+            sdf::Value::TokenListOp(Box::new(sdf::TokenListOp {
                 deleted_items: vec![tf::Token::from("RemovedAPI"), tf::Token::from("RemovedAPI")],
                 ..Default::default()
-            }),
+            })),
         );
         let mut prim = PrimSpecMut::get(&mut data, path).expect("prim spec");
 
@@ -2032,7 +2032,7 @@ mod tests {
         let mut op = sdf::PathListOp::added([x.clone()]);
         op.deleted_items.push(x.clone());
         let (mut data, path) = data_with_spec("/A.rel", sdf::SpecType::Relationship);
-        data.set_field(&path, sdf::FieldKey::TargetPaths.as_str(), sdf::Value::PathListOp(op));
+        data.set_field(&path, sdf::FieldKey::TargetPaths.as_str(), sdf::Value::PathListOp(Box::new(op)));
 
         let mut rel = RelationshipSpecMut::get(&mut data, path).expect("relationship spec");
         assert!(rel.remove_target(&x));

@@ -22,6 +22,11 @@ use super::*;
 ///
 /// Type-safe extraction is supported via [`TryFrom<Value>`] implementations for common Rust
 /// types (e.g. `f32`, `String`, `gf::Vec3f`).
+///
+/// The variants larger than a pointer pair and a word or two (matrices of three rows or
+/// more, list ops, asset paths, payloads) are boxed (ppis patch, see PATCHED.md): every
+/// field of every spec is a `Value`, and unboxed the enum was as large as a list op
+/// (about 160 bytes) whatever it held.
 #[derive(Debug, Clone, PartialEq, EnumIs, EnumTryAs, IntoStaticStr, derive_more::From)]
 pub enum Value {
     /// None value, only produced by expressions (not directly assignable).
@@ -61,7 +66,7 @@ pub enum Value {
     Token(Token),
     TokenVec(Vec<Token>),
 
-    AssetPath(AssetPath),
+    AssetPath(Box<AssetPath>),
     AssetPathVec(Vec<AssetPath>),
 
     Quath(gf::Quath),
@@ -99,8 +104,8 @@ pub enum Value {
     Vec4iVec(Vec<gf::Vec4i>),
 
     Matrix2d(gf::Mat2d),
-    Matrix3d(gf::Mat3d),
-    Matrix4d(gf::Matrix4d),
+    Matrix3d(Box<gf::Mat3d>),
+    Matrix4d(Box<gf::Matrix4d>),
     Matrix2dVec(Vec<gf::Mat2d>),
     Matrix3dVec(Vec<gf::Mat3d>),
     Matrix4dVec(Vec<gf::Matrix4d>),
@@ -111,17 +116,17 @@ pub enum Value {
 
     Dictionary(HashMap<String, Value>),
 
-    TokenListOp(TokenListOp),
-    StringListOp(StringListOp),
-    PathListOp(PathListOp),
-    ReferenceListOp(ReferenceListOp),
-    IntListOp(IntListOp),
-    Int64ListOp(Int64ListOp),
-    UIntListOp(UintListOp),
-    UInt64ListOp(Uint64ListOp),
-    PayloadListOp(PayloadListOp),
+    TokenListOp(Box<TokenListOp>),
+    StringListOp(Box<StringListOp>),
+    PathListOp(Box<PathListOp>),
+    ReferenceListOp(Box<ReferenceListOp>),
+    IntListOp(Box<IntListOp>),
+    Int64ListOp(Box<Int64ListOp>),
+    UIntListOp(Box<UintListOp>),
+    UInt64ListOp(Box<Uint64ListOp>),
+    PayloadListOp(Box<PayloadListOp>),
 
-    Payload(Payload),
+    Payload(Box<Payload>),
     PathVec(Vec<Path>),
     /// Layer-level relocates: `(source, target)` path pairs for namespace remapping.
     Relocates(RelocateList),
@@ -141,12 +146,94 @@ pub enum Value {
     #[from(skip)]
     UnregisteredValue(String),
     #[from(skip)]
-    UnregisteredValueListOp(StringListOp),
+    UnregisteredValueListOp(Box<StringListOp>),
 
     TimeCode(TimeCode),
     TimeCodeVec(Vec<TimeCode>),
     #[from(skip)]
     PathExpression(String),
+}
+
+// Every spec field holds a `Value`: its size is that of its largest unboxed variant (a
+// `HashMap`, 48 bytes) and the tag.
+const _: () = assert!(std::mem::size_of::<Value>() <= 56);
+
+impl From<gf::Mat3d> for Value {
+    fn from(v: gf::Mat3d) -> Self {
+        Value::Matrix3d(Box::new(v))
+    }
+}
+
+impl From<gf::Matrix4d> for Value {
+    fn from(v: gf::Matrix4d) -> Self {
+        Value::Matrix4d(Box::new(v))
+    }
+}
+
+impl From<AssetPath> for Value {
+    fn from(v: AssetPath) -> Self {
+        Value::AssetPath(Box::new(v))
+    }
+}
+
+impl From<Payload> for Value {
+    fn from(v: Payload) -> Self {
+        Value::Payload(Box::new(v))
+    }
+}
+
+impl From<TokenListOp> for Value {
+    fn from(v: TokenListOp) -> Self {
+        Value::TokenListOp(Box::new(v))
+    }
+}
+
+impl From<StringListOp> for Value {
+    fn from(v: StringListOp) -> Self {
+        Value::StringListOp(Box::new(v))
+    }
+}
+
+impl From<PathListOp> for Value {
+    fn from(v: PathListOp) -> Self {
+        Value::PathListOp(Box::new(v))
+    }
+}
+
+impl From<ReferenceListOp> for Value {
+    fn from(v: ReferenceListOp) -> Self {
+        Value::ReferenceListOp(Box::new(v))
+    }
+}
+
+impl From<IntListOp> for Value {
+    fn from(v: IntListOp) -> Self {
+        Value::IntListOp(Box::new(v))
+    }
+}
+
+impl From<Int64ListOp> for Value {
+    fn from(v: Int64ListOp) -> Self {
+        Value::Int64ListOp(Box::new(v))
+    }
+}
+
+impl From<UintListOp> for Value {
+    fn from(v: UintListOp) -> Self {
+        Value::UIntListOp(Box::new(v))
+    }
+}
+
+impl From<Uint64ListOp> for Value {
+    fn from(v: Uint64ListOp) -> Self {
+        Value::UInt64ListOp(Box::new(v))
+    }
+}
+
+impl From<PayloadListOp> for Value {
+    fn from(v: PayloadListOp) -> Self {
+        Value::PayloadListOp(Box::new(v))
+    }
 }
 
 #[cfg(feature = "serde")]
@@ -373,7 +460,7 @@ impl Value {
         let remap = &remap;
         match self {
             Value::PathVec(paths) => Value::PathVec(paths.iter().filter_map(remap).collect()),
-            Value::PathListOp(op) => Value::PathListOp(op.clone().filter_map(|p| remap(&p))),
+            Value::PathListOp(op) => Value::PathListOp(Box::new(op.clone().filter_map(|p| remap(&p)))),
             Value::Relocates(relocates) => Value::Relocates(
                 relocates
                     .iter()
@@ -382,18 +469,18 @@ impl Value {
                     .filter_map(|(s, t)| remap(s).map(|s| (s, remap(t).unwrap_or_else(|| t.clone()))))
                     .collect(),
             ),
-            Value::ReferenceListOp(op) => Value::ReferenceListOp(op.clone().filter_map(|mut reference| {
+            Value::ReferenceListOp(op) => Value::ReferenceListOp(Box::new(op.clone().filter_map(|mut reference| {
                 if reference.asset_path.is_empty() && !reference.prim_path.is_empty() {
                     reference.prim_path = remap(&reference.prim_path)?;
                 }
                 Some(reference)
-            })),
-            Value::PayloadListOp(op) => Value::PayloadListOp(op.clone().filter_map(|mut payload| {
+            }))),
+            Value::PayloadListOp(op) => Value::PayloadListOp(Box::new(op.clone().filter_map(|mut payload| {
                 if payload.asset_path.is_empty() && !payload.prim_path.is_empty() {
                     payload.prim_path = remap(&payload.prim_path)?;
                 }
                 Some(payload)
-            })),
+            }))),
             other => other.clone(),
         }
     }
@@ -454,9 +541,9 @@ impl_try_from_value!(f32, try_as_float, "Float");
 impl_try_from_value!(f64, try_as_double, "Double");
 impl_try_from_value!(Specifier, try_as_specifier, "Specifier");
 impl_try_from_value!(Variability, try_as_variability, "Variability");
-impl_try_from_value!(ReferenceListOp, try_as_reference_list_op, "ReferenceListOp");
-impl_try_from_value!(PayloadListOp, try_as_payload_list_op, "PayloadListOp");
-impl_try_from_value!(PathListOp, try_as_path_list_op, "PathListOp");
+impl_try_from_value!(ReferenceListOp, try_as_reference_list_op, "ReferenceListOp", |b: Box<_>| *b);
+impl_try_from_value!(PayloadListOp, try_as_payload_list_op, "PayloadListOp", |b: Box<_>| *b);
+impl_try_from_value!(PathListOp, try_as_path_list_op, "PathListOp", |b: Box<_>| *b);
 
 // gf scalar types — trivially unwrap the matching variant.
 impl_try_from_value!(gf::Vec2f, try_as_vec_2f, "gf::Vec2f");
@@ -475,8 +562,8 @@ impl_try_from_value!(gf::Quatf, try_as_quatf, "gf::Quatf");
 impl_try_from_value!(gf::Quatd, try_as_quatd, "gf::Quatd");
 impl_try_from_value!(gf::Quath, try_as_quath, "gf::Quath");
 impl_try_from_value!(gf::Mat2d, try_as_matrix_2d, "gf::Mat2d");
-impl_try_from_value!(gf::Mat3d, try_as_matrix_3d, "gf::Mat3d");
-impl_try_from_value!(gf::Matrix4d, try_as_matrix_4d, "gf::Matrix4d");
+impl_try_from_value!(gf::Mat3d, try_as_matrix_3d, "gf::Mat3d", |b: Box<_>| *b);
+impl_try_from_value!(gf::Matrix4d, try_as_matrix_4d, "gf::Matrix4d", |b: Box<_>| *b);
 
 // gf array types.
 impl_try_from_value!(Vec<gf::Vec2f>, try_as_vec_2f_vec, "Vec2fVec");
@@ -504,12 +591,12 @@ impl_try_from_value!(String, try_as_string, "String");
 impl_try_from_value!(Token, try_as_token, "Token");
 impl_try_from_value!(Vec<Token>, try_as_token_vec, "TokenVec");
 impl_try_from_value!(Vec<String>, try_as_string_vec, "StringVec");
-impl_try_from_value!(AssetPath, try_as_asset_path, "AssetPath");
+impl_try_from_value!(AssetPath, try_as_asset_path, "AssetPath", |b: Box<_>| *b);
 impl_try_from_value!(Vec<AssetPath>, try_as_asset_path_vec, "AssetPathVec");
 
 // List ops, relocations, time samples, and layer offsets — composite payloads
 // read through the typed spec accessors.
-impl_try_from_value!(TokenListOp, try_as_token_list_op, "TokenListOp");
+impl_try_from_value!(TokenListOp, try_as_token_list_op, "TokenListOp", |b: Box<_>| *b);
 impl_try_from_value!(RelocateList, try_as_relocates, "Relocates");
 impl_try_from_value!(TimeSampleMap, try_as_time_samples, "TimeSamples");
 impl_try_from_value!(Vec<LayerOffset>, try_as_layer_offset_vec, "LayerOffsetVec");
@@ -579,7 +666,7 @@ impl From<[i32; 4]> for Value {
 }
 impl From<[f64; 16]> for Value {
     fn from(v: [f64; 16]) -> Self {
-        Value::Matrix4d(gf::Matrix4d(v))
+        Value::Matrix4d(Box::new(gf::Matrix4d(v)))
     }
 }
 
@@ -930,7 +1017,7 @@ mod tests {
         let remap = |path: &Path| path.replace_prefix(&p("/A"), &p("/B")).unwrap_or_else(|| path.clone());
 
         // PathListOp: an in-subtree path re-roots, an outside path is untouched.
-        let op = Value::PathListOp(PathListOp::explicit([p("/A/Child"), p("/Other")]));
+        let op = Value::PathListOp(Box::new(PathListOp::explicit([p("/A/Child"), p("/Other")])));
         let items: Vec<String> = op
             .remap_paths(remap)
             .try_as_path_list_op()
@@ -972,7 +1059,7 @@ mod tests {
         assert_eq!(gf::Quatf::try_from(Value::Quatf(q)).unwrap(), q);
 
         let m = gf::Matrix4d::IDENTITY;
-        assert_eq!(gf::Matrix4d::try_from(Value::Matrix4d(m)).unwrap(), m);
+        assert_eq!(gf::Matrix4d::try_from(Value::Matrix4d(Box::new(m))).unwrap(), m);
     }
 
     #[test]
@@ -1009,7 +1096,7 @@ mod tests {
 
     #[test]
     fn try_from_asset_path() {
-        let scalar = AssetPath::try_from(Value::AssetPath("./tex.png".into())).unwrap();
+        let scalar = AssetPath::try_from(Value::AssetPath(Box::new("./tex.png".into()))).unwrap();
         assert_eq!(scalar, AssetPath::new("./tex.png"));
 
         let array = Vec::<AssetPath>::try_from(Value::AssetPathVec(vec!["a.png".into(), "b.png".into()])).unwrap();
@@ -1019,7 +1106,7 @@ mod tests {
         assert!(AssetPath::try_from(Value::String("a.png".into())).is_err());
 
         // Round-trips back through the authoring `From` impls.
-        assert_eq!(Value::from(scalar), Value::AssetPath("./tex.png".into()));
+        assert_eq!(Value::from(scalar), Value::AssetPath(Box::new("./tex.png".into())));
         assert_eq!(
             Value::from(array),
             Value::AssetPathVec(vec!["a.png".into(), "b.png".into()])
@@ -1109,6 +1196,6 @@ mod tests {
         assert_eq!(Value::from(v), Value::Vec3f(v));
 
         let m = gf::Matrix4d::IDENTITY;
-        assert_eq!(Value::from(m), Value::Matrix4d(m));
+        assert_eq!(Value::from(m), Value::Matrix4d(Box::new(m)));
     }
 }

@@ -1026,11 +1026,11 @@ mod tests {
             .set_at(sdf::Value::Double(3.0), TimeCode::new(10.0))?;
         stage.define_prim("/Prim")?.set_metadata(
             sdf::FieldKey::References.as_str(),
-            sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+            sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                 prim_path: sdf::path("/Source")?,
                 layer_offset: sdf::LayerOffset::new(10.0, 1.0),
                 ..Default::default()
-            }])),
+            }]))),
         )?;
 
         let attr = stage.attribute("/Prim.x");

@@ -72,7 +72,7 @@ impl ClipsAPI {
     pub fn set_clip_sets(&self, clip_sets: sdf::StringListOp) -> Result<(), StageAuthoringError> {
         self.prim
             .clone()
-            .set_metadata(sdf::FieldKey::ClipSets.as_str(), Value::StringListOp(clip_sets))?;
+            .set_metadata(sdf::FieldKey::ClipSets.as_str(), Value::StringListOp(Box::new(clip_sets)))?;
         Ok(())
     }
 
@@ -134,7 +134,8 @@ impl ClipsAPI {
     pub fn clip_manifest_asset_path(&self, clip_set: &str) -> anyhow::Result<Option<AssetPath>> {
         Ok(self
             .field(clip_set, keys::MANIFEST_ASSET_PATH)?
-            .and_then(Value::try_as_asset_path))
+            .and_then(Value::try_as_asset_path)
+            .map(|a| *a))
     }
 
     /// Whether gaps in `clip_set` interpolate across surrounding clips rather
@@ -203,7 +204,7 @@ impl ClipsAPI {
         clip_set: &str,
         asset_path: impl Into<AssetPath>,
     ) -> Result<(), StageAuthoringError> {
-        self.set_field(clip_set, keys::MANIFEST_ASSET_PATH, Value::AssetPath(asset_path.into()))
+        self.set_field(clip_set, keys::MANIFEST_ASSET_PATH, Value::AssetPath(Box::new(asset_path.into())))
     }
 
     /// Author the interpolate-missing flag for `clip_set` (`interpolateMissingClipValues`).
@@ -224,7 +225,7 @@ impl ClipsAPI {
         self.set_field(
             clip_set,
             keys::TEMPLATE_ASSET_PATH,
-            Value::AssetPath(AssetPath::new(asset_path)),
+            Value::AssetPath(Box::new(AssetPath::new(asset_path))),
         )
     }
 
@@ -359,7 +360,7 @@ mod tests {
                 ),
                 (
                     keys::MANIFEST_ASSET_PATH.to_string(),
-                    Value::AssetPath("manifest.usda".into()),
+                    Value::AssetPath(Box::new("manifest.usda".into())),
                 ),
                 (keys::INTERPOLATE_MISSING.to_string(), Value::Bool(true)),
                 (keys::TEMPLATE_ACTIVE_OFFSET.to_string(), Value::Double(0.5)),

@@ -1851,10 +1851,10 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Other").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     prim_path: path("/A").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let stage = Stage::builder().make_stage(vec![root], 0, Vec::new());
@@ -1888,7 +1888,7 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Other.rel").unwrap(),
                 FieldKey::TargetPaths.as_str(),
-                sdf::Value::PathListOp(sdf::PathListOp::prepended([path("/A").unwrap()])),
+                sdf::Value::PathListOp(Box::new(sdf::PathListOp::prepended([path("/A").unwrap()]))),
             );
         });
         let stage = Stage::builder().make_stage(vec![root], 0, Vec::new());
@@ -2045,11 +2045,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2355,11 +2355,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2434,11 +2434,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2479,11 +2479,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2495,7 +2495,7 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model/B.rel").unwrap(),
                 FieldKey::TargetPaths.as_str(),
-                sdf::Value::PathListOp(sdf::PathListOp::explicit([path("/Model/A").unwrap()])),
+                sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit([path("/Model/A").unwrap()]))),
             );
         });
         let stage = Stage::builder().make_stage(vec![root, model], 0, Vec::new());
@@ -2561,11 +2561,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2576,11 +2576,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "deep.usda".into(),
                     prim_path: path("/Deep").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut deep = sdf::Layer::new_in_memory("deep.usda");
@@ -2658,11 +2658,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2673,10 +2673,10 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     prim_path: path("/Deep").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Deep", Specifier::Def, "Xform").unwrap();
             sdf::PrimSpec::new(e.data_mut(), "/Deep/Inner", Specifier::Def, "").unwrap();
@@ -2715,11 +2715,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2781,11 +2781,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2862,11 +2862,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2875,11 +2875,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "deep.usda".into(),
                     prim_path: path("/Deep").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut deep = sdf::Layer::new_in_memory("deep.usda");
@@ -2953,11 +2953,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -2976,7 +2976,7 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model/B.rel").unwrap(),
                 FieldKey::TargetPaths.as_str(),
-                sdf::Value::PathListOp(sdf::PathListOp::explicit([path("/Model/A").unwrap()])),
+                sdf::Value::PathListOp(Box::new(sdf::PathListOp::explicit([path("/Model/A").unwrap()]))),
             );
         });
         let stage = Stage::builder().make_stage(vec![root, model, model_sub], 0, Vec::new());
@@ -3003,11 +3003,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             for name in overrides {
                 sdf::PrimSpec::over(e.data_mut(), format!("/Ref/{name}").as_str()).unwrap();
@@ -3154,11 +3154,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             // Pre-existing relocate bringing the referenced /Ref/Orig to /Ref/Geom.
             e.set_relocates(vec![(path("/Ref/Orig").unwrap(), path("/Ref/Geom").unwrap())])
@@ -3213,11 +3213,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             // Pre-existing relocate with a child of /Ref/Geom as its destination.
             e.set_relocates(vec![(path("/Ref/B").unwrap(), path("/Ref/Geom/Sub").unwrap())])
@@ -3369,11 +3369,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -3429,11 +3429,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -3461,11 +3461,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -3556,11 +3556,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -3613,11 +3613,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Src", Specifier::Def, "").unwrap();
             sdf::AttributeSpec::new(e.data_mut(), "/Src.attr", "double", Variability::Varying, false).unwrap();
@@ -3648,11 +3648,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![(path("/Ref/Orig").unwrap(), path("/Ref/Geom").unwrap())])
                 .unwrap();
@@ -3688,11 +3688,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Local", Specifier::Def, "").unwrap();
             // /Ref/Geom is relocated under the local prim /Local.
@@ -3789,11 +3789,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut sub = sdf::Layer::new_in_memory("sub.usda");
@@ -3840,11 +3840,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut sub = sdf::Layer::new_in_memory("sub.usda");
@@ -3878,11 +3878,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             // Invalid: a root prim cannot be a relocate source. Pcp drops it.
             e.set_relocates(vec![(path("/B").unwrap(), path("/C").unwrap())])
@@ -3914,11 +3914,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![(path("/A").unwrap(), path("/Ref/Geom").unwrap())])
                 .unwrap();
@@ -4008,11 +4008,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![(path("/Ref/Orig").unwrap(), path("/Ref/Strong").unwrap())])
                 .unwrap();
@@ -4087,11 +4087,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Local", Specifier::Def, "").unwrap();
         });
@@ -4132,11 +4132,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut sub = sdf::Layer::new_in_memory("sub.usda");
@@ -4173,11 +4173,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Local", Specifier::Def, "").unwrap();
         });
@@ -4243,11 +4243,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model/Geom").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -4411,11 +4411,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![(path("/Ref/Orig").unwrap(), path("/Ref/Geom").unwrap())])
                 .unwrap();
@@ -4472,11 +4472,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut model = sdf::Layer::new_in_memory("model.usda");
@@ -4487,11 +4487,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Model").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "deep.usda".into(),
                     prim_path: path("/Deep").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![(path("/Model/Orig").unwrap(), path("/Model/Geom").unwrap())])
                 .unwrap();
@@ -4531,11 +4531,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![
                 (path("/Ref/A").unwrap(), path("/Ref/Geom").unwrap()),
@@ -4574,11 +4574,11 @@ mod tests {
             e.data_mut().set_field(
                 &path("/Ref").unwrap(),
                 FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "model.usda".into(),
                     prim_path: path("/Model").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             e.set_relocates(vec![
                 (path("/Ref/X").unwrap(), path("/Ref/Geom").unwrap()),

@@ -142,8 +142,8 @@ fn lerp_value(a: &Value, b: &Value, t: f64) -> Option<Value> {
         (V::TimeCode(x), V::TimeCode(y)) => V::TimeCode(gf::lerp(x.0, y.0, t).into()),
 
         (V::Matrix2d(x), V::Matrix2d(y)) => V::Matrix2d(x.lerp(*y, t)),
-        (V::Matrix3d(x), V::Matrix3d(y)) => V::Matrix3d(x.lerp(*y, t)),
-        (V::Matrix4d(x), V::Matrix4d(y)) => V::Matrix4d(x.lerp(*y, t)),
+        (V::Matrix3d(x), V::Matrix3d(y)) => V::Matrix3d(Box::new(x.lerp(**y, t))),
+        (V::Matrix4d(x), V::Matrix4d(y)) => V::Matrix4d(Box::new(x.lerp(**y, t))),
 
         (V::Vec2h(x), V::Vec2h(y)) => V::Vec2h(x.lerp(*y, t32)),
         (V::Vec2f(x), V::Vec2f(y)) => V::Vec2f(x.lerp(*y, t32)),
@@ -304,8 +304,8 @@ mod tests {
         a[0] = 1.0;
         b[0] = 3.0;
         let s = vec![
-            (0.0, Value::Matrix4d(gf::Matrix4d(a))),
-            (10.0, Value::Matrix4d(gf::Matrix4d(b))),
+            (0.0, Value::Matrix4d(Box::new(gf::Matrix4d(a)))),
+            (10.0, Value::Matrix4d(Box::new(gf::Matrix4d(b)))),
         ];
         let out = evaluate(&s, 5.0, InterpolationType::Linear).unwrap();
         if let Value::Matrix4d(m) = out {

@@ -898,10 +898,10 @@ mod tests {
             layer.data_mut().set_field(
                 &path,
                 sdf::FieldKey::ApiSchemas.as_str(),
-                sdf::Value::TokenListOp(sdf::TokenListOp {
+                sdf::Value::TokenListOp(Box::new(sdf::TokenListOp {
                     appended_items: vec![Token::from("ExistingAPI")],
                     ..Default::default()
-                }),
+                })),
             );
             Ok(())
         })?;

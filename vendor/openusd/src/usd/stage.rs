@@ -4803,11 +4803,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/P").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/Target").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut target = sdf::Layer::new_in_memory("target.usda");
@@ -4845,11 +4845,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/Ref").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/Target").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Indep", sdf::Specifier::Def, "").unwrap();
         });
@@ -4925,11 +4925,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/Ref").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/Target").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
             sdf::PrimSpec::new(e.data_mut(), "/Indep", sdf::Specifier::Def, "").unwrap();
         });
@@ -4967,11 +4967,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/Ref").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/A").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut target = sdf::Layer::new_in_memory("target.usda");
@@ -5037,11 +5037,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/Ref").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/T").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut target = sdf::Layer::new_in_memory("target.usda");
@@ -5313,11 +5313,11 @@ def "T" {
             e.data_mut().set_field(
                 &sdf::path("/P").unwrap(),
                 sdf::FieldKey::References.as_str(),
-                sdf::Value::ReferenceListOp(sdf::ReferenceListOp::prepended([sdf::Reference {
+                sdf::Value::ReferenceListOp(Box::new(sdf::ReferenceListOp::prepended([sdf::Reference {
                     asset_path: "target.usda".into(),
                     prim_path: sdf::path("/Target").unwrap(),
                     ..Default::default()
-                }])),
+                }]))),
             );
         });
         let mut target = sdf::Layer::new_in_memory("target.usda");

@@ -644,7 +644,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, targets)
                     .context("Unable to build connection listOp")?;
-                spec.add_list_op(FieldKey::ConnectionPaths, sdf::Value::PathListOp(list_op));
+                spec.add_list_op(FieldKey::ConnectionPaths, sdf::Value::PathListOp(Box::new(list_op)));
             }
             return Ok(());
         }
@@ -922,7 +922,7 @@ impl<'a> Parser<'a> {
         let list_op = self
             .apply_list_op(list_op, targets)
             .context("Unable to build relationship targets listOp")?;
-        spec.add_list_op(FieldKey::TargetPaths, sdf::Value::PathListOp(list_op));
+        spec.add_list_op(FieldKey::TargetPaths, sdf::Value::PathListOp(Box::new(list_op)));
 
         if self.is_next(Token::Punctuation('(')) {
             self.parse_property_metadata(&mut spec)
@@ -975,7 +975,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, values)
                     .context("Unable to build apiSchemas listOp")?;
-                spec.add_list_op("apiSchemas", sdf::Value::TokenListOp(list_op));
+                spec.add_list_op("apiSchemas", sdf::Value::TokenListOp(Box::new(list_op)));
             }
             n if n == FieldKey::References.as_str() => {
                 let references = self
@@ -984,7 +984,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, references)
                     .context("Unable to build references listOp")?;
-                spec.add_list_op(FieldKey::References, sdf::Value::ReferenceListOp(list_op));
+                spec.add_list_op(FieldKey::References, sdf::Value::ReferenceListOp(Box::new(list_op)));
             }
             n if n == FieldKey::Payload.as_str() => {
                 let payloads = self
@@ -993,7 +993,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, payloads)
                     .context("Unable to build payload listOp")?;
-                spec.add_list_op(FieldKey::Payload, sdf::Value::PayloadListOp(list_op));
+                spec.add_list_op(FieldKey::Payload, sdf::Value::PayloadListOp(Box::new(list_op)));
             }
             n if n == FieldKey::InheritPaths.as_str() => {
                 let paths = self.one_or_list(Self::parse_path_reference)?;
@@ -1006,7 +1006,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, paths)
                     .context("Unable to build inherits listOp")?;
-                spec.add_list_op(FieldKey::InheritPaths, sdf::Value::PathListOp(list_op));
+                spec.add_list_op(FieldKey::InheritPaths, sdf::Value::PathListOp(Box::new(list_op)));
             }
             n if n == FieldKey::Kind.as_str() => {
                 ensure!(list_op.is_none(), "kind metadata does not support list ops");
@@ -1048,7 +1048,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, values)
                     .context("Unable to build variantSets listOp")?;
-                spec.add_list_op(FieldKey::VariantSetNames, sdf::Value::TokenListOp(list_op));
+                spec.add_list_op(FieldKey::VariantSetNames, sdf::Value::TokenListOp(Box::new(list_op)));
             }
             n if n == FieldKey::Specializes.as_str() => {
                 let paths = self.one_or_list(Self::parse_path_reference)?;
@@ -1058,7 +1058,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, paths)
                     .context("Unable to build specializes listOp")?;
-                spec.add_list_op(FieldKey::Specializes, sdf::Value::PathListOp(list_op));
+                spec.add_list_op(FieldKey::Specializes, sdf::Value::PathListOp(Box::new(list_op)));
             }
             n if n == FieldKey::Instanceable.as_str() => {
                 ensure!(list_op.is_none(), "instanceable metadata does not support list ops");
@@ -1102,7 +1102,7 @@ impl<'a> Parser<'a> {
                 let list_op = self
                     .apply_list_op(list_op, values)
                     .context("Unable to build clipSets listOp")?;
-                spec.add_list_op(FieldKey::ClipSets, sdf::Value::StringListOp(list_op));
+                spec.add_list_op(FieldKey::ClipSets, sdf::Value::StringListOp(Box::new(list_op)));
             }
             // Unknown prim metadata - e.g. DCC / Omniverse hints like
             // `hide_in_stage_window` or `no_delete`. The Sdf grammar accepts
@@ -1488,7 +1488,7 @@ impl<'a> Parser<'a> {
             (Type::Bool, false) => sdf::Value::Bool(self.parse_bool()?),
             (Type::Bool, true) => sdf::Value::BoolVec(self.parse_bool_array()?),
 
-            (Type::Asset, false) => sdf::Value::AssetPath(self.parse_asset_path()?.into()),
+            (Type::Asset, false) => sdf::Value::AssetPath(Box::new(self.parse_asset_path()?.into())),
             (Type::Asset, true) => {
                 sdf::Value::AssetPathVec(self.parse_asset_path_array()?.into_iter().map(Into::into).collect())
             }
@@ -1557,8 +1557,8 @@ impl<'a> Parser<'a> {
             (Type::String | Type::Token, true) => sdf::Value::token_vec(self.parse_array::<String>()?),
 
             (Type::Matrix2d, false) => sdf::Value::Matrix2d(gf::Mat2d(self.parse_matrix::<2, 4>()?)),
-            (Type::Matrix3d, false) => sdf::Value::Matrix3d(gf::Mat3d(self.parse_matrix::<3, 9>()?)),
-            (Type::Matrix4d, false) => sdf::Value::Matrix4d(gf::Matrix4d(self.parse_matrix::<4, 16>()?)),
+            (Type::Matrix3d, false) => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.parse_matrix::<3, 9>()?))),
+            (Type::Matrix4d, false) => sdf::Value::Matrix4d(Box::new(gf::Matrix4d(self.parse_matrix::<4, 16>()?))),
             (Type::Matrix2d, true) => {
                 sdf::Value::Matrix2dVec(self.parse_matrix_array::<2, 4>()?.into_iter().map(gf::Mat2d).collect())
             }
@@ -2480,7 +2480,7 @@ def Shader "Image_Texture"
         assert!(matches!(
             file_spec
                 .get(FieldKey::Default.as_str()),
-            Some(sdf::Value::AssetPath(path)) if path == "./texture.png"
+            Some(sdf::Value::AssetPath(path)) if **path == "./texture.png"
         ));
 
         let output_spec = data

@@ -31,34 +31,54 @@ struct Spec {
     /// Specifies the type of an object.
     ty: sdf::SpecType,
     /// Start index into the file's `fieldsets` for the fields read from the
-    /// crate, or `None` for a spec created in memory.
-    fieldset: Option<usize>,
+    /// crate, or [`NO_FIELDSET`] for a spec created in memory.
+    fieldset: u32,
     /// Fields authored after load, layered over the crate fields in authored
     /// order. `Some` sets or overrides a field; `None` tombstones one so it
-    /// reads as absent even when the crate holds it.
-    authored: Vec<(String, Option<sdf::Value>)>,
+    /// reads as absent even when the crate holds it. Boxed, and absent until a
+    /// field is authored (ppis patch: a spec is 16 bytes instead of 48, and the
+    /// layer's table holds one per spec of the file; see PATCHED.md).
+    authored: Option<Box<Vec<(String, Option<sdf::Value>)>>>,
 }
 
+/// [`Spec::fieldset`] of a spec created in memory.
+const NO_FIELDSET: u32 = u32::MAX;
+
+const _: () = assert!(mem::size_of::<Spec>() == 16);
+
 impl Spec {
+    /// Start index into the file's `fieldsets`, or `None` for a spec created in memory.
+    fn fieldset(&self) -> Option<usize> {
+        (self.fieldset != NO_FIELDSET).then_some(self.fieldset as usize)
+    }
+
+    /// The fields authored after load.
+    fn authored_fields(&self) -> &[(String, Option<sdf::Value>)] {
+        self.authored.as_deref().map_or(&[], Vec::as_slice)
+    }
+
     /// Returns the authored override for `field`: `Some(&Some(value))` when set,
     /// `Some(&None)` when tombstoned, `None` when the crate fields alone decide.
     fn authored(&self, field: &str) -> Option<&Option<sdf::Value>> {
-        self.authored.iter().find(|(k, _)| k == field).map(|(_, v)| v)
+        self.authored_fields().iter().find(|(k, _)| k == field).map(|(_, v)| v)
     }
 
     /// Sets the authored override for `field`, replacing any prior one.
     fn set_authored(&mut self, field: &str, value: Option<sdf::Value>) {
-        if let Some(slot) = self.authored.iter_mut().find(|(k, _)| k == field) {
+        let authored = self.authored.get_or_insert_with(Box::default);
+        if let Some(slot) = authored.iter_mut().find(|(k, _)| k == field) {
             slot.1 = value;
         } else {
-            self.authored.push((field.to_owned(), value));
+            authored.push((field.to_owned(), value));
         }
     }
 
     /// Drops any authored override for `field`, restoring authored order so a
     /// later set re-appends rather than reusing the old slot.
     fn remove_authored(&mut self, field: &str) {
-        self.authored.retain(|(k, _)| k != field);
+        if let Some(authored) = &mut self.authored {
+            authored.retain(|(k, _)| k != field);
+        }
     }
 }
 
@@ -88,12 +108,16 @@ where
 
         for spec in &specs {
             let path = file.paths[spec.path_index].clone();
+            let fieldset = u32::try_from(spec.fieldset_index)
+                .ok()
+                .filter(|&i| i != NO_FIELDSET)
+                .context("corrupt file: fieldset index out of range")?;
             data.insert(
                 path,
                 Spec {
                     ty: spec.spec_type,
-                    fieldset: Some(spec.fieldset_index),
-                    authored: Vec::new(),
+                    fieldset,
+                    authored: None,
                 },
             );
         }
@@ -121,7 +145,7 @@ where
         if let Some(authored) = spec.authored(field) {
             return authored.is_some();
         }
-        match spec.fieldset {
+        match spec.fieldset() {
             Some(start) => crate_fields(&self.file.borrow(), start).any(|(name, _)| name == field),
             None => false,
         }
@@ -139,7 +163,7 @@ where
         if let Some(authored) = spec.authored(field) {
             return Ok(authored.as_ref().map(Cow::Borrowed));
         }
-        let Some(start) = spec.fieldset else {
+        let Some(start) = spec.fieldset() else {
             return Ok(None);
         };
         let rep = crate_fields(&self.file.borrow(), start)
@@ -161,7 +185,7 @@ where
     fn list_fields(&self, path: &sdf::Path) -> Option<Vec<String>> {
         let spec = self.data.get(path)?;
         let mut names = Vec::new();
-        if let Some(start) = spec.fieldset {
+        if let Some(start) = spec.fieldset() {
             for (name, _) in crate_fields(&self.file.borrow(), start) {
                 // A tombstoned crate field is skipped; an overridden one keeps
                 // its crate position and is not duplicated by the overlay pass.
@@ -170,7 +194,7 @@ where
                 }
             }
         }
-        for (field, value) in &spec.authored {
+        for (field, value) in spec.authored_fields() {
             if value.is_some() && !names.iter().any(|n| n == field) {
                 names.push(field.clone());
             }
@@ -189,8 +213,8 @@ where
             path,
             Spec {
                 ty,
-                fieldset: None,
-                authored: Vec::new(),
+                fieldset: NO_FIELDSET,
+                authored: None,
             },
         );
     }
@@ -214,7 +238,7 @@ where
         // authored-only or absent field, dropping the overlay entry keeps erase
         // idempotent and lets a later set re-append in authored order.
         let masks_crate = spec
-            .fieldset
+            .fieldset()
             .is_some_and(|start| crate_fields(&self.file.borrow(), start).any(|(name, _)| name == field));
         if masks_crate {
             spec.set_authored(field, None);

@@ -1000,7 +1000,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 self.set_position(value.payload())?;
                 sdf::Value::AssetPathVec(self.read_string_vec()?.into_iter().map(Into::into).collect())
             }
-            Type::AssetPath => sdf::Value::AssetPath(self.read_asset_path(value)?.into()),
+            Type::AssetPath => sdf::Value::AssetPath(Box::new(self.read_asset_path(value)?.into())),
 
             Type::Token if value.is_array() => {
                 let (count, _) = self.unpack_array_len(value, ArrayKind::Other)?;
@@ -1125,15 +1125,15 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 sdf::Value::Matrix2d(gf::Mat2d(to_mat_diag::<2, 4>(self.unpack_value(value)?)))
             }
             Type::Matrix3d if value.is_inlined() => {
-                sdf::Value::Matrix3d(gf::Mat3d(to_mat_diag::<3, 9>(self.unpack_value(value)?)))
+                sdf::Value::Matrix3d(Box::new(gf::Mat3d(to_mat_diag::<3, 9>(self.unpack_value(value)?))))
             }
             Type::Matrix4d if value.is_inlined() => {
-                sdf::Value::Matrix4d(gf::Matrix4d(to_mat_diag::<4, 16>(self.unpack_value(value)?)))
+                sdf::Value::Matrix4d(Box::new(gf::Matrix4d(to_mat_diag::<4, 16>(self.unpack_value(value)?))))
             }
 
             Type::Matrix2d => sdf::Value::Matrix2d(gf::Mat2d(self.unpack_value::<[f64; 4]>(value)?)),
-            Type::Matrix3d => sdf::Value::Matrix3d(gf::Mat3d(self.unpack_value::<[f64; 9]>(value)?)),
-            Type::Matrix4d => sdf::Value::Matrix4d(gf::Matrix4d(self.unpack_value::<[f64; 16]>(value)?)),
+            Type::Matrix3d => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.unpack_value::<[f64; 9]>(value)?))),
+            Type::Matrix4d => sdf::Value::Matrix4d(Box::new(gf::Matrix4d(self.unpack_value::<[f64; 16]>(value)?))),
 
             //
             // Quats
@@ -1180,19 +1180,19 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 let list = self.read_list_op(value, |file: &mut Self| {
                     Ok(file.read_token_vec()?.into_iter().map(tf::Token::from).collect())
                 })?;
-                sdf::Value::TokenListOp(list)
+                sdf::Value::TokenListOp(Box::new(list))
             }
             Type::StringListOp => {
                 ensure!(!value.is_inlined());
 
                 let list = self.read_list_op(value, |file: &mut Self| file.read_string_vec())?;
-                sdf::Value::StringListOp(list)
+                sdf::Value::StringListOp(Box::new(list))
             }
             Type::PathListOp => {
                 ensure!(!value.is_inlined());
 
                 let list = self.read_list_op(value, |file: &mut Self| file.read_path_vec())?;
-                sdf::Value::PathListOp(list)
+                sdf::Value::PathListOp(Box::new(list))
             }
             Type::ReferenceListOp => {
                 ensure!(!value.is_inlined());
@@ -1209,24 +1209,24 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     Ok(vec)
                 })?;
 
-                sdf::Value::ReferenceListOp(list)
+                sdf::Value::ReferenceListOp(Box::new(list))
             }
 
             Type::IntListOp => {
                 ensure!(!value.is_inlined());
-                sdf::Value::IntListOp(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?)
+                sdf::Value::IntListOp(Box::new(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?))
             }
             Type::Int64ListOp => {
                 ensure!(!value.is_inlined());
-                sdf::Value::Int64ListOp(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?)
+                sdf::Value::Int64ListOp(Box::new(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?))
             }
             Type::UIntListOp => {
                 ensure!(!value.is_inlined());
-                sdf::Value::UIntListOp(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?)
+                sdf::Value::UIntListOp(Box::new(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?))
             }
             Type::UInt64ListOp => {
                 ensure!(!value.is_inlined());
-                sdf::Value::UInt64ListOp(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?)
+                sdf::Value::UInt64ListOp(Box::new(self.read_list_op(value, |f: &mut Self| f.read_pod_vec())?))
             }
 
             //
@@ -1295,7 +1295,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 self.set_position(value.payload())?;
 
                 let payload = self.read_payload()?;
-                sdf::Value::Payload(payload)
+                sdf::Value::Payload(Box::new(payload))
             }
 
             Type::PayloadListOp => {
@@ -1310,7 +1310,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     Ok(vec)
                 })?;
 
-                sdf::Value::PayloadListOp(list)
+                sdf::Value::PayloadListOp(Box::new(list))
             }
 
             Type::VariantSelectionMap => {
@@ -1418,7 +1418,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             Type::UnregisteredValueListOp => {
                 ensure!(!value.is_inlined());
                 let list = self.read_list_op(value, |file: &mut Self| file.read_string_vec())?;
-                sdf::Value::UnregisteredValueListOp(list)
+                sdf::Value::UnregisteredValueListOp(Box::new(list))
             }
 
             Type::Relocates => {

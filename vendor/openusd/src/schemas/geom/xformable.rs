@@ -254,7 +254,7 @@ fn build_op_matrix(prim: &Prim, op_name: &str, time: TimeCode) -> Result<gf::Mat
             }
         }
         "transform" => match raw {
-            sdf::Value::Matrix4d(m) => m,
+            sdf::Value::Matrix4d(m) => *m,
             _ => gf::Matrix4d::IDENTITY,
         },
         _ => gf::Matrix4d::IDENTITY,

@@ -809,7 +809,7 @@ mod tests {
         let r = RectLight::define(&stage, "/Rect")?;
         r.create_width_attr()?.set(2.0_f32)?;
         r.create_texture_file_attr()?
-            .set(sdf::Value::AssetPath("./softbox.exr".into()))?;
+            .set(sdf::Value::AssetPath(Box::new("./softbox.exr".into())))?;
         r.create_filters_rel()?.set_targets([sdf::path("/Filter")?])?;
 
         let r = RectLight::get(&stage, "/Rect")?.expect("RectLight");

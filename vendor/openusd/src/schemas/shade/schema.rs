@@ -310,7 +310,7 @@ mod tests {
             .set(ImplementationSource::SourceAsset)?;
         shader
             .create_source_asset_attr()?
-            .set(Value::AssetPath("./OmniPBR.mdl".into()))?;
+            .set(Value::AssetPath(Box::new("./OmniPBR.mdl".into())))?;
         shader
             .create_source_asset_subidentifier_attr()?
             .set(sdf::Value::token("OmniPBR"))?;

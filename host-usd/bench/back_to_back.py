@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""Import time of `ppis info` and Pixar's library back to back, wall clock and CPU time.
+
+For each FILE, R times: `ppis info FILE` (wall clock; user + system CPU time and peak RSS by
+`/usr/bin/time`), then Pixar's `Usd.Stage.Open` plus a traversal computing every gprim's
+world transform (as import_bench.py; `process_time` for its CPU time). Prints the minimum of
+each column and the ratios, a Markdown table. On a shared machine the CPU-time ratio is the
+steadier one.
+
+    python3 host-usd/bench/back_to_back.py PPIS R FILE...
+
+The files come from import_bench.py (its --dir).
+"""
+import subprocess, sys, time, os
+PIXAR = r"""
+import sys, time
+from pxr import Usd, UsdGeom
+t = time.perf_counter(); c = time.process_time()
+stage = Usd.Stage.Open(sys.argv[1])
+cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+n = 0
+for p in stage.Traverse():
+    if p.IsA(UsdGeom.Gprim):
+        cache.GetLocalToWorldTransform(p)
+        n += 1
+print(time.perf_counter() - t, time.process_time() - c, n)
+"""
+ppis = sys.argv[1]; R = int(sys.argv[2]); files = sys.argv[3:]
+print("| file | ppis s | Pixar s | ratio | ppis CPU s | Pixar CPU s | CPU ratio | peak MB |")
+print("|---|---:|---:|---:|---:|---:|---:|---:|")
+for f in files:
+    pw=[];pc=[];xw=[];xc=[];rss=[]
+    for _ in range(R):
+        t=time.perf_counter()
+        r=subprocess.run(["/usr/bin/time","-f","%U %S %M",ppis,"info",f],capture_output=True,text=True)
+        pw.append(time.perf_counter()-t)
+        assert r.returncode==0, r.stderr[-500:]
+        u,s,m=r.stderr.strip().splitlines()[-1].split()
+        pc.append(float(u)+float(s)); rss.append(int(m)*1024)
+        x=subprocess.run([sys.executable,"-c",PIXAR,f],capture_output=True,text=True).stdout.split()
+        xw.append(float(x[0])); xc.append(float(x[1]))
+    name=os.path.basename(f)
+    print(f"| {name} | {min(pw):.3f} | {min(xw):.3f} | {min(pw)/min(xw):.2f} | {min(pc):.2f} | {min(xc):.2f} | {min(pc)/min(xc):.2f} | {min(rss)/2**20:.1f} |",flush=True)
