@@ -70,7 +70,7 @@ pub(super) fn build(prims: Vec<Primitive>) -> (Vec<Primitive>, Vec<Node>) {
         return (prims, Vec::new());
     }
     let mut items: Vec<Item> =
-        prims.par_iter().enumerate().map(|(k, p)| Item { bounds: p.bounds(), prim: k as u32 }).collect();
+        prims.par_iter().enumerate().map(|(k, p)| Item { bounds: p.aabb(), prim: k as u32 }).collect();
     let mut nodes = Vec::with_capacity(2 * prims.len() / LEAF_SIZE + 1);
     let extent = Extent::of(&items);
     subtree(&mut items, 0, 0, extent, &mut nodes);
@@ -264,7 +264,7 @@ mod tests {
             if n.count > 0 {
                 assert!(n.count as usize <= LEAF_MAX, "leaf {i} holds {}", n.count);
                 for p in &ordered[n.offset as usize..(n.offset + n.count) as usize] {
-                    assert!(inside(p.bounds(), n.bounds));
+                    assert!(inside(p.aabb(), n.bounds));
                     seen[material(p) as usize] += 1;
                 }
             } else {

@@ -45,7 +45,13 @@ struct CornerAttrs {
 }
 
 impl Primitive {
-    fn bounds(&self) -> Aabb {
+    /// The corners (min, max) of the primitive's bounding box.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let b = self.aabb();
+        (b.min, b.max)
+    }
+
+    fn aabb(&self) -> Aabb {
         match *self {
             Primitive::Sphere { center, radius, .. } => {
                 Aabb { min: center - Vec3::splat(radius), max: center + Vec3::splat(radius) }
@@ -57,9 +63,9 @@ impl Primitive {
         }
     }
 
-    /// Distance along the ray to the nearest hit in (t_min, t_max), if any.
+    /// Distance along o + t·d to the nearest hit in (t_min, t_max), if any.
     #[inline]
-    fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
         match *self {
             Primitive::Sphere { center, radius, .. } => {
                 // Numerically robust: the closest approach first (Ray Tracing Gems ch. 7).
@@ -219,6 +225,11 @@ impl Bvh {
     /// Number of primitives.
     pub fn primitive_count(&self) -> usize {
         self.prims.len()
+    }
+
+    /// The primitives, in the hierarchy's order.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.prims
     }
 
     /// The nearest hit along o + t·d (d unit), t ∈ (t_min, t_max).
