@@ -3,12 +3,15 @@
 //! Debian's `libembree-dev`) Embree 3, on the scenes of docs/scenes/ and a 100k-triangle mesh.
 //! The figures are in docs/bvh.md.
 
+mod cpu_time;
 mod scenes;
 #[cfg(feature = "embree")]
 mod theirs_embree;
 mod theirs_obvhs;
 
+use cpu_time::ThreadCpu;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use host_std::trace::bvh::ShadowRay;
 use scenes::{Case, Ray};
 use std::hint::black_box;
 use std::time::Duration;
@@ -69,7 +72,7 @@ fn agreement(case: &Case, name: &str, t: &impl Tracer) {
 }
 
 /// One tracer's two measurements on a case.
-fn measure(c: &mut Criterion, case: &Case, name: &str, t: &impl Tracer) {
+fn measure(c: &mut Criterion<ThreadCpu>, case: &Case, name: &str, t: &impl Tracer) {
     agreement(case, name, t);
     let mut g = c.benchmark_group(format!("closest/{}", case.name));
     g.throughput(Throughput::Elements(case.camera.len() as u64));
@@ -81,7 +84,28 @@ fn measure(c: &mut Criterion, case: &Case, name: &str, t: &impl Tracer) {
     g.finish();
 }
 
-fn group(c: &mut Criterion, case: &Case) {
+/// Our shadow rays through the batched call, in batches of 256 as a wavefront would hand them.
+fn many(c: &mut Criterion<ThreadCpu>, case: &Case) {
+    let rays: Vec<ShadowRay> =
+        case.shadow.iter().map(|r| ShadowRay { origin: r.o, dir: r.d, t_min: r.t_min, t_max: f32::INFINITY }).collect();
+    let mut out = vec![false; 256];
+    let mut g = c.benchmark_group(format!("shadow/{}", case.name));
+    g.throughput(Throughput::Elements(rays.len() as u64));
+    g.bench_function("ours-many", |b| {
+        b.iter(|| {
+            let mut n = 0;
+            for batch in rays.chunks(256) {
+                let out = &mut out[..batch.len()];
+                case.bvh.occluded_many(black_box(batch), out);
+                n += out.iter().filter(|&&o| o).count();
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+}
+
+fn group(c: &mut Criterion<ThreadCpu>, case: &Case) {
     eprintln!(
         "{}: {} primitives, {} camera rays, {} shadow rays",
         case.name,
@@ -90,6 +114,7 @@ fn group(c: &mut Criterion, case: &Case) {
         case.shadow.len()
     );
     measure(c, case, "ours", &Ours(&case.bvh));
+    many(c, case);
     measure(c, case, "obvhs", &theirs_obvhs::Obvhs::build(&case.bvh));
     #[cfg(feature = "embree")]
     measure(c, case, "embree", &theirs_embree::Embree::build(&case.bvh));
@@ -100,7 +125,7 @@ fn count(rays: &[Ray], f: impl Fn(&Ray) -> bool) -> usize {
     black_box(rays.iter().filter(|r| f(black_box(r))).count())
 }
 
-fn bvh(c: &mut Criterion) {
+fn bvh(c: &mut Criterion<ThreadCpu>) {
     for case in scenes::cases() {
         group(c, &case);
     }
@@ -108,7 +133,7 @@ fn bvh(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3)).sample_size(20);
+    config = Criterion::default().with_measurement(cpu_time::ThreadCpu).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3)).sample_size(20);
     targets = bvh
 }
 criterion_main!(benches);
