@@ -70,7 +70,7 @@ pub(super) fn build(prims: Vec<Primitive>) -> (Vec<Primitive>, Vec<Node>) {
         return (prims, Vec::new());
     }
     let mut items: Vec<Item> =
-        prims.par_iter().enumerate().map(|(k, p)| Item { bounds: p.bounds(), prim: k as u32 }).collect();
+        prims.par_iter().enumerate().map(|(k, p)| Item { bounds: p.aabb(), prim: k as u32 }).collect();
     let mut nodes = Vec::with_capacity(2 * prims.len() / LEAF_SIZE + 1);
     let extent = Extent::of(&items);
     subtree(&mut items, 0, 0, extent, &mut nodes);
@@ -83,8 +83,8 @@ pub(super) fn build(prims: Vec<Primitive>) -> (Vec<Primitive>, Vec<Node>) {
 fn subtree(items: &mut [Item], first: usize, depth: u32, extent: Extent, nodes: &mut Vec<Node>) {
     let bounds = extent.bounds;
     let index = nodes.len();
-    nodes.push(Node { bounds, offset: first as u32, count: items.len() as u32, axis: 0 });
-    let Some((axis, mid, [le, re])) = split(items, extent, depth) else { return };
+    nodes.push(Node { bounds, offset: first as u32, count: items.len() as u32 });
+    let Some((mid, [le, re])) = split(items, extent, depth) else { return };
     let parallel = items.len() >= PARALLEL_MIN;
     let (left, right) = items.split_at_mut(mid);
     let second = if parallel {
@@ -108,12 +108,12 @@ fn subtree(items: &mut [Item], first: usize, depth: u32, extent: Extent, nodes: 
         subtree(right, first + mid, depth + 1, re, nodes);
         base
     };
-    nodes[index] = Node { bounds, offset: second as u32, count: 0, axis };
+    nodes[index] = Node { bounds, offset: second as u32, count: 0 };
 }
 
-/// Where to split `items` (reordering them): the axis, the size of the first part and the
-/// extents of both parts, or `None` for a leaf.
-fn split(items: &mut [Item], extent: Extent, depth: u32) -> Option<(u8, usize, [Extent; 2])> {
+/// Where to split `items` (reordering them): the size of the first part and the extents of
+/// both parts, or `None` for a leaf.
+fn split(items: &mut [Item], extent: Extent, depth: u32) -> Option<(usize, [Extent; 2])> {
     let n = items.len();
     if n <= LEAF_SIZE {
         return None;
@@ -141,10 +141,10 @@ fn split(items: &mut [Item], extent: Extent, depth: u32) -> Option<(u8, usize, [
         let m = n / 2;
         items.select_nth_unstable_by(m, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
         let (l, r) = items.split_at(m);
-        return Some((axis as u8, m, [Extent::of(l), Extent::of(r)]));
+        return Some((m, [Extent::of(l), Extent::of(r)]));
     }
     let side = |bins: &[Bin]| bins.iter().fold(Extent::EMPTY, |e, b| e.union(b.0));
-    Some((axis as u8, mid, [side(&bins[..=last_left]), side(&bins[last_left + 1..])]))
+    Some((mid, [side(&bins[..=last_left]), side(&bins[last_left + 1..])]))
 }
 
 /// The items' bins (in parallel for many items: the union and the counts do not depend on
@@ -230,9 +230,9 @@ mod tests {
         pool.install(|| build(prims.to_vec()))
     }
 
-    fn key(n: &Node) -> ([f32; 6], u32, u32, u8) {
+    fn key(n: &Node) -> ([f32; 6], u32, u32) {
         let b = n.bounds;
-        ([b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z], n.offset, n.count, n.axis)
+        ([b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z], n.offset, n.count)
     }
 
     fn material(p: &Primitive) -> u32 {
@@ -264,7 +264,7 @@ mod tests {
             if n.count > 0 {
                 assert!(n.count as usize <= LEAF_MAX, "leaf {i} holds {}", n.count);
                 for p in &ordered[n.offset as usize..(n.offset + n.count) as usize] {
-                    assert!(inside(p.bounds(), n.bounds));
+                    assert!(inside(p.aabb(), n.bounds));
                     seen[material(p) as usize] += 1;
                 }
             } else {

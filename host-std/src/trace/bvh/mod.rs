@@ -1,39 +1,21 @@
-//! Ray intersection: spheres and triangles in a bounding volume hierarchy built with the binned
-//! surface-area heuristic (`build.rs`), flattened depth-first.
+//! Ray intersection: spheres and triangles in a bounding volume hierarchy, built binary with
+//! the binned surface-area heuristic (`build.rs`) and collapsed to four children per node
+//! (`wide.rs`) whose boxes a ray tests at once in SIMD lanes (`lanes.rs`, `traverse.rs`).
+//! Primitive tests (`primitive.rs`) decide every hit, so the closest hit is the one a test of
+//! every primitive finds.
 
 mod build;
+mod lanes;
+mod leaf;
+mod primitive;
+mod traverse;
+mod wide;
+
+use primitive::Aabb;
+pub use primitive::Primitive;
 
 use crate::scene::{Scene, Shape};
 use sampler_core::glam::{Vec2, Vec3};
-use std::mem::MaybeUninit;
-
-/// One intersectable primitive.
-#[derive(Clone, Copy, Debug)]
-pub enum Primitive {
-    /// A sphere.
-    Sphere {
-        /// Centre.
-        center: Vec3,
-        /// Radius.
-        radius: f32,
-        /// Index into the scene's materials.
-        material: u32,
-    },
-    /// v0 and two edges; the front face is normalize(e1 × e2).
-    Triangle {
-        /// A vertex.
-        v0: Vec3,
-        /// The edge from `v0` to the second vertex.
-        e1: Vec3,
-        /// The edge from `v0` to the third vertex.
-        e2: Vec3,
-        /// Index into the scene's materials.
-        material: u32,
-        /// Index into the corner attributes, or `NO_ATTRS` (face normal, no texture
-        /// coordinates).
-        attrs: u32,
-    },
-}
 
 const NO_ATTRS: u32 = u32::MAX;
 
@@ -44,99 +26,6 @@ struct CornerAttrs {
     uvs: Option<[Vec2; 3]>,
 }
 
-impl Primitive {
-    fn bounds(&self) -> Aabb {
-        match *self {
-            Primitive::Sphere { center, radius, .. } => {
-                Aabb { min: center - Vec3::splat(radius), max: center + Vec3::splat(radius) }
-            }
-            Primitive::Triangle { v0, e1, e2, .. } => {
-                let (a, b) = (v0 + e1, v0 + e2);
-                Aabb { min: v0.min(a).min(b), max: v0.max(a).max(b) }
-            }
-        }
-    }
-
-    /// Distance along the ray to the nearest hit in (t_min, t_max), if any.
-    #[inline]
-    fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
-        match *self {
-            Primitive::Sphere { center, radius, .. } => {
-                // Numerically robust: the closest approach first (Ray Tracing Gems ch. 7).
-                let f = o - center;
-                let b = -f.dot(d);
-                let perp = f + b * d;
-                let disc = radius * radius - perp.length_squared();
-                if disc < 0.0 {
-                    return None;
-                }
-                // Roots of t² − 2bt + c = 0: q = b ± √disc with the sign of b, and c/q.
-                let c = f.length_squared() - radius * radius;
-                let q = b + disc.sqrt().copysign(b);
-                let (t0, t1) = if q != 0.0 { (q, c / q) } else { (0.0, 0.0) };
-                let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-                if near > t_min && near < t_max {
-                    Some(near)
-                } else if far > t_min && far < t_max {
-                    Some(far)
-                } else {
-                    None
-                }
-            }
-            Primitive::Triangle { v0, e1, e2, .. } => {
-                // Möller–Trumbore.
-                let p = d.cross(e2);
-                let det = e1.dot(p);
-                if det.abs() < 1e-20 {
-                    return None;
-                }
-                let inv = 1.0 / det;
-                let s = o - v0;
-                let u = s.dot(p) * inv;
-                if !(0.0..=1.0).contains(&u) {
-                    return None;
-                }
-                let q = s.cross(e1);
-                let v = d.dot(q) * inv;
-                if v < 0.0 || u + v > 1.0 {
-                    return None;
-                }
-                let t = e2.dot(q) * inv;
-                (t > t_min && t < t_max).then_some(t)
-            }
-        }
-    }
-}
-
-/// Axis-aligned box.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Aabb {
-    min: Vec3,
-    max: Vec3,
-}
-
-impl Aabb {
-    const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
-
-    fn union(self, o: Aabb) -> Aabb {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
-    }
-
-    fn area(&self) -> f32 {
-        let e = (self.max - self.min).max(Vec3::ZERO);
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-    }
-
-    #[inline]
-    fn hit(&self, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
-        let t0 = (self.min - o) * inv_d;
-        let t1 = (self.max - o) * inv_d;
-        let near = t0.min(t1).max_element().max(0.0);
-        let far = t0.max(t1).min_element().min(t_max);
-        near <= far
-    }
-}
-
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Node {
     bounds: Aabb,
@@ -144,8 +33,6 @@ pub(crate) struct Node {
     offset: u32,
     /// Primitives in a leaf; 0 for an inner node.
     count: u32,
-    /// Inner node: the split axis (its first child holds the lower side).
-    axis: u8,
 }
 
 /// Where a ray hit.
@@ -166,10 +53,25 @@ pub struct Hit {
     pub material: u32,
 }
 
+/// A shadow ray for [`Bvh::occluded_many`]: is anything on origin + t·dir, t ∈ (t_min, t_max)?
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRay {
+    /// Where the ray starts.
+    pub origin: Vec3,
+    /// Its direction (unit for distances in units of length).
+    pub dir: Vec3,
+    /// Start of the tested interval (exclusive).
+    pub t_min: f32,
+    /// End of the tested interval (exclusive).
+    pub t_max: f32,
+}
+
 /// The scene's primitives and their hierarchy.
 pub struct Bvh {
     prims: Vec<Primitive>,
-    nodes: Vec<Node>,
+    nodes: Vec<wide::Node4>,
+    /// The leaves' primitives, four to a block.
+    blocks: Vec<leaf::Block>,
     /// Per-corner shading normals and texture coordinates of triangles that have them.
     corner_attrs: Vec<CornerAttrs>,
 }
@@ -211,9 +113,10 @@ impl Bvh {
                 }
             }
         }
-        let nodes;
-        (prims, nodes) = build::build(prims);
-        Bvh { prims, nodes, corner_attrs }
+        let binary;
+        (prims, binary) = build::build(prims);
+        let (nodes, blocks) = wide::collapse(&binary, &prims);
+        Bvh { prims, nodes, blocks, corner_attrs }
     }
 
     /// Number of primitives.
@@ -221,16 +124,34 @@ impl Bvh {
         self.prims.len()
     }
 
+    /// The primitives, in the hierarchy's order.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.prims
+    }
+
     /// The nearest hit along o + t·d (d unit), t ∈ (t_min, t_max).
     pub fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
         let mut best: Option<usize> = None;
         let mut t_max = t_max;
-        self.traverse(o, d, &mut t_max, true, |prim, t_max| {
-            if let Some(t) = self.prims[prim].intersect(o, d, t_min, *t_max) {
-                *t_max = t;
-                best = Some(prim);
+        traverse::closest(&self.nodes, o, d, &mut t_max, |first, count, t_max| {
+            for b in &self.blocks[first as usize..(first + count) as usize] {
+                let (hits, t) = b.triangles(o, d, t_min, *t_max);
+                // Lane by lane as a loop over the primitives would meet them, so that the first
+                // of equal distances wins either way.
+                for k in 0..4 {
+                    let t = if hits & (1 << k) != 0 {
+                        Some(t[k])
+                    } else if b.spheres() & (1 << k) != 0 {
+                        self.prims[b.prim[k] as usize].intersect(o, d, t_min, *t_max)
+                    } else {
+                        None
+                    };
+                    if let Some(t) = t.filter(|t| *t < *t_max) {
+                        *t_max = t;
+                        best = Some(b.prim[k] as usize);
+                    }
+                }
             }
-            false
         });
         let prim = best?;
         let point = o + t_max * d;
@@ -268,63 +189,28 @@ impl Bvh {
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        let mut hit = false;
-        let mut t_max = t_max;
-        self.traverse(o, d, &mut t_max, false, |prim, t_max| {
-            hit = self.prims[prim].intersect(o, d, t_min, *t_max).is_some();
-            hit
-        });
-        hit
+        traverse::any(&self.nodes, o, d, t_max, |first, count| {
+            self.blocks[first as usize..(first + count) as usize].iter().any(|b| {
+                b.triangles(o, d, t_min, t_max).0 != 0 || {
+                    let mut spheres = b.spheres();
+                    let mut hit = false;
+                    while spheres != 0 && !hit {
+                        let k = spheres.trailing_zeros() as usize;
+                        spheres &= spheres - 1;
+                        hit = self.prims[b.prim[k] as usize].intersect(o, d, t_min, t_max).is_some();
+                    }
+                    hit
+                }
+            })
+        })
     }
 
-    /// Visits the primitives of every leaf the ray's box test lets through; `visit` may shrink
-    /// `t_max` and returns true to stop.
-    #[inline]
-    fn traverse(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t_max: &mut f32,
-        near_first: bool,
-        mut visit: impl FnMut(usize, &mut f32) -> bool,
-    ) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let inv_d = d.recip();
-        // Left uninitialised: zeroing the stack per ray is a noticeable share of a render of
-        // simple scenes.
-        let mut stack = [const { MaybeUninit::<u32>::uninit() }; 128];
-        stack[0].write(0);
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            // SAFETY: entries below `sp` were all written (the root above, children below).
-            let index = unsafe { stack[sp].assume_init() };
-            let node = self.nodes[index as usize];
-            if !node.bounds.hit(o, inv_d, *t_max) {
-                continue;
-            }
-            if node.count > 0 {
-                for prim in node.offset as usize..(node.offset + node.count) as usize {
-                    if visit(prim, t_max) {
-                        return;
-                    }
-                }
-            } else {
-                // The near child on top (visited next): the first child holds the lower side of
-                // the split axis. The build bounds the depth (median splits past depth 40), so
-                // the stack cannot overflow.
-                debug_assert!(sp + 2 <= stack.len());
-                let (near, far) = if (d[node.axis as usize] < 0.0) == near_first {
-                    (node.offset, index + 1)
-                } else {
-                    (index + 1, node.offset)
-                };
-                stack[sp].write(far);
-                stack[sp + 1].write(near);
-                sp += 2;
-            }
+    /// [`Bvh::occluded`] for each ray: `out[k]` is ray k's answer, bit for bit the one-at-a-time
+    /// call's. Panics unless `out` has one entry per ray.
+    pub fn occluded_many(&self, rays: &[ShadowRay], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "occluded_many: one answer per ray");
+        for (r, o) in rays.iter().zip(out) {
+            *o = self.occluded(r.origin, r.dir, r.t_min, r.t_max);
         }
     }
 }
@@ -351,6 +237,7 @@ mod tests {
         let scene = Scene { objects, materials: vec![material], ..crate::scene::builtin::scene() };
         let bvh = Bvh::build(&scene);
         let mut hits = 0;
+        let mut rays = Vec::new();
         for k in 0..2000 {
             let f = k as f32;
             let o = Vec3::new(-3.0 + (f * 0.37) % 20.0, -2.0 + (f * 0.11) % 16.0, -5.0);
@@ -360,8 +247,28 @@ mod tests {
             let hit = bvh.intersect(o, d, 1e-4, f32::INFINITY).map_or(f32::INFINITY, |h| h.t);
             assert_eq!(hit, brute, "ray {k}");
             assert_eq!(bvh.occluded(o, d, 1e-4, 50.0), brute < 50.0, "ray {k}");
+            rays.push(ShadowRay { origin: o, dir: d, t_min: 1e-4, t_max: if k % 2 == 0 { 50.0 } else { brute } });
             hits += usize::from(brute.is_finite());
         }
         assert!(hits > 300 && hits < 1900, "{hits} of 2000 rays hit: the test would miss some failures");
+        let mut many = vec![false; rays.len()];
+        bvh.occluded_many(&rays, &mut many);
+        for (r, m) in rays.iter().zip(&many) {
+            assert_eq!(*m, bvh.occluded(r.origin, r.dir, r.t_min, r.t_max));
+        }
+        assert!(many.iter().any(|&m| m) && !many.iter().all(|&m| m));
+    }
+
+    #[test]
+    fn a_lone_sphere_and_an_empty_scene_answer() {
+        let material = Material::new(crate::scene::Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
+        let sphere = Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 };
+        let scene = |objects| Scene { objects, materials: vec![material.clone()], ..crate::scene::builtin::scene() };
+        let (o, d) = (Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        let one = Bvh::build(&scene(vec![sphere]));
+        assert_eq!(one.intersect(o, d, 0.0, f32::INFINITY).map(|h| h.t), Some(4.0));
+        assert!(one.occluded(o, d, 0.0, f32::INFINITY) && !one.occluded(o, -d, 0.0, f32::INFINITY));
+        let none = Bvh::build(&scene(Vec::new()));
+        assert!(none.intersect(o, d, 0.0, f32::INFINITY).is_none() && !none.occluded(o, d, 0.0, f32::INFINITY));
     }
 }

@@ -1,0 +1,95 @@
+//! Traversal of the four-wide nodes with a fixed stack: closest hit visits the children a ray
+//! meets nearest first and skips those that start beyond the best hit so far; occlusion tests
+//! leaf children as soon as their box is met and stops at the first blocker.
+
+use super::wide::{LEAF, Node4, RayLanes};
+use sampler_core::glam::Vec3;
+use std::mem::MaybeUninit;
+
+/// Stack entries: a node descends at most one binary level per wide level, the binary build
+/// bounds its depth (median splits past depth 40), and each level leaves at most three
+/// entries behind.
+const STACK: usize = 256;
+
+/// Visits the primitives of every leaf whose box the ray meets within `t_max`, nearest box
+/// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`.
+#[inline(always)]
+pub(super) fn closest(nodes: &[Node4], o: Vec3, d: Vec3, t_max: &mut f32, mut visit: impl FnMut(u32, u32, &mut f32)) {
+    if nodes.is_empty() {
+        return;
+    }
+    let ray = RayLanes::new(o, d);
+    // Left uninitialised: zeroing the stack per ray is a noticeable share of simple scenes.
+    let mut stack = [const { MaybeUninit::<(u32, u32, f32)>::uninit() }; STACK];
+    stack[0].write((0, 0, 0.0));
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        // SAFETY: entries below `sp` were all written (the root above, children below).
+        let (child, count, entry) = unsafe { stack[sp].assume_init() };
+        if entry > *t_max {
+            continue;
+        }
+        if child & LEAF != 0 {
+            visit(child & !LEAF, count, t_max);
+            continue;
+        }
+        let node = &nodes[child as usize];
+        let (mut mask, near) = node.hit(&ray, *t_max);
+        // Pushed farthest first so that the nearest is popped next.
+        let mut order = [(0u32, 0u32, 0.0f32); 4];
+        let mut n = 0;
+        while mask != 0 {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let item = (node.child[k], node.count[k], near[k]);
+            let mut j = n;
+            while j > 0 && order[j - 1].2 < item.2 {
+                order[j] = order[j - 1];
+                j -= 1;
+            }
+            order[j] = item;
+            n += 1;
+        }
+        debug_assert!(sp + n <= STACK);
+        for item in &order[..n] {
+            stack[sp].write(*item);
+            sp += 1;
+        }
+    }
+}
+
+/// True when `test(first, count)` finds a blocker in a leaf whose box the ray meets within
+/// `t_max`.
+#[inline(always)]
+pub(super) fn any(nodes: &[Node4], o: Vec3, d: Vec3, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
+    if nodes.is_empty() {
+        return false;
+    }
+    let ray = RayLanes::new(o, d);
+    let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
+    stack[0].write(0);
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        // SAFETY: as in `closest`.
+        let index = unsafe { stack[sp].assume_init() };
+        let node = &nodes[index as usize];
+        let (mut mask, _) = node.hit(&ray, t_max);
+        while mask != 0 {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let child = node.child[k];
+            if child & LEAF != 0 {
+                if test(child & !LEAF, node.count[k]) {
+                    return true;
+                }
+            } else {
+                debug_assert!(sp < STACK);
+                stack[sp].write(child);
+                sp += 1;
+            }
+        }
+    }
+    false
+}

@@ -1,0 +1,135 @@
+//! The four-wide hierarchy that rays traverse: each node holds its four children's boxes as
+//! structure of arrays (one four-lane row per box plane), so one ray tests all four in a few
+//! SIMD operations ([`super::lanes::F4`]). It is collapsed from the binary SAH tree
+//! (`build.rs`): a node takes its binary children and keeps opening the largest inner one
+//! until it has four, so the boxes are the binary tree's boxes and only the levels between
+//! them go.
+
+use super::lanes::F4;
+use super::leaf::Block;
+use super::{Aabb, Node, Primitive};
+use sampler_core::glam::Vec3;
+
+/// A child that is a leaf: the low bits are its first block of primitives.
+pub(super) const LEAF: u32 = 1 << 31;
+/// A lane with no child (its box is empty, so no ray enters it).
+const EMPTY: u32 = u32::MAX;
+
+/// Four children's boxes and links.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Node4 {
+    /// Rows min x, max x, min y, max y, min z, max z; lane k is child k.
+    planes: [[f32; 4]; 6],
+    /// An inner child's node index, or `LEAF | first block`, or `EMPTY`.
+    pub(super) child: [u32; 4],
+    /// A leaf child's number of blocks (0 for the others).
+    pub(super) count: [u32; 4],
+}
+
+/// A ray prepared for box tests: origin and reciprocal direction in all lanes, and per axis
+/// which of a box's two planes it meets first.
+pub(super) struct RayLanes {
+    o: [F4; 3],
+    inv: [F4; 3],
+    /// Row offset (0 or 1) of the near plane of each axis within its pair.
+    near: [usize; 3],
+}
+
+impl RayLanes {
+    pub(super) fn new(o: Vec3, d: Vec3) -> RayLanes {
+        let inv = d.recip();
+        // The sign bit, not a comparison: a direction of −0 has reciprocal −∞ and meets the
+        // max plane first, which keeps empty lanes (min +∞, max −∞) empty.
+        let near = [inv.x, inv.y, inv.z].map(|v| usize::from(v.is_sign_negative()));
+        RayLanes { o: [o.x, o.y, o.z].map(F4::splat), inv: [inv.x, inv.y, inv.z].map(F4::splat), near }
+    }
+}
+
+impl Node4 {
+    /// Which children's boxes the ray meets within [0, t_max] (bit k for child k) and the
+    /// entry distance of each. NaN slab distances (a ray in a box's plane) leave the interval
+    /// as it is, so such boxes count as met.
+    #[inline(always)]
+    pub(super) fn hit(&self, r: &RayLanes, t_max: f32) -> (u32, [f32; 4]) {
+        let mut near = F4::splat(0.0);
+        let mut far = F4::splat(t_max);
+        for axis in 0..3 {
+            let lo = F4::load(&self.planes[2 * axis + r.near[axis]]);
+            let hi = F4::load(&self.planes[2 * axis + 1 - r.near[axis]]);
+            near = lo.sub(r.o[axis]).mul(r.inv[axis]).max_or(near);
+            far = hi.sub(r.o[axis]).mul(r.inv[axis]).min_or(far);
+        }
+        (near.le_mask(far), near.to_array())
+    }
+}
+
+/// The four-wide nodes over the binary tree `bin` of `prims` (root first, then each subtree
+/// depth first), and the blocks of its leaves.
+pub(super) fn collapse(bin: &[Node], prims: &[Primitive]) -> (Vec<Node4>, Vec<Block>) {
+    let mut tree = Tree { bin, prims, nodes: Vec::with_capacity(bin.len() / 2 + 1), blocks: Vec::new() };
+    if !bin.is_empty() {
+        tree.emit(0);
+    }
+    (tree.nodes, tree.blocks)
+}
+
+/// The collapse under way.
+struct Tree<'a> {
+    bin: &'a [Node],
+    prims: &'a [Primitive],
+    nodes: Vec<Node4>,
+    blocks: Vec<Block>,
+}
+
+impl Tree<'_> {
+    /// Appends the node whose children are the binary node `index`'s (or the leaf `index`
+    /// alone), opened up to four, and their subtrees; returns its index.
+    fn emit(&mut self, index: usize) -> u32 {
+        let children = open(self.bin, index);
+        let me = self.nodes.len();
+        let empty = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
+        let mut node = Node4 { planes: [[0.0; 4]; 6], child: [EMPTY; 4], count: [0; 4] };
+        self.nodes.push(node);
+        for k in 0..4 {
+            let b = children.get(k).map_or(empty, |&c| self.bin[c].bounds);
+            for axis in 0..3 {
+                node.planes[2 * axis][k] = b.min[axis];
+                node.planes[2 * axis + 1][k] = b.max[axis];
+            }
+            if let Some(&c) = children.get(k) {
+                let n = self.bin[c];
+                if n.count > 0 {
+                    let first = self.blocks.len() as u32;
+                    Block::pack(self.prims, n.offset, n.count, &mut self.blocks);
+                    assert!(first < LEAF, "too many primitives for the node format");
+                    (node.child[k], node.count[k]) = (LEAF | first, self.blocks.len() as u32 - first);
+                } else {
+                    node.child[k] = self.emit(c);
+                }
+            }
+        }
+        self.nodes[me] = node;
+        me as u32
+    }
+}
+
+/// The binary nodes that become one wide node's children: the binary node's two children,
+/// the inner one of largest surface area replaced by its two until there are four (or only
+/// leaves), in depth-first order.
+fn open(bin: &[Node], index: usize) -> Vec<usize> {
+    let node = bin[index];
+    if node.count > 0 {
+        return vec![index];
+    }
+    let mut children = vec![index + 1, node.offset as usize];
+    while children.len() < 4 {
+        let widest = (0..children.len())
+            .filter(|&k| bin[children[k]].count == 0)
+            .max_by(|&a, &b| bin[children[a]].bounds.area().total_cmp(&bin[children[b]].bounds.area()));
+        let Some(k) = widest else { break };
+        let c = children[k];
+        children.splice(k..=k, [c + 1, bin[c].offset as usize]);
+    }
+    children
+}
