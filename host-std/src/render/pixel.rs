@@ -9,7 +9,7 @@ use crate::render::strategy::Strategy;
 use crate::render::wavefront::{self, WaveBuffers};
 use crate::render::{Context, Counters};
 use crate::scene::{Bsdf, Scene};
-use crate::trace::bvh;
+use crate::trace::bvh::{self, ShadowRay};
 use crate::trace::camera::Camera;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
@@ -204,9 +204,26 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
                 Some(&k) => run_of(&hits[k]),
                 None => Run { seed: seeds.light, block: 0 },
             });
+            let origins: [Vec3; GROUP] =
+                std::array::from_fn(|i| members[..m].get(i).map_or(Vec3::ZERO, |&k| hits[k].origin));
             let mut out = [DVec3::ZERO; GROUP];
-            let mut vis = |i: usize, d: Vec3| visible(members[i], d);
-            wavefront::shade_wavefront(&sampling, env, &points[..m], &runs[..m], budget, waves, &mut vis, &mut out);
+            let occluded_many = |rays: &[ShadowRay], blocked: &mut [bool]| {
+                if shadows {
+                    ctx.bvh.occluded_many(rays, blocked);
+                }
+            };
+            rays += wavefront::shade_wavefront(
+                &sampling,
+                env,
+                &points[..m],
+                &runs[..m],
+                &origins[..m],
+                budget,
+                waves,
+                occluded_many,
+                &mut out,
+            )
+            .map_or(0, |r| r as u64);
             for (i, &k) in members[..m].iter().enumerate() {
                 (values[k], done[k]) = (out[i], true);
             }

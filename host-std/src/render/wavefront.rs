@@ -6,6 +6,7 @@
 //! together and their shadow rays traced together.
 
 use crate::render::shade::{Run, Sampling};
+use crate::trace::bvh::ShadowRay;
 use sampler_core::brdf::Brdf;
 use sampler_core::direction::DirectionSampler;
 use sampler_core::env::EnvHierarchy;
@@ -83,23 +84,27 @@ pub(crate) fn split_counts(budget: usize, share: f64) -> (usize, usize) {
 pub(crate) struct WaveBuffers {
     samples: Vec<WaveSample>,
     candidates: Vec<Candidate>,
+    rays: Vec<ShadowRay>,
+    blocked: Vec<bool>,
 }
 
 /// Each shading point's estimate of its direct light into `out`, from `budget` samples drawn
 /// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
-/// through one sampler for all of them and the budget is small ([`fits`]); `visible(k, dir)`
-/// traces point k's shadow ray. `None` (nothing done) otherwise.
+/// through one sampler for all of them and the budget is small ([`fits`]). The shadow rays of
+/// all samples that need one (from `origins[k]`, point k's) are traced together by
+/// `occluded_many`; returns how many. `None` (nothing done) where the wavefront does not fit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_wavefront(
     sampling: &Sampling<'_, '_>,
     env: &EnvHierarchy<'_>,
     points: &[ShadingPoint<'_, dyn Brdf + '_>],
     runs: &[Run],
+    origins: &[Vec3],
     budget: usize,
     buffers: &mut WaveBuffers,
-    mut visible: impl FnMut(usize, Vec3) -> bool,
+    mut occluded_many: impl FnMut(&[ShadowRay], &mut [bool]),
     out: &mut [DVec3],
-) -> Option<()> {
+) -> Option<usize> {
     let layout = layout(sampling, budget)?;
     let weighting = match layout {
         Layout::Single { .. } => Weighting::Single,
@@ -123,12 +128,24 @@ pub(crate) fn shade_wavefront(
         Sampling::ProductMis { sampler, .. } => draw(sampler, points, weighting, buffers),
         _ => draw(env, points, weighting, buffers),
     }
+    // The shadow rays, all at once.
+    buffers.rays.clear();
     let per_point = layout.len();
-    for (point, (candidates, o)) in buffers.candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
-        let mut value = |c: &Candidate| if c.needs_ray && visible(point, c.dir) { c.value } else { DVec3::ZERO };
+    for (k, c) in buffers.candidates.iter().enumerate().filter(|(_, c)| c.needs_ray) {
+        buffers.rays.push(ShadowRay { origin: origins[k / per_point], dir: c.dir, t_min: 0.0, t_max: f32::INFINITY });
+    }
+    buffers.blocked.clear();
+    buffers.blocked.resize(buffers.rays.len(), false);
+    occluded_many(&buffers.rays, &mut buffers.blocked);
+    let mut blocked = buffers.blocked.iter();
+    for (candidates, o) in buffers.candidates.chunks(per_point).zip(out.iter_mut()) {
+        let mut value = |c: &Candidate| {
+            let visible = c.needs_ray && !blocked.next().copied().unwrap_or(true);
+            if visible { c.value } else { DVec3::ZERO }
+        };
         *o = reduce(layout, candidates, &mut value);
     }
-    Some(())
+    Some(buffers.rays.len())
 }
 
 /// The wavefront's candidates, drawn by `sampler`.
