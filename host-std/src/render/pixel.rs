@@ -182,13 +182,7 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         let lead_sp = shading_point(ctx.scene, lead);
         let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
         let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });
-        // The material's points from here on, for a wavefront or a shared sampler.
-        let mut members = [0usize; GROUP];
-        let mut m = 0;
-        for k in (first..n).filter(|&k| hits[k].material == group) {
-            members[m] = k;
-            m += 1;
-        }
+        let (members, m) = members_of(hits, first);
         let mut rays = 0u64;
         let mut visible = |k: usize, d: Vec3| {
             rays += 1;
@@ -250,6 +244,18 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         counters.shadow_rays += if shadows { rays } else { 0 };
     }
     add_in_order(ctx, hits, &values[..n], sum);
+}
+
+/// The indices of the hits of `hits[first]`'s material from `first` on (in order), and their
+/// count: the points a wavefront or a shared sampler shades together.
+fn members_of(hits: &[Hit], first: usize) -> ([usize; GROUP], usize) {
+    let mut members = [0usize; GROUP];
+    let mut m = 0;
+    for k in (first..hits.len()).filter(|&k| hits[k].material == hits[first].material) {
+        members[m] = k;
+        m += 1;
+    }
+    (members, m)
 }
 
 /// Adds the points' estimates to `sum` in hit order, a product-MIS material's points
