@@ -152,7 +152,7 @@ struct PdfLane {
 
 impl ProductSampler<'_, '_> {
     /// [`pdf_square`](Self::pdf_square) at every point of `uv` (into `out`, as many as both
-    /// hold), bit for bit: the same leaves and their path probabilities, [`LANES`] descents side by
+    /// hold), bit for bit: the same leaves and their path probabilities, eight descents side by
     /// side.
     pub fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
         let Some(&root) = self.nodes.first() else {
