@@ -17,9 +17,6 @@ const CRATES: [&str; 5] = ["sampler-core", "sampler-capi", "host-std", "host-usd
 const PLACEHOLDERS: [&str; 10] = ["OUT", "SCENE", "DIR", "FILE", "NAME", "…", "...", "<", "*", "{"];
 /// Files `ppis render` and `ppis report` write, named in the docs as outputs.
 const OUTPUTS: [&str; 5] = ["render.exr", "render.png", "reference.exr", "error_vs_time.csv", "report.md"];
-/// Stale paths in docs/perf.md, which is being rewritten separately: listed so that this test
-/// holds meanwhile; remove an entry when its path is gone from the doc.
-const KNOWN_STALE: [(&str, &str); 2] = [("docs/perf.md", "env_io.rs"), ("docs/perf.md", "host-std/src/bvh/")];
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -142,8 +139,7 @@ fn every_path_the_docs_name_exists() {
         for candidate in candidates(&text) {
             if let Some(path) = as_path(&candidate, doc_dir) {
                 checked += 1;
-                let stale = KNOWN_STALE.contains(&(name.as_str(), path));
-                if !stale && !resolves(path, doc_dir, &names, &paths) {
+                if !resolves(path, doc_dir, &names, &paths) {
                     missing.push(format!("{name}: {path}"));
                 }
             }
