@@ -110,8 +110,9 @@ impl<'a> EnvHierarchy<'a> {
     }
 
     /// How peaked the lighting is at a scale: the largest node of `level` (clamped to the
-    /// finest) relative to the mean — 1 for a constant map, ~700 for a sky with a sun at
-    /// level 5 (cells ~6.4° wide). A cheap test of whether sampling the lighting can pay.
+    /// finest) relative to the mean — 1 for a constant map, and in the hundreds for a sky with
+    /// a sun at level 5 (cells ~6.4° wide). A cheap test of whether sampling the lighting can
+    /// pay.
     #[must_use]
     pub fn peak(&self, level: u32) -> f32 {
         let level = level.min(self.finest);
