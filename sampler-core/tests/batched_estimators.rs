@@ -8,7 +8,6 @@ mod common;
 
 use common::TestEnv;
 use glam::{DVec2, Vec2, Vec3};
-use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::estimator::{self, Contribution, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
@@ -22,13 +21,7 @@ fn bits(c: &Contribution) -> ([u64; 3], [u32; 3], u32, u32) {
 fn batched_mis_is_pair_by_pair_mis() {
     let env = TestEnv::random_smooth(5, 9);
     let e = env.view();
-    let brdfs: Vec<Box<dyn Brdf>> = vec![
-        Box::new(RoughConductor::new(0.05, Vec3::new(0.9, 0.7, 0.5))),
-        Box::new(RoughConductor::new(1e-3, Vec3::ONE)),
-        Box::new(Lambert::new(Vec3::splat(0.6))),
-        Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.7), 200.0)),
-        Box::new(CarPaint::default()),
-    ];
+    let brdfs = common::batch_brdfs();
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let mut compared = 0;
     for (i, brdf) in brdfs.iter().enumerate() {

@@ -7,7 +7,7 @@ mod common;
 
 use common::TestEnv;
 use glam::{DVec2, DVec3, Vec3};
-use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
+use sampler_core::brdf::Brdf;
 use sampler_core::direction::DirectionSampler;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WAVE, WaveSample, Weighting, wavefront};
 use sampler_core::estimator::{self, ShadingPoint};
@@ -97,13 +97,7 @@ fn check<S: DirectionSampler + ?Sized>(
 fn a_wavefront_is_the_per_point_estimators_sample_by_sample() {
     let env = TestEnv::random_smooth(5, 9);
     let e = env.view();
-    let brdfs: Vec<Box<dyn Brdf>> = vec![
-        Box::new(RoughConductor::new(0.05, Vec3::new(0.9, 0.7, 0.5))),
-        Box::new(RoughConductor::new(1e-3, Vec3::ONE)),
-        Box::new(Lambert::new(Vec3::splat(0.6))),
-        Box::new(Phong::new(Vec3::splat(0.2), Vec3::splat(0.7), 200.0)),
-        Box::new(CarPaint::default()),
-    ];
+    let brdfs = common::batch_brdfs();
     let normals = [Vec3::Z, Vec3::new(0.3, -0.5, 0.8), Vec3::new(-0.9, 0.1, 0.2)];
     let points: Vec<ShadingPoint<'_, dyn Brdf + '_>> = (0..15)
         .map(|i| {

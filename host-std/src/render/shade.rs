@@ -2,7 +2,7 @@
 //! same budget: `budget` visibility samples (shadow rays) per shading point. MIS in pairs spends
 //! them one per technique, so it takes ⌊budget/2⌋ pairs (at least one).
 
-use crate::render::wavefront::split_counts;
+use crate::render::wavefront::{split_counts, split_shares};
 use sampler_core::brdf::Brdf;
 use sampler_core::direction::DirectionSampler;
 use sampler_core::env::EnvHierarchy;
@@ -232,7 +232,7 @@ fn shade_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     let Run { seed, block } = run;
     let (n_p, n_b) = split_counts(budget, share);
     let total = (n_p + n_b) as f64;
-    let shares = ((n_p as f64 / total) as f32, (n_b as f64 / total) as f32);
+    let shares = split_shares(n_p, n_b);
     let mut sum = DVec3::ZERO;
     let (mut done_p, mut done_b) = (0, 0);
     let mut first_points = [DVec2::ZERO; BATCH];

@@ -8,7 +8,6 @@
 use crate::render::shade::{Run, Sampling};
 use crate::trace::bvh::ShadowRay;
 use sampler_core::brdf::Brdf;
-use sampler_core::direction::DirectionSampler;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
 use sampler_core::estimator::{BATCH, ShadingPoint};
@@ -79,6 +78,13 @@ pub(crate) fn split_counts(budget: usize, share: f64) -> (usize, usize) {
     }
 }
 
+/// Each technique's share of a split budget of `first` + `brdf` samples, the weights of the
+/// multi-sample balance heuristic.
+pub(crate) fn split_shares(first: usize, brdf: usize) -> (f32, f32) {
+    let total = (first + brdf) as f64;
+    ((first as f64 / total) as f32, (brdf as f64 / total) as f32)
+}
+
 /// Reused buffers of the wavefronts.
 #[derive(Default)]
 pub(crate) struct WaveBuffers {
@@ -110,8 +116,8 @@ pub(crate) fn shade_wavefront(
         Layout::Single { .. } => Weighting::Single,
         Layout::Pairs { .. } => Weighting::Balance,
         Layout::Split { first, brdf } => {
-            let total = (first + brdf) as f64;
-            Weighting::Split { sampler: (first as f64 / total) as f32, brdf: (brdf as f64 / total) as f32 }
+            let (sampler, brdf) = split_shares(first, brdf);
+            Weighting::Split { sampler, brdf }
         }
     };
     buffers.samples.clear();
@@ -125,8 +131,10 @@ pub(crate) fn shade_wavefront(
     buffers.candidates.clear();
     buffers.candidates.resize(buffers.samples.len(), Candidate::default());
     match sampling {
-        Sampling::ProductMis { sampler, .. } => draw(sampler, points, weighting, buffers),
-        _ => draw(env, points, weighting, buffers),
+        Sampling::ProductMis { sampler, .. } => {
+            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
+        }
+        _ => wavefront(env, points, &buffers.samples, weighting, &mut buffers.candidates),
     }
     // The shadow rays, all at once.
     buffers.rays.clear();
@@ -146,16 +154,6 @@ pub(crate) fn shade_wavefront(
         *o = reduce(layout, candidates, &mut value);
     }
     Some(buffers.rays.len())
-}
-
-/// The wavefront's candidates, drawn by `sampler`.
-fn draw<S: DirectionSampler + ?Sized>(
-    sampler: &S,
-    points: &[ShadingPoint<'_, dyn Brdf + '_>],
-    weighting: Weighting,
-    buffers: &mut WaveBuffers,
-) {
-    wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates);
 }
 
 /// A shading point's samples in the order its estimate sums them, from its `block` of the

@@ -2,11 +2,14 @@
 //! (after Mitsuba 3's `ChiSquareTest`), quadrature, and test environments.
 #![allow(dead_code)]
 
+mod brdfs;
 mod chi2;
 mod quadrature;
 mod test_env;
 
 // Each test uses some of the helpers.
+#[allow(unused_imports)]
+pub use brdfs::*;
 #[allow(unused_imports)]
 pub use chi2::*;
 #[allow(unused_imports)]
