@@ -45,6 +45,7 @@ extern crate std;
 // The source groups what belongs together (`sphere/`, `env/`, `product/`, `baselines/`,
 // `estimator/`, `brdf/`); the public modules keep one flat path each.
 mod baselines;
+mod prefetch;
 mod product;
 mod sphere;
 

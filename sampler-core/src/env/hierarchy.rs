@@ -6,6 +6,7 @@ use crate::cell::Cell;
 use crate::mapping::{
     SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
 };
+use crate::prefetch::prefetch;
 use glam::{Mat3, Vec2, Vec3};
 
 /// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
@@ -225,6 +226,18 @@ impl<'a> EnvHierarchy<'a> {
     pub fn radiance_at(&self, uv: Vec2) -> Vec3 {
         let (x, y) = self.texel_at(uv);
         self.radiance_texel(x, y)
+    }
+
+    /// Asks the memory system for what [`radiance_at`](Self::radiance_at) and
+    /// [`pdf_square`](Self::pdf_square) read at `uv`, ahead of reading it: a hint that changes
+    /// no result.
+    #[inline]
+    pub fn prefetch_texel(&self, uv: Vec2) {
+        let (x, y) = self.texel_at(uv);
+        let i = y as usize * self.resolution() as usize + x as usize;
+        prefetch(&self.radiance[i..=i]);
+        let node = pyramid_index(Cell::new(self.finest, x, y));
+        prefetch(&self.pyramid[node..=node]);
     }
 
     /// Env-only density per unit area of the square at `uv` (mean 1 over the square).

@@ -8,6 +8,7 @@ use super::EnvHierarchy;
 use super::pyramid::level_offset;
 use crate::cell::Cell;
 use crate::direction::DirectionSample;
+use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
 
@@ -76,19 +77,21 @@ impl EnvHierarchy<'_> {
             return;
         }
         loop {
+            // Every lane's next node first, so that their loads are in flight together.
+            for lane in lanes.iter().filter(|l| l.alive && l.cell.level < self.finest) {
+                prefetch(self.next_nodes(lane));
+            }
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.alive && l.cell.level < self.finest) {
                 busy = true;
                 if lane.cell.level + 2 <= self.finest {
-                    let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
-                    let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().unwrap();
+                    let g: &[f32; 16] = self.next_nodes(lane).try_into().unwrap();
                     match choose_grandchild_branchless(g, &mut lane.xi) {
                         Some((c, gx, gy)) => lane.step(2, gx, gy, c),
                         None => lane.alive = false,
                     }
                 } else {
-                    let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
-                    let q = &self.pyramid[base..base + 4];
+                    let q = self.next_nodes(lane);
                     match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
                         Some(c) => {
                             let (dx, dy) = child_offset(c);
@@ -101,6 +104,19 @@ impl EnvHierarchy<'_> {
             if !busy {
                 return;
             }
+        }
+    }
+
+    /// The nodes a lane above the finest level chooses among next: its sixteen grandchildren,
+    /// or its four children one level above the finest.
+    #[inline(always)]
+    fn next_nodes(&self, lane: &WarpLane) -> &[f32] {
+        if lane.cell.level + 2 <= self.finest {
+            let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
+            &self.pyramid[base..base + 16]
+        } else {
+            let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
+            &self.pyramid[base..base + 4]
         }
     }
 }

@@ -119,6 +119,11 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
         n_sampler += 1;
     }
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
+    // Their texels' radiance is read below, after the BRDF's draws: asked for now, it arrives
+    // meanwhile.
+    for d in drawn[..n_sampler].iter().flatten() {
+        env.prefetch_texel(d.uv);
+    }
     // The BRDF's draws, each at its own shading point, then their points of the square and the
     // other technique's densities there in one batch.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
@@ -134,6 +139,9 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
     let mut uvs = [Vec2::ZERO; WAVE];
     env.squares_of(&dirs[..n_brdf], &mut uvs[..n_brdf]);
+    for uv in &uvs[..n_brdf] {
+        env.prefetch_texel(*uv);
+    }
     let mut p_square = [0.0f32; WAVE];
     if weighting != Weighting::Single {
         sampler.pdf_square_many(&uvs[..n_brdf], &mut p_square[..n_brdf]);
