@@ -5,7 +5,8 @@
 //! or its `src/`, or as the end of a path in the repository (a table's `bvh/mod.rs` under its
 //! folder), or, for a bare file name, anywhere in it. Generated outputs (`target/…` and the files
 //! `ppis` writes), commands' placeholders (`OUT`, `SCENE`, `NAME`, `…`) and the shared material
-//! beside the repository (`../shared/`, named as outside it) are not paths of the repository.
+//! beside the repository (`../shared/usd-assets/`, third-party files that stay out of its history:
+//! docs/usd.md) are not paths of the repository.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -88,7 +89,7 @@ fn as_path<'c>(candidate: &'c str, doc_dir: &Path) -> Option<&'c str> {
     if c.is_empty() || c.contains(char::is_whitespace) || c.contains("://") || c.starts_with('-') {
         return None;
     }
-    if c.starts_with("../shared/") || c.starts_with("target/") || c.starts_with('$') || c.starts_with('/') {
+    if c.starts_with("../shared/usd-assets/") || c.starts_with("target/") || c.starts_with('$') || c.starts_with('/') {
         return None;
     }
     if PLACEHOLDERS.iter().any(|p| c.contains(p)) || OUTPUTS.contains(&c) {
