@@ -1,5 +1,5 @@
-//! Every file or folder the docs name exists in the repository: the Markdown under `docs/`, the
-//! README, CONTRIBUTING.md and CHANGELOG.md. A name in backticks or a link target counts as a path
+//! Every file or folder the docs name exists in the repository: the Markdown in `docs/` and
+//! `docs/reference/`, the README, CONTRIBUTING.md and CHANGELOG.md. A name in backticks or a link target counts as a path
 //! when it ends in a file extension or a `/`, or when it contains a `/` after a folder that
 //! exists; it resolves when it exists relative to the repository's root, `docs/`, a crate's folder
 //! or its `src/`, or as the end of a path in the repository (a table's `bvh/mod.rs` under its
@@ -127,9 +127,12 @@ fn every_path_the_docs_name_exists() {
     files(&root, "", &mut names, &mut paths);
     let mut docs: Vec<PathBuf> =
         ["README.md", "CONTRIBUTING.md", "CHANGELOG.md"].iter().map(|d| root.join(d)).collect();
-    for entry in std::fs::read_dir(root.join("docs")).unwrap().flatten() {
-        if entry.path().extension().is_some_and(|e| e == "md") {
-            docs.push(entry.path());
+    // docs/ and its folders (docs/reference/), but not the reports `ppis report` writes.
+    for dir in [root.join("docs"), root.join("docs/reference")] {
+        for entry in std::fs::read_dir(dir).unwrap().flatten() {
+            if entry.path().extension().is_some_and(|e| e == "md") {
+                docs.push(entry.path());
+            }
         }
     }
     let mut missing = Vec::new();
