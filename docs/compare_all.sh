@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Every method against Mitsuba 3 on s1–s3 and our two scenes (docs/stability.md). Needs
-# ../shared/reference/mitsuba_ref.py (not in the repository), `pip install mitsuba numpy` and, for the
-# fast llvm variant, `apt-get install libllvm19`. Usage: docs/compare_all.sh OUT_DIR [SPP]
+# Every method against Mitsuba 3 on s1–s3 and our two scenes (docs/stability.md), Mitsuba through
+# docs/reference/mitsuba_ref.py. Needs `pip install mitsuba numpy` and, for the fast llvm variant,
+# `apt-get install libllvm19` (docs/reference/README.md). Usage: docs/compare_all.sh OUT_DIR [SPP]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source docs/compare_scene.sh

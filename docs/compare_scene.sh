@@ -7,7 +7,7 @@ compare_scene() {
     local out="$1" scene="$2" name="$3" mts_spp="$4" spp="$5" points="$6"
     shift 6
     if [ ! -f "$out/${name}_mts.exr" ]; then
-        python3 ../shared/reference/mitsuba_ref.py "$scene" --spp "$mts_spp" --passes 4 \
+        python3 docs/reference/mitsuba_ref.py "$scene" --spp "$mts_spp" --passes 4 \
             --out "$out/${name}_mts.exr" --stderr-out "$out/${name}_mts_se.exr" \
             --coverage-out "$out/${name}_cov.exr" | tail -1
     fi

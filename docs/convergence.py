@@ -10,13 +10,13 @@ footprint is integrated too — docs/perf.md, "Shading points per pixel").
 Without SCENE: the embedded default scene. The reference is rendered once (method mis, seed
 4242) and cached in DIR. Needs numpy and the `exr`-reading `mitsuba` package, or OpenEXR."""
 import argparse, os, subprocess, sys
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def load(path):
     import mitsuba as mi
+    import numpy as np
     mi.set_variant('scalar_rgb')
     return np.array(mi.Bitmap(path), dtype=np.float64)[..., :3]
 
@@ -41,6 +41,7 @@ def main():
     ap.add_argument('--height', type=int, default=90)
     ap.add_argument('--ppis', default=os.path.join(HERE, '..', 'target', 'release', 'ppis'))
     args = ap.parse_args()
+    import numpy as np
     os.makedirs(args.out, exist_ok=True)
     ref_path = os.path.join(args.out, 'reference.exr')
     if not os.path.exists(ref_path):

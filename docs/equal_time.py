@@ -15,13 +15,12 @@ that time. Prints one Markdown table of times, relMSE and ratios at equal time, 
 throughput per core: our shading points and shadow rays per second beside Mitsuba's (one primary
 ray and two shadow rays per sample: `direct` samples the emitter and the BSDF once each).
 
-Needs `pip install mitsuba numpy`, `apt-get install libllvm19`, and
-../shared/reference/mitsuba_ref.py (not in the repository). References are cached in DIR."""
+Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
+renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
 import argparse, json, math, os, re, subprocess, sys
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-MITSUBA_REF = os.path.normpath(os.path.join(HERE, '..', '..', 'shared', 'reference', 'mitsuba_ref.py'))
+MITSUBA_REF = os.path.join(HERE, 'reference', 'mitsuba_ref.py')
 
 
 def run(cmd):
@@ -33,11 +32,13 @@ def run(cmd):
 
 def load(path):
     import mitsuba as mi
+    import numpy as np
     mi.set_variant('scalar_rgb')
     return np.array(mi.Bitmap(path), dtype=np.float64)[..., :3]
 
 
 def relmse(image, reference, covered):
+    import numpy as np
     o, r = image[covered], reference[covered]
     return float(np.mean((o - r) ** 2 / (r ** 2 + 0.01)))
 

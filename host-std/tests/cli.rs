@@ -45,6 +45,10 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["render", "scene.txt"], "scene.txt");
     // Usage errors too.
     fails(dir, &["render", "--no-such-flag"], "--no-such-flag");
+    fails(dir, &["render", "--spp"], "--spp");
+    fails(dir, &["info", "--no-such-flag"], "--no-such-flag");
+    fails(dir, &["report", "--methods", "mis,nope"], "nope");
+    fails(dir, &["report", "--spp", "0"], "--spp");
     fails(dir, &["bogus"], "bogus");
     fails(dir, &[], "render");
     fails(dir, &["render", "--render-settings", "/Render/S"], "USD");

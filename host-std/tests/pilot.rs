@@ -91,8 +91,8 @@ fn a_matte_studio_can_be_env_sampled() {
     // (0.02) lit by 24 soft boxes, discs of 3–6° of radiance 20–200 above the horizon.
     // Cosine-weighted BRDF samples seldom find them and MIS spends a quarter of its samples
     // that way; the rule's plan is MIS 3:1 and the pilot replaces it where it measures env
-    // sampling more than twice as good (as on the real studio; docs/perf.md, "Error against
-    // time (`ppis report`)").
+    // sampling more than twice as good (as on the real studio; docs/perf.md, "Headline: error at
+    // equal time").
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes");
     let mut scene = host_std::scene::json::load(&dir.join("studio.json")).unwrap();
     scene.camera.width = 96;

@@ -87,20 +87,27 @@ fn main() {
             }
             t_mis += t.elapsed().as_secs_f64();
         }
-        let per = |t: f64| t / (points.len() * pairs) as f64 * 1e9;
-        println!(
-            "round {round}: build {:.1} µs | product sample {:.0} ns, batched {:.0} | product-MIS pair {:.0} ns, batched {:.0} | MIS pair {:.0} ns, batched {:.0} | batched ratio {:.2} ({:.1e})",
-            t_build / points.len() as f64 * 1e6,
-            per(t_sample),
-            per(t_sb),
-            per(t_pm),
-            per(t_pmb),
-            per(t_mis),
-            per(t_misb),
-            t_pmb / t_misb,
-            acc.x
-        );
+        let times = [t_build, t_sample, t_sb, t_pm, t_pmb, t_mis, t_misb];
+        print_round(round, times, points.len(), pairs, acc.x);
     }
+}
+
+/// One round's line: the build per shading point, then each sampling path per sample or pair.
+fn print_round(round: usize, times: [f64; 7], points: usize, pairs: usize, checksum: f64) {
+    let [t_build, t_sample, t_sb, t_pm, t_pmb, t_mis, t_misb] = times;
+    let per = |t: f64| t / (points * pairs) as f64 * 1e9;
+    println!(
+        "round {round}: build {:.1} µs | product sample {:.0} ns, batched {:.0} | product-MIS pair {:.0} ns, batched {:.0} | MIS pair {:.0} ns, batched {:.0} | batched ratio {:.2} ({:.1e})",
+        t_build / points as f64 * 1e6,
+        per(t_sample),
+        per(t_sb),
+        per(t_pm),
+        per(t_pmb),
+        per(t_mis),
+        per(t_misb),
+        t_pmb / t_misb,
+        checksum
+    );
 }
 
 /// A blue sky with structure and a small sun of radiance 1e4, on a `2^level` equal-area map.

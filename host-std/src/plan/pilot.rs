@@ -38,7 +38,7 @@ pub struct Candidate {
     /// The strategy.
     pub strategy: Strategy,
     /// Time per visibility sample relative to MIS's pairs, measured once over the benchmark
-    /// scenes (docs/perf.md, "Equal time against Mitsuba 3").
+    /// scenes (docs/perf.md, "Cost per visibility sample").
     pub cost: f64,
 }
 

@@ -2,7 +2,7 @@
 //! the material's lobe and how peaked the lighting is — its plan before the pilot
 //! (`plan::pilot`) checks it on the scene, and its plan where the image is too small for a
 //! pilot. The thresholds and splits come from equal-time sweeps per material region
-//! (`ppis report`; docs/perf.md, "Error against time (`ppis report`)").
+//! (`ppis report`; docs/perf.md, "Headline: error at equal time" and "Budget splits").
 //!
 //! * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is wide
 //!   enough to span bright detail of the map and narrow enough that one B̃ per pixel fits its
