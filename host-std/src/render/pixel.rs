@@ -189,36 +189,10 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
             !shadows || !ctx.bvh.occluded(hits[k].origin, d, 0.0, f32::INFINITY)
         };
         let shaded = if wavefront::fits(&sampling, budget) {
-            // Past the members, placeholders that nothing reads.
-            let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] = std::array::from_fn(|i| match members[..m].get(i) {
-                Some(&k) => shading_point(ctx.scene, &hits[k]),
-                None => ShadingPoint { frame: lead_sp.frame, wo: lead_sp.wo, brdf: lead_sp.brdf },
-            });
-            let runs: [Run; GROUP] = std::array::from_fn(|i| match members[..m].get(i) {
-                Some(&k) => run_of(&hits[k]),
-                None => Run { seed: seeds.light, block: 0 },
-            });
-            let origins: [Vec3; GROUP] =
-                std::array::from_fn(|i| members[..m].get(i).map_or(Vec3::ZERO, |&k| hits[k].origin));
-            let mut out = [DVec3::ZERO; GROUP];
-            let occluded_many = |rays: &[ShadowRay], blocked: &mut [bool]| {
-                if shadows {
-                    ctx.bvh.occluded_many(rays, blocked);
-                }
-            };
-            rays += wavefront::shade_wavefront(
-                &sampling,
-                env,
-                &points[..m],
-                &runs[..m],
-                &origins[..m],
-                budget,
-                waves,
-                occluded_many,
-                &mut out,
-            )
-            .map_or(0, |r| r as u64);
-            for (i, &k) in members[..m].iter().enumerate() {
+            let members = &members[..m];
+            let (out, traced) = shade_members(ctx, env, &sampling, hits, members, (&lead_sp, run_of), budget, waves);
+            rays += traced;
+            for (i, &k) in members.iter().enumerate() {
                 (values[k], done[k]) = (out[i], true);
             }
             m
@@ -244,6 +218,53 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         counters.shadow_rays += if shadows { rays } else { 0 };
     }
     add_in_order(ctx, hits, &values[..n], sum);
+}
+
+/// The estimates of a material's `members` shaded as one wavefront through `sampling` (see
+/// [`wavefront::fits`]), and the shadow rays traced. `lead` is the first member's shading
+/// point, standing in for the unused slots past the members, and the run of each hit.
+#[allow(clippy::too_many_arguments)]
+fn shade_members(
+    ctx: &Context<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    sampling: &Sampling<'_, '_>,
+    hits: &[Hit],
+    members: &[usize],
+    (lead, run_of): (&ShadingPoint<'_, dyn Brdf + '_>, impl Fn(&Hit) -> Run),
+    budget: usize,
+    waves: &mut WaveBuffers,
+) -> ([DVec3; GROUP], u64) {
+    let m = members.len();
+    // Past the members, placeholders that nothing reads.
+    let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] = std::array::from_fn(|i| match members.get(i) {
+        Some(&k) => shading_point(ctx.scene, &hits[k]),
+        None => ShadingPoint { frame: lead.frame, wo: lead.wo, brdf: lead.brdf },
+    });
+    let runs: [Run; GROUP] = std::array::from_fn(|i| match members.get(i) {
+        Some(&k) => run_of(&hits[k]),
+        None => Run { seed: run_of(&hits[members[0]]).seed, block: 0 },
+    });
+    let origins: [Vec3; GROUP] = std::array::from_fn(|i| members.get(i).map_or(Vec3::ZERO, |&k| hits[k].origin));
+    let mut out = [DVec3::ZERO; GROUP];
+    let shadows = ctx.options.shadows;
+    let occluded_many = |rays: &[ShadowRay], blocked: &mut [bool]| {
+        if shadows {
+            ctx.bvh.occluded_many(rays, blocked);
+        }
+    };
+    let traced = wavefront::shade_wavefront(
+        sampling,
+        env,
+        &points[..m],
+        &runs[..m],
+        &origins[..m],
+        budget,
+        waves,
+        occluded_many,
+        &mut out,
+    )
+    .map_or(0, |r| r as u64);
+    (out, traced)
 }
 
 /// The indices of the hits of `hits[first]`'s material from `first` on (in order), and their
