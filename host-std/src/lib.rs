@@ -15,6 +15,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cpu_time;
 pub mod light;
 pub mod output;
 pub mod plan;

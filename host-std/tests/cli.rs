@@ -118,6 +118,7 @@ fn a_small_render_writes_exr_png_and_stats() {
         "load_seconds",
         "preprocess_seconds",
         "render_seconds",
+        "render_cpu_seconds",
         "shading_points",
         "shadow_rays",
     ] {

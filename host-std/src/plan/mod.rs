@@ -10,6 +10,7 @@ pub mod rules;
 pub use budget::ShadingPoints;
 pub use method::Method;
 
+use crate::cpu_time::process_cpu_time;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
 use crate::render::{Context, Options, summed_area_table, two_level_cones};
@@ -65,6 +66,8 @@ pub struct Rendered {
     pub pixels: Vec<[f32; 3]>,
     /// Wall clock of the render, `auto`'s pilot included.
     pub render_seconds: f64,
+    /// CPU time of the render, every thread's (`None` where the platform does not say).
+    pub render_cpu_seconds: Option<f64>,
     /// Shading points shaded.
     pub shading_points: u64,
     /// Shadow rays traced.
@@ -108,6 +111,7 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     };
     // Timed from here: `auto`'s pilot is part of its cost.
     let start = Instant::now();
+    let cpu_start = process_cpu_time();
     let (chosen, pilot) = match (settings.method, env) {
         (Method::Auto, Some(e)) => {
             let (chosen, measured) = pilot::choose(&ctx, e, env_peak);
@@ -118,12 +122,14 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     let pilot_seconds = start.elapsed().as_secs_f64();
     let image = render_tiles(&Context { plans: chosen.as_deref().unwrap_or(&plans), ..ctx }, start);
     let render_seconds = start.elapsed().as_secs_f64();
+    let render_cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
     let c = image.counters;
     Rendered {
         width: image.width,
         height: image.height,
         pixels: image.pixels,
         render_seconds,
+        render_cpu_seconds,
         shading_points: c.shading_points,
         shadow_rays: c.shadow_rays,
         camera_rays: c.camera_rays,

@@ -18,6 +18,37 @@ use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
 
+/// What a sweep's renders are timed by.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Clock {
+    /// Wall-clock seconds of the render: its latency, on an otherwise idle machine.
+    #[default]
+    Wall,
+    /// CPU seconds of every render thread: its cost in cores, which does not grow while its
+    /// threads wait for a core on a machine shared with other work (wall clock where the
+    /// platform does not say).
+    Cpu,
+}
+
+impl Clock {
+    /// A render's time by this clock.
+    fn seconds(self, image: &plan::Rendered) -> f64 {
+        match self {
+            Clock::Wall => image.render_seconds,
+            Clock::Cpu => image.render_cpu_seconds.unwrap_or(image.render_seconds),
+        }
+    }
+}
+
+/// How a sweep times its renders: by which clock, and the fastest of how many runs.
+#[derive(Clone, Copy, Debug)]
+pub struct Timing {
+    /// The clock.
+    pub clock: Clock,
+    /// Runs per render, the fastest kept (at least 1).
+    pub repeat: usize,
+}
+
 /// One render of the sweep: errors over all pixels (`rmse`, `relmse`) and per region.
 #[derive(Clone, Debug)]
 pub struct Measurement {
@@ -52,7 +83,7 @@ impl Measurement {
 /// (the base method of the equal-time tables), every faster method is then rendered on at
 /// doubling spp — at most [`BRACKET_DOUBLINGS`] times — until its time reaches the base's at
 /// its largest spp, so that the tables interpolate its error there instead of extrapolating.
-/// With `repeat` > 1 every render is timed that many times in all, in rounds over all the
+/// Renders are timed by `timing.clock`. With `timing.repeat` > 1 every render is timed that many times in all, in rounds over all the
 /// (method, spp) pairs — so that a slow spell of the machine falls on all methods alike — and
 /// keeps its fastest time (the image, and so its error, is the same each time: renders are
 /// deterministic). `progress` is told about each first render.
@@ -67,7 +98,7 @@ pub fn sweep(
     points: ShadingPoints,
     reference: &[[f32; 3]],
     bracket: Option<Method>,
-    repeat: usize,
+    timing: Timing,
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
@@ -88,7 +119,7 @@ pub fn sweep(
                 )
             })
             .collect();
-        let m = Measurement { method, spp, seconds: image.render_seconds, rmse, relmse, regions, plans };
+        let m = Measurement { method, spp, seconds: timing.clock.seconds(&image), rmse, relmse, regions, plans };
         progress(&m);
         m
     };
@@ -101,8 +132,8 @@ pub fn sweep(
     if let Some(target) = bracket {
         bracket_base(&mut out, methods, target, &mut measure);
     }
-    keep_fastest(&mut out, repeat, |method, spp| {
-        plan::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }).render_seconds
+    keep_fastest(&mut out, timing.repeat, |method, spp| {
+        timing.clock.seconds(&plan::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }))
     });
     out
 }

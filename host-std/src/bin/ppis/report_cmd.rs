@@ -8,6 +8,7 @@ use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{self, Settings, ShadingPoints};
+use host_std::report::{Clock, Timing};
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
 use host_std::{output, report};
@@ -50,6 +51,10 @@ pub(crate) struct ReportArgs {
     /// fastest: single timings vary with what else the machine is doing.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
+    /// What renders are timed by: `wall` (seconds of the render, for an idle machine) or `cpu`
+    /// (CPU seconds of its threads, for a machine shared with other work).
+    #[arg(long, value_enum, default_value_t = Clock::Wall)]
+    clock: Clock,
     #[command(flatten)]
     sampling: SamplingArgs,
     /// Output folder (created if missing).
@@ -109,7 +114,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     let measurements = pool.install(|| {
         let points = shading_points(&args);
         let methods = &args.methods;
-        let repeat = args.repeat as usize;
+        let timing = Timing { clock: args.clock, repeat: args.repeat as usize };
         report::sweep(
             &scene,
             &bvh,
@@ -120,7 +125,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             points,
             &reference,
             bracket,
-            repeat,
+            timing,
             |m| {
                 eprintln!(
                     "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
@@ -181,7 +186,7 @@ fn write_outputs(
     output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(measurements))?;
     output::write_text(
         &args.out.join("report.md"),
-        &report::markdown(scene, measurements, base_method, threads, &timing_note(note, args.repeat)),
+        &report::markdown(scene, measurements, base_method, threads, &timing_note(note, args.repeat, args.clock)),
     )?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
@@ -198,8 +203,13 @@ fn write_outputs(
 }
 
 /// The report's reference note, and how renders were timed when more than once.
-fn timing_note(reference: &str, repeat: u32) -> String {
-    if repeat > 1 { format!("{reference}; times: the fastest of {repeat} runs") } else { reference.to_string() }
+fn timing_note(reference: &str, repeat: u32, clock: Clock) -> String {
+    let clock = match clock {
+        Clock::Wall => "",
+        Clock::Cpu => "; times: CPU seconds of the render threads",
+    };
+    let repeat = if repeat > 1 { format!("; times: the fastest of {repeat} runs") } else { String::new() };
+    format!("{reference}{clock}{repeat}")
 }
 
 /// The report's shading points per pixel: `--samples-per-point`, else `--shading-points`, else

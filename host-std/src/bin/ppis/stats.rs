@@ -36,6 +36,9 @@ pub(crate) struct Stats {
     /// The environment's build and the BVH's.
     preprocess_seconds: f64,
     primitives: usize,
+    /// Every render thread's CPU time (`null` where the platform does not say): the cost per
+    /// core on a machine shared with other work.
+    render_cpu_seconds: Option<f64>,
     render_seconds: f64,
     scene: String,
     seed: u64,
@@ -107,6 +110,7 @@ impl Stats {
             pilot_seconds: image.pilot_seconds,
             preprocess_seconds: env_build + prepared.bvh_seconds,
             primitives: prepared.bvh.primitive_count(),
+            render_cpu_seconds: image.render_cpu_seconds,
             render_seconds: image.render_seconds,
             scene: scene.name.clone(),
             seed: args.sampling.seed,
