@@ -3,7 +3,7 @@
 "Equal time against Mitsuba 3").
 
   python3 docs/equal_time.py --out DIR [--spp 256] [--ref-spp 8192] [--methods mis,product-mis,auto]
-                             [--threads 2] [--ppis target/release/ppis] SCENE.json...
+                             [--threads 2] [--clock wall|cpu] [--ppis target/release/ppis] SCENE.json...
 
 Per scene: Mitsuba's converged image (`ldsampler`, --ref-spp) and ours (`mis`, --ref-spp, another
 seed), each renderer measured against its own (the two differ on uncovered pixels by the map's
@@ -21,6 +21,7 @@ import argparse, json, math, os, re, subprocess, sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MITSUBA_REF = os.path.join(HERE, 'reference', 'mitsuba_ref.py')
+CLOCK = 'wall'
 
 
 def run(cmd):
@@ -46,7 +47,13 @@ def relmse(image, reference, covered):
 def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=()):
     text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
                 '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
-    return float(re.search(r'render_seconds:\s*([0-9.eE+-]+)', text).group(1))
+    key = 'render_cpu_seconds' if CLOCK == 'cpu' else 'render_seconds'
+    return float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1))
+
+
+def seconds(stats):
+    """Our render's time by the chosen clock."""
+    return stats['render_cpu_seconds'] if CLOCK == 'cpu' else stats['render_seconds']
 
 
 def ours(args, scene, method, spp, seed, out):
@@ -85,13 +92,13 @@ def scene_rows(args, scene):
     for method in args.methods:
         points = []
         stats = ours(args, scene, method, args.spp, 7, d(f'{method}.exr'))
-        points.append((stats['render_seconds'], relmse(load(d(f'{method}.exr')), pref, covered)))
-        spp = max(1, 2 ** round(math.log2(args.spp * target / stats['render_seconds'])))
+        points.append((seconds(stats), relmse(load(d(f'{method}.exr')), pref, covered)))
+        spp = max(1, 2 ** round(math.log2(args.spp * target / seconds(stats))))
         if spp != args.spp:
             s2 = ours(args, scene, method, spp, 7, d(f'{method}_{spp}.exr'))
-            points.append((s2['render_seconds'], relmse(load(d(f'{method}_{spp}.exr')), pref, covered)))
-        per_core = args.threads * stats['render_seconds']
-        results.append((method, stats['render_seconds'], points[0][1], at_time(points, target),
+            points.append((seconds(s2), relmse(load(d(f'{method}_{spp}.exr')), pref, covered)))
+        per_core = seconds(stats) if CLOCK == 'cpu' else args.threads * seconds(stats)
+        results.append((method, seconds(stats), points[0][1], at_time(points, target),
                         stats['shading_points'] / per_core, stats['shadow_rays'] / per_core))
     samples = w * h * args.spp
     return name, rows, results, samples
@@ -105,8 +112,13 @@ def main():
     ap.add_argument('--ref-spp', type=int, default=8192)
     ap.add_argument('--methods', default='mis,product-mis,auto', type=lambda s: s.split(','))
     ap.add_argument('--threads', type=int, default=2)
+    ap.add_argument('--clock', choices=['wall', 'cpu'], default='wall',
+                    help='time both renderers by wall clock (an idle machine) or by the CPU seconds of '
+                         'all their threads (a machine shared with other work)')
     ap.add_argument('--ppis', default=os.path.join(HERE, '..', 'target', 'release', 'ppis'))
     args = ap.parse_args()
+    global CLOCK
+    CLOCK = args.clock
     os.makedirs(args.out, exist_ok=True)
     print(f'{args.spp} spp, {args.threads} threads; relMSE on covered pixels, each renderer against its own '
           f'converged image ({args.ref_spp} spp); "at Mitsuba-ld time": ours interpolated log-log at its time.\n')
@@ -122,7 +134,7 @@ def main():
             e_in_at = e_in * t_in / t_ld
             print(f'| {name} | {t_ld:.2f} s, {e_ld:.2e} | {t_in:.2f} s, {e_in:.2e} | {method} | {t:.2f} s, {e:.2e} '
                   f'| {e_at:.2e} | {e_at / e_ld:.2f} | {e_at / e_in_at:.2f} | {sp / 1e6:.2f} M | {sr / 1e6:.2f} M '
-                  f'| {samples / (args.threads * t_ld) / 1e6:.2f} M |', flush=True)
+                  f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M |', flush=True)
 
 
 if __name__ == '__main__':

@@ -7,7 +7,8 @@ Mitsuba 3 and writes a linear float32 RGB EXR.
            --warmup (render once, untimed, before the timed render: excludes LLVM JIT compile time)
            --stderr-out FILE (with --passes>=2: per-pixel std. error of the mean image)
            --coverage-out FILE (geometry coverage per pixel, 0..1, from a black-shapes/white-env render)
-Prints 'render_seconds: X' = wall time of the rendering calls only (scene loading excluded).
+Prints 'render_seconds: X' = wall time of the rendering calls only (scene loading excluded), and
+'render_cpu_seconds: Y' = the CPU time of every thread of the process over the same calls.
 With --passes N the image is the mean of N renders of spp/N samples each (seeds (seed*65537+k) mod 2^32),
 which with the box pixel filter is exactly equivalent to one render with spp samples.
 """
@@ -164,7 +165,7 @@ def build_scene(sc, base_dir, spp, seed, integrator='direct', override=None):
 
 def render(scene_json, spp, seed, variant='llvm_ad_rgb', integrator='direct', passes=1, warmup=False,
            override=None, verbose=True):
-    """Returns (image HxWx3 float32 numpy, render_seconds, per-pixel std error or None)."""
+    """Returns (image HxWx3 float32 numpy, (render_seconds, render_cpu_seconds), per-pixel std error or None)."""
     if variant.startswith('llvm'):
         _setup_llvm()
     import numpy as np, mitsuba as mi, drjit as dr
@@ -179,7 +180,7 @@ def render(scene_json, spp, seed, variant='llvm_ad_rgb', integrator='direct', pa
         img = mi.render(scene, spp=spp_pass, seed=seed + 999331)
         dr.eval(img); dr.sync_thread()
     acc = None; acc2 = None
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for k in range(passes):
         s = seed if passes == 1 else (seed * 65537 + k) % 2**32
         img = mi.render(scene, spp=spp_pass, seed=s)
@@ -187,7 +188,7 @@ def render(scene_json, spp, seed, variant='llvm_ad_rgb', integrator='direct', pa
         a = np.array(img, dtype=np.float64)
         acc = a if acc is None else acc + a
         acc2 = a * a if acc2 is None else acc2 + a * a
-    secs = time.perf_counter() - t0
+    secs = (time.perf_counter() - t0, time.process_time() - c0)
     mean = acc / passes
     se = None
     if passes >= 2:
@@ -215,7 +216,7 @@ def main():
         os.environ['PEER_SAMPLER'] = a.sampler
     img, secs, se = render(a.scene, a.spp, a.seed, a.variant, a.integrator, a.passes, a.warmup)
     write_exr(a.out, img)
-    print(f'render_seconds: {secs:.4f}  (variant={a.variant}, integrator={a.integrator}, sampler={sampler_type()}, spp={a.spp}, '
+    print(f'render_seconds: {secs[0]:.4f}  render_cpu_seconds: {secs[1]:.4f}  (variant={a.variant}, integrator={a.integrator}, sampler={sampler_type()}, spp={a.spp}, '
           f'passes={a.passes}, seed={a.seed}, warmup={a.warmup})')
     if a.stderr_out and se is not None:
         write_exr(a.stderr_out, se)
