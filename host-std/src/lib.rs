@@ -11,12 +11,14 @@
 //! * [`plan`]: the methods, `auto`'s rules and its pilot, and [`plan::render`], which plans a
 //!   render and runs it;
 //! * [`report`]: error against time over many renders;
-//! * [`output`]: writing images and text, used by the command line and the report.
+//! * [`output`]: writing images and text, used by the command line and the report;
+//! * [`merge`]: a frame assembled from crops rendered apart (`ppis merge`).
 
 #![warn(missing_docs)]
 
 pub mod cpu_time;
 pub mod light;
+pub mod merge;
 pub mod output;
 pub mod plan;
 pub mod render;

@@ -2,6 +2,7 @@
 //! written to a temporary name in the same folder and renamed into place, so an error never
 //! leaves a partial file behind.
 
+use crate::render::crop::Crop;
 use std::path::{Path, PathBuf};
 
 /// Why an output file cannot be written.
@@ -38,17 +39,42 @@ fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> R
 /// are compressed in parallel but written in increasing order (the exr crate's default order,
 /// "unspecified", writes them as they finish, so the file's bytes varied from run to run).
 pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[[f32; 3]]) -> Result<(), WriteError> {
+    write_exr_part(path, (width, height), Crop::full(width, height), pixels, None)
+}
+
+/// The header attribute that holds the render's settings (one text attribute: the exr crate
+/// keeps custom attributes in a hash map and writes them in its order, so several would make
+/// the file's bytes vary from run to run).
+pub const SETTINGS_ATTRIBUTE: &str = "ppisRenderSettings";
+
+/// Linear RGB of `crop` of a `frame` (width, height) as 32-bit float OpenEXR: the data window
+/// is the crop, the display window the frame; `settings` goes into the header as
+/// [`SETTINGS_ATTRIBUTE`] (Latin-1 text: escape anything else). Byte for byte the same for the same arguments, as [`write_exr`].
+pub fn write_exr_part(
+    path: &Path,
+    frame: (usize, usize),
+    crop: Crop,
+    pixels: &[[f32; 3]],
+    settings: Option<&str>,
+) -> Result<(), WriteError> {
     use exr::prelude::*;
+    let width = crop.width();
     let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p: [f32; 3] = pixels[y * width + x];
         (p[0], p[1], p[2])
     });
     let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    let mut attributes = LayerAttributes { layer_position: Vec2(crop.x0 as i32, crop.y0 as i32), ..Default::default() };
+    if let Some(text) = settings {
+        let Some(text) = Text::new_or_none(text) else {
+            return Err(WriteError::Write { path: path.to_owned(), message: "settings beyond Latin-1".into() });
+        };
+        attributes.other.insert(Text::from(SETTINGS_ATTRIBUTE), AttributeValue::Text(text));
+    }
+    let layer = Layer::new((width, crop.height()), attributes, encoding, channels);
+    let display = IntegerBounds::new((0, 0), frame);
     atomically(path, |tmp| {
-        Image::from_encoded_channels((width, height), encoding, channels)
-            .write()
-            .to_file(tmp)
-            .map_err(|e| e.to_string())
+        Image::new(ImageAttributes::new(display), layer).write().to_file(tmp).map_err(|e| e.to_string())
     })
 }
 

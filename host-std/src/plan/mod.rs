@@ -1,6 +1,7 @@
 //! Planning a render: the methods (`--method`), `auto`'s rules and its pilot, and [`render`],
 //! which resolves the method per material, runs the pilot where `auto` asks for one, and
-//! renders. Calls down into `render`, never the reverse.
+//! renders ([`render_crop`]: a part of the frame, planned as the whole frame is). Calls down
+//! into `render`, never the reverse.
 
 pub mod budget;
 pub mod method;
@@ -11,6 +12,7 @@ pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::cpu_time::process_cpu_time;
+use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
 use crate::render::{Context, Options, summed_area_table, two_level_cones};
@@ -58,17 +60,19 @@ impl Settings {
 
 /// A rendered image and what it took.
 pub struct Rendered {
-    /// Width in pixels.
+    /// Width in pixels (the crop's).
     pub width: usize,
-    /// Height in pixels.
+    /// Height in pixels (the crop's).
     pub height: usize,
+    /// Where the pixels are in the frame (the whole frame unless cropped).
+    pub crop: Crop,
     /// Linear RGB, rows top to bottom.
     pub pixels: Vec<[f32; 3]>,
     /// Wall clock of the render, `auto`'s pilot included.
     pub render_seconds: f64,
     /// CPU time of the render, every thread's (`None` where the platform does not say).
     pub render_cpu_seconds: Option<f64>,
-    /// Shading points shaded.
+    /// Shading points shaded (a crop counts every pixel of the render tiles it meets).
     pub shading_points: u64,
     /// Shadow rays traced.
     pub shadow_rays: u64,
@@ -84,6 +88,19 @@ pub struct Rendered {
 
 /// Renders the scene. `env` is `None` when the scene has no environment light.
 pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Rendered {
+    let frame = Crop::full(scene.camera.width as usize, scene.camera.height as usize);
+    render_crop(scene, bvh, env, settings, frame)
+}
+
+/// Renders the pixels of `crop` (inside the frame), bit for bit the same pixels of the whole
+/// frame's render: everything is planned from the whole frame (`auto`'s pilot too).
+pub fn render_crop(
+    scene: &Scene,
+    bvh: &Bvh,
+    env: Option<&EnvHierarchy<'_>>,
+    settings: &Settings,
+    crop: Crop,
+) -> Rendered {
     // `auto` and product-MIS resolve per material once, knowing how peaked the lighting is.
     let env_peak = match env {
         Some(e) if settings.method.reads_env_peak() => e.peak(5),
@@ -120,13 +137,14 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
         _ => (None, Vec::new()),
     };
     let pilot_seconds = start.elapsed().as_secs_f64();
-    let image = render_tiles(&Context { plans: chosen.as_deref().unwrap_or(&plans), ..ctx }, start);
+    let image = render_tiles(&Context { plans: chosen.as_deref().unwrap_or(&plans), ..ctx }, crop, start);
     let render_seconds = start.elapsed().as_secs_f64();
     let render_cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
     let c = image.counters;
     Rendered {
         width: image.width,
         height: image.height,
+        crop: image.crop,
         pixels: image.pixels,
         render_seconds,
         render_cpu_seconds,

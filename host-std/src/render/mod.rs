@@ -9,6 +9,7 @@
 //! which tile. Each pixel gets P shading points (primary rays jittered uniformly inside the
 //! pixel: a box filter) and each shading point spp/P visibility samples.
 
+pub mod crop;
 pub mod pixel;
 pub mod sampler_cache;
 pub mod shade;

@@ -6,13 +6,18 @@ use clap::{Parser, Subcommand};
 mod args;
 mod info_cmd;
 mod load;
+mod merge_cmd;
+mod provenance;
 mod render_cmd;
 mod report_cmd;
 mod stats;
+mod tiles_cmd;
 
 use info_cmd::{InfoArgs, info_command};
+use merge_cmd::{MergeArgs, merge_command};
 use render_cmd::{RenderArgs, render_command};
 use report_cmd::{ReportArgs, report_command};
+use tiles_cmd::{TilesArgs, tiles_command};
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +39,12 @@ enum Command {
     /// Error against run time: render each method at each spp, compare with a reference, write
     /// DIR/error_vs_time.csv, DIR/error_vs_time.{svg,png} and DIR/report.md.
     Report(ReportArgs),
+    /// Print the crops (x0,y0,x1,y1, one per line) that split a frame into tiles, for
+    /// `ppis render --crop` on a render farm.
+    Tiles(TilesArgs),
+    /// Assemble the tiles `ppis render --crop` wrote into the frame (EXR + PNG): the same bytes
+    /// as the frame rendered in one process.
+    Merge(MergeArgs),
 }
 
 /// The command line, or the one-line error (exit 2) a failure to parse it is; help and the
@@ -46,11 +57,17 @@ fn parse_command_line() -> Cli {
         Err(e) => {
             let line = match e.kind() {
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-                    "no command given: render, info or report (see ppis --help)".to_string()
+                    "no command given: render, info, report, tiles or merge (see ppis --help)".to_string()
                 }
                 _ => {
                     let text = e.render().to_string();
-                    let first = text.lines().next().unwrap_or_default().trim_start_matches("error: ").to_string();
+                    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+                    let mut first = lines.next().unwrap_or_default().trim_start_matches("error: ").to_string();
+                    // "the following required arguments were not provided:" lists them below.
+                    if first.ends_with(':') {
+                        let named: Vec<&str> = lines.take_while(|l| !l.starts_with("Usage:")).collect();
+                        first = format!("{} {}", first, named.join(", "));
+                    }
                     format!("{first} (see --help)")
                 }
             };
@@ -66,6 +83,8 @@ fn main() {
         Command::Render(args) => render_command(args),
         Command::Info(args) => info_command(args),
         Command::Report(args) => report_command(args),
+        Command::Tiles(args) => tiles_command(args),
+        Command::Merge(args) => merge_command(args),
     };
     if let Err(e) = result {
         eprintln!("ppis: error: {e:#}");

@@ -1,14 +1,16 @@
 //! `ppis render`: one scene, one method, to a linear EXR, an sRGB PNG and optionally the
-//! stats JSON.
+//! stats JSON; with `--crop`, a part of the frame (a tile for `ppis merge`).
 
 use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, parse_method};
 use crate::load::{load_scene, warn_notes};
+use crate::provenance;
 use crate::stats::Stats;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::output;
 use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
+use host_std::render::crop::Crop;
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
 use std::path::{Path, PathBuf};
@@ -17,7 +19,7 @@ use std::time::Instant;
 #[derive(Args)]
 pub(crate) struct RenderArgs {
     #[command(flatten)]
-    scene: SceneArgs,
+    pub(crate) scene: SceneArgs,
     /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto. The default,
     /// product-MIS, is product sampling beside BRDF sampling: faster than `product` alone at
     /// equal error and far less noisy (docs/perf.md).
@@ -34,6 +36,15 @@ pub(crate) struct RenderArgs {
     /// Write timings and counts as JSON.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+    /// Render only the pixels x0 ≤ x < x1, y0 ≤ y < y1 (half-open, as pbrt's --pixelbounds),
+    /// bit for bit those of the whole frame's render: the EXR's data window is the crop, its
+    /// display window the frame (a tile for `ppis merge`); the PNG holds the crop.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, allow_hyphen_values = true)]
+    crop: Option<Crop>,
+}
+
+fn parse_crop(text: &str) -> Result<Crop, String> {
+    Crop::parse(text).map_err(|e| e.to_string().trim_start_matches(&format!("--crop {text}: ")).to_string())
 }
 
 /// A scene ready to render: loaded, its environment and BVH built, and how long that took.
@@ -44,6 +55,8 @@ pub(crate) struct Prepared {
     /// Seconds loading the scene (the environment's own load time is in its stats).
     pub(crate) load_seconds: f64,
     pub(crate) bvh_seconds: f64,
+    /// The pixels to render: `--crop`, checked against the frame, or the whole frame.
+    pub(crate) crop: Crop,
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
@@ -66,10 +79,14 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         progress: true,
         shadows: !args.sampling.unshadowed,
     };
+    let camera = &prepared.scene.camera;
+    let frame = (camera.width as usize, camera.height as usize);
+    let crop = prepared.crop;
+    let record = provenance::settings_text(&args, &settings, frame)?;
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
-    let image = pool.install(|| plan::render(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings));
+    let image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
 
-    output::write_exr(&exr_path, image.width, image.height, &image.pixels)?;
+    output::write_exr_part(&exr_path, frame, crop, &image.pixels, Some(&record))?;
     output::write_png(&png_path, image.width, image.height, &image.pixels)?;
     if let Some(path) = &args.stats_json {
         let stats = Stats::new(&args, &prepared, hierarchy.as_ref(), &image, shading_points, threads);
@@ -123,6 +140,11 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
     warn_notes(&loaded.scene, &loaded.notes);
     let mut scene = loaded.scene;
     args.sampling.resize(&mut scene);
+    let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
+    let crop = match args.crop {
+        Some(crop) => crop.check(width, height)?,
+        None => Crop::full(width, height),
+    };
     let load_seconds = t_load.elapsed().as_secs_f64();
     let environment = match &scene.env {
         Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
@@ -139,7 +161,7 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
             env.stats.source, env.stats.sanitized
         );
     }
-    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds })
+    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop })
 }
 
 /// One line per material `auto`'s pilot measured.

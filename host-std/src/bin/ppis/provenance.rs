@@ -1,0 +1,59 @@
+//! The render's settings as `ppis render` writes them into its EXR's header
+//! (`host_std::output::SETTINGS_ATTRIBUTE`), one `key=value` per line: what `ppis merge`
+//! compares to refuse tiles of different renders. A whole frame's file holds the same text as
+//! each of its tiles', so a merged frame is byte for byte the one-process render. Files are
+//! named by their name and the FNV-1a hash of their bytes (not their folder: farm machines
+//! mount the same files at different paths); files a scene refers to (meshes, textures, a
+//! USD stage's sublayers) are not hashed.
+
+use crate::render_cmd::RenderArgs;
+use anyhow::{Context, Result};
+use host_std::plan::Settings;
+use std::fmt::Write;
+use std::path::Path;
+
+/// The settings text for a render of a `width`×`height` frame.
+pub(crate) fn settings_text(args: &RenderArgs, settings: &Settings, frame: (usize, usize)) -> Result<String> {
+    let scene = &args.scene;
+    let mut lines: Vec<(&str, String)> = vec![("ppis", env!("CARGO_PKG_VERSION").to_string())];
+    match &scene.scene {
+        Some(path) => {
+            lines.push(("scene", file_name(path)));
+            lines.push(("scene_fnv1a64", file_hash(path)?));
+        }
+        None => lines.push(("scene", "builtin".into())),
+    }
+    lines.push(("camera", scene.camera.clone().unwrap_or_default()));
+    lines.push(("render_settings", scene.render_settings.clone().unwrap_or_default()));
+    if let Some(path) = &scene.env {
+        lines.push(("env", file_name(path)));
+        lines.push(("env_fnv1a64", file_hash(path)?));
+    }
+    lines.push(("env_scale", scene.env_scale.map(|s| s.to_bits().to_string()).unwrap_or_default()));
+    lines.push(("env_rotate_y", scene.env_rotate_y.map(|r| r.to_bits().to_string()).unwrap_or_default()));
+    lines.push(("width", frame.0.to_string()));
+    lines.push(("height", frame.1.to_string()));
+    lines.push(("method", settings.method.to_string()));
+    lines.push(("spp", settings.spp.to_string()));
+    lines.push(("shading_points", settings.shading_points.to_string()));
+    lines.push(("brdf_samples", settings.brdf_samples.to_string()));
+    lines.push(("seed", settings.seed.to_string()));
+    lines.push(("shadows", settings.shadows.to_string()));
+    let mut text = String::new();
+    for (key, value) in lines {
+        // Latin-1 only in an EXR text attribute: anything else escaped.
+        let _ = writeln!(text, "{key}={}", value.escape_default());
+    }
+    Ok(text)
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// FNV-1a (64 bits) of the file's bytes, in hex: to tell files apart, not against tampering.
+fn file_hash(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
+    Ok(format!("{hash:016x}"))
+}
