@@ -65,10 +65,11 @@ def ours(args, scene, method, spp, seed, out):
 
 
 def at_time(points, t):
-    """log-log interpolation (or extrapolation) of (time, error) points at time t."""
+    """log-log interpolation (or extrapolation) of (time, error) points at time t; from a single
+    point, error ∝ 1/time."""
     (t1, e1), (t2, e2) = sorted(points)[:1] + sorted(points)[-1:]
     if t1 == t2:
-        return e1
+        return e1 * t1 / t
     slope = (math.log(e2) - math.log(e1)) / (math.log(t2) - math.log(t1))
     return math.exp(math.log(e1) + slope * (math.log(t) - math.log(t1)))
 
