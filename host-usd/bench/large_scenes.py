@@ -10,7 +10,7 @@ Writes, under --out:
   Xforms of 40 prims each, with four UsdPreviewSurface materials) under a dome;
 - `mesh_10m.usdc`: one Mesh of 10 million triangles (a displaced grid of 5 million quads) under
   a dome.
-Then renders each with `ppis render --width 320 --height 240 --spp 4 --stats-json` and prints
+Then renders each with `ppis render --method product-mis --width 320 --height 240 --spp 4 --stats-json` and prints
 the file size, load, BVH build and render times and peak memory (`/usr/bin/time -v`), the
 table docs/usd.md ("Large scenes") holds.
 """
@@ -104,7 +104,7 @@ def mesh_10m(path, quads_side=1582):
 def measure(ppis, scene):
     with tempfile.TemporaryDirectory() as tmp:
         stats = os.path.join(tmp, "stats.json")
-        cmd = ["/usr/bin/time", "-v", ppis, "render", scene, "--width", "320", "--height", "240", "--spp", "4",
+        cmd = ["/usr/bin/time", "-v", ppis, "render", scene, "--method", "product-mis", "--width", "320", "--height", "240", "--spp", "4",
                "-o", os.path.join(tmp, "r.exr"), "--stats-json", stats]
         run = subprocess.run(cmd, capture_output=True, text=True)
         if run.returncode != 0:

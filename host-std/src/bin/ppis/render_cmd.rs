@@ -20,10 +20,10 @@ use std::time::Instant;
 pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
-    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage or auto. The default,
-    /// product-MIS, is product sampling beside BRDF sampling: faster than `product` alone at
-    /// equal error and far less noisy (docs/perf.md).
-    #[arg(long, default_value = "product-mis", value_parser = parse_method)]
+    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage, two-level, two-level-mis
+    /// or auto. The default, auto, picks per material the plan with the least error at equal
+    /// time, from rules checked by a pilot render (docs/perf.md#auto-and-its-pilot).
+    #[arg(long, default_value = "auto", value_parser = parse_method)]
     pub(crate) method: Method,
     /// Visibility samples (shadow rays) per pixel.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
