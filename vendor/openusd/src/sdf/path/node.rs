@@ -1,0 +1,395 @@
+//! The tree behind a [`Path`]: each path is a node holding its parent and the one
+//! element it adds (a prim name, a variant selection or a property name), as Pixar's
+//! `SdfPath` is. Making a child, taking the parent or prim path, and testing or
+//! replacing a prefix then cost the elements involved rather than the text of the whole
+//! path, and a prim's paths share their ancestors instead of each holding a copy of
+//! them: a namespace `d` deep takes memory and time linear in `d`, not quadratic.
+//!
+//! The decomposition is canonical: a text that follows the path grammar below always
+//! parses to the same chain of nodes, and the fast constructors (`child_*`) make only
+//! nodes that parsing their text would make. So two paths are equal exactly when their
+//! chains are, and hashing the chain is hashing the text's structure. A text outside
+//! that grammar (relative paths, relationship targets `[..]`, unusual characters) is
+//! one opaque [`Kind::Text`] node, on which [`Path`]'s methods work on the text.
+//!
+//! Structured nodes are interned (`intern.rs`): a path made again, by parsing its text
+//! or by appending to its parent, is the node already made, so equal paths are nearly
+//! always one node and compare in one step. A node left out of the table (on a 64-bit
+//! hash collision) is still compared by its chain.
+//!
+//! The grammar of structured paths: `/`, then a prim name, then any sequence of
+//! `/name` (after a prim), `name` (directly after a variant selection), `{set=sel}`
+//! (after a prim or a variant selection), and at most one final `.property`. Names
+//! are alphanumeric or `_`; a selection may also hold `-` or `|` or be empty; a
+//! property name may hold `:` and `.` but not end with `.`.
+
+use super::intern;
+use super::{is_prim_name_char, Path};
+use std::cmp::Ordering;
+use std::hash::{DefaultHasher, Hash, Hasher};
+use std::sync::{Arc, LazyLock, OnceLock};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(super) enum Kind {
+    /// The empty path `""`.
+    Empty,
+    /// The absolute root `/`.
+    Root,
+    /// A prim child; `seg` is its name (the `/` before it follows from the parent).
+    Prim,
+    /// A variant selection; `seg` is `{set=sel}`.
+    Variant,
+    /// A property; `seg` is `.name`.
+    Property,
+    /// A text outside the structured grammar, whole in `seg`, with no parent.
+    Text,
+}
+
+pub(super) struct Node {
+    pub(super) parent: Option<Path>,
+    pub(super) seg: Box<str>,
+    pub(super) kind: Kind,
+    /// Prim names along the chain (`Path::prim_element_count`).
+    pub(super) prims: u32,
+    /// Prim names and variant selections along the chain (`Path::element_count`).
+    pub(super) elems: u32,
+    /// Whether a variant selection is on the chain.
+    pub(super) variants: bool,
+    /// The length of the path's text.
+    pub(super) len: usize,
+    pub(super) hash: u64,
+    /// Whether the node is the one in the intern table for its chain; two distinct
+    /// interned nodes are different paths.
+    pub(super) interned: bool,
+    /// The whole text, made on the first `Path::as_str` of a node with a parent.
+    text: OnceLock<Box<str>>,
+}
+
+impl Drop for Node {
+    /// Unlinks the chain one node at a time: dropping the last path of a deep chain
+    /// would otherwise recurse once per level.
+    fn drop(&mut self) {
+        let mut next = self.parent.take();
+        while let Some(path) = next {
+            next = match Arc::into_inner(path.node) {
+                Some(mut node) => node.parent.take(),
+                None => None,
+            };
+        }
+    }
+}
+
+fn leaf(kind: Kind, text: &str) -> Path {
+    // A fixed-key SipHash, so equal paths hash equal in every map and process.
+    let mut hasher = DefaultHasher::new();
+    text.hash(&mut hasher);
+    Path {
+        node: Arc::new(Node {
+            parent: None,
+            seg: text.into(),
+            kind,
+            prims: 0,
+            elems: 0,
+            variants: false,
+            len: text.len(),
+            hash: hasher.finish(),
+            interned: false,
+            text: OnceLock::new(),
+        }),
+    }
+}
+
+fn is_prim_name(name: &str) -> bool {
+    !name.is_empty() && name.chars().all(is_prim_name_char)
+}
+
+fn is_selection(text: &str) -> bool {
+    text.chars().all(|c| is_prim_name_char(c) || c == '-' || c == '|')
+}
+
+/// A property name the text-based queries read back whole: no separator but `.` and
+/// `:` inside it, and a last `.`-part that is non-empty (`Path::is_property_path`).
+fn is_property_name(name: &str) -> bool {
+    !name.is_empty() && !name.ends_with('.') && name.chars().all(|c| is_prim_name_char(c) || c == ':' || c == '.')
+}
+
+impl Path {
+    pub(super) fn empty() -> Path {
+        static EMPTY: LazyLock<Path> = LazyLock::new(|| leaf(Kind::Empty, ""));
+        EMPTY.clone()
+    }
+
+    pub(super) fn root() -> Path {
+        static ROOT: LazyLock<Path> = LazyLock::new(|| leaf(Kind::Root, "/"));
+        ROOT.clone()
+    }
+
+    pub(super) fn kind(&self) -> Kind {
+        self.node.kind
+    }
+
+    /// Whether the path is a chain of elements (not an opaque text).
+    pub(super) fn is_structured(&self) -> bool {
+        self.node.kind != Kind::Text
+    }
+
+    /// The path of `text`: its chain of nodes when it follows the grammar, else one
+    /// opaque node.
+    pub(super) fn parse(text: &str) -> Path {
+        match text {
+            "" => Path::empty(),
+            "/" => Path::root(),
+            _ => Path::parse_structured(text).unwrap_or_else(|| leaf(Kind::Text, text)),
+        }
+    }
+
+    fn parse_structured(text: &str) -> Option<Path> {
+        let mut rest = text.strip_prefix('/')?;
+        let mut at = Path::root();
+        while !rest.is_empty() {
+            let kind = at.node.kind;
+            let first = rest.chars().next()?;
+            if first == '{' && kind != Kind::Root {
+                let close = rest.find('}')?;
+                let (set, selection) = rest[1..close].split_once('=')?;
+                at = at.child_variant(set, selection)?;
+                rest = &rest[close + 1..];
+                continue;
+            }
+            if first == '.' && kind != Kind::Root {
+                return at.child_property(&rest[1..]);
+            }
+            if first == '/' && kind == Kind::Prim {
+                rest = &rest[1..];
+            } else if kind == Kind::Prim {
+                return None;
+            }
+            let end = rest.find(|c: char| !is_prim_name_char(c)).unwrap_or(rest.len());
+            at = at.child_prim(&rest[..end])?;
+            rest = &rest[end..];
+        }
+        Some(at)
+    }
+
+    fn child(&self, kind: Kind, seg: &str) -> Path {
+        let up = &self.node;
+        let mut hasher = DefaultHasher::new();
+        hasher.write_u64(up.hash);
+        hasher.write_u8(kind as u8);
+        seg.hash(&mut hasher);
+        let hash = hasher.finish();
+        let make = |interned| {
+            let separator = usize::from(kind == Kind::Prim && up.kind == Kind::Prim);
+            Arc::new(Node {
+                parent: Some(self.clone()),
+                seg: seg.into(),
+                kind,
+                prims: up.prims + u32::from(kind == Kind::Prim),
+                elems: up.elems + u32::from(matches!(kind, Kind::Prim | Kind::Variant)),
+                variants: up.variants || kind == Kind::Variant,
+                len: up.len + separator + seg.len(),
+                hash,
+                interned,
+                text: OnceLock::new(),
+            })
+        };
+        // Below a node left out of the table nothing is interned: an interned node's
+        // ancestors are all interned, so its parent pointer names its parent path.
+        let parent_interned = up.interned || matches!(up.kind, Kind::Root | Kind::Empty);
+        if !parent_interned {
+            return Path { node: make(false) };
+        }
+        let same = |n: &Node| {
+            n.kind == kind && n.seg.as_ref() == seg && n.parent.as_ref().is_some_and(|p| Arc::ptr_eq(&p.node, up))
+        };
+        Path {
+            node: intern::find_or_insert(hash, same, make),
+        }
+    }
+
+    /// The prim child `name`, when both are structured.
+    pub(super) fn child_prim(&self, name: &str) -> Option<Path> {
+        let fits = matches!(self.node.kind, Kind::Root | Kind::Prim | Kind::Variant);
+        (fits && is_prim_name(name)).then(|| self.child(Kind::Prim, name))
+    }
+
+    /// The variant selection `{set=selection}`, when both are structured.
+    pub(super) fn child_variant(&self, set: &str, selection: &str) -> Option<Path> {
+        let fits = matches!(self.node.kind, Kind::Prim | Kind::Variant);
+        (fits && is_prim_name(set) && is_selection(selection))
+            .then(|| self.child(Kind::Variant, &["{", set, "=", selection, "}"].concat()))
+    }
+
+    /// The property `name`, when both are structured.
+    pub(super) fn child_property(&self, name: &str) -> Option<Path> {
+        let fits = matches!(self.node.kind, Kind::Prim | Kind::Variant);
+        (fits && is_property_name(name)).then(|| self.child(Kind::Property, &[".", name].concat()))
+    }
+
+    /// The nodes from the root (or opaque text) down to this one.
+    pub(super) fn chain(&self) -> Vec<&Path> {
+        let mut chain = Vec::with_capacity(self.node.elems as usize + 2);
+        let mut at = Some(self);
+        while let Some(p) = at {
+            chain.push(p);
+            at = p.node.parent.as_ref();
+        }
+        chain.reverse();
+        chain
+    }
+
+    /// The text, piece by piece, root first.
+    pub(super) fn for_each_piece(&self, mut f: impl FnMut(&str)) {
+        if self.node.parent.is_none() {
+            return f(&self.node.seg);
+        }
+        if let Some(text) = self.node.text.get() {
+            return f(text);
+        }
+        for p in self.chain() {
+            if p.node.kind == Kind::Prim && p.node.parent.as_ref().is_some_and(|up| up.node.kind == Kind::Prim) {
+                f("/");
+            }
+            f(&p.node.seg);
+        }
+    }
+
+    /// The whole text, made once per node and kept.
+    pub(super) fn text(&self) -> &str {
+        if self.node.parent.is_none() {
+            return &self.node.seg;
+        }
+        self.node.text.get_or_init(|| {
+            let mut text = String::with_capacity(self.node.len);
+            self.for_each_piece(|piece| text.push_str(piece));
+            text.into()
+        })
+    }
+
+    /// The nearest node at or above this one whose text is `len` bytes long or
+    /// shorter, and whether it is exactly `len` long.
+    pub(super) fn ancestor_of_len(&self, len: usize) -> (&Path, bool) {
+        let mut at = self;
+        while at.node.len > len {
+            match &at.node.parent {
+                Some(up) => at = up,
+                None => break,
+            }
+        }
+        (at, at.node.len == len)
+    }
+
+    pub(super) fn same(&self, other: &Path) -> bool {
+        let (mut a, mut b) = (self, other);
+        loop {
+            if Arc::ptr_eq(&a.node, &b.node) {
+                return true;
+            }
+            let (x, y) = (&a.node, &b.node);
+            if x.interned && y.interned {
+                return false;
+            }
+            if x.hash != y.hash || x.len != y.len || x.kind != y.kind || x.seg != y.seg {
+                return false;
+            }
+            match (&x.parent, &y.parent) {
+                (Some(p), Some(q)) => (a, b) = (p, q),
+                (None, None) => return true,
+                _ => return false,
+            }
+        }
+    }
+
+    pub(super) fn hash_value(&self) -> u64 {
+        self.node.hash
+    }
+
+    pub(super) fn text_cmp(&self, other: &Path) -> Ordering {
+        if Arc::ptr_eq(&self.node, &other.node) {
+            return Ordering::Equal;
+        }
+        let pieces = |p: &Path| {
+            let mut v: Vec<u8> = Vec::with_capacity(p.node.len);
+            p.for_each_piece(|s| v.extend_from_slice(s.as_bytes()));
+            v
+        };
+        match (self.node.parent.is_none() || self.node.text.get().is_some(), other.node.parent.is_none()) {
+            (true, true) => self.text().cmp(other.text()),
+            _ => pieces(self).cmp(&pieces(other)),
+        }
+    }
+}
+
+impl Path {
+    /// The set and selection of a variant node.
+    fn variant_parts(&self) -> Option<(&str, &str)> {
+        let seg = &*self.node.seg;
+        (self.kind() == Kind::Variant).then(|| seg[1..seg.len() - 1].split_once('='))?
+    }
+
+    /// [`Path::has_prefix`] by the nodes, or `None` when the text decides: an opaque
+    /// path, or a property prefix (whose name may be the text prefix of a longer
+    /// property name, `.a` of `.a.b`).
+    pub(super) fn has_prefix_node(&self, prefix: &Path) -> Option<bool> {
+        if !self.is_structured() || matches!(prefix.kind(), Kind::Text | Kind::Property | Kind::Empty) {
+            return None;
+        }
+        if prefix.kind() == Kind::Root {
+            return Some(self.kind() != Kind::Empty);
+        }
+        let (at, exact) = self.ancestor_of_len(prefix.node.len);
+        Some(exact && at.same(prefix))
+    }
+
+    /// [`Path::replace_prefix`] by the nodes: the elements below `old` re-attached
+    /// under `new`. `None` when the text decides (as in `has_prefix_node`, or when an
+    /// element cannot attach under `new`, such as a property under the root).
+    pub(super) fn replace_prefix_nodes(&self, old: &Path, new: &Path) -> Option<Option<Path>> {
+        let structured = self.is_structured() && new.is_structured();
+        if !structured || matches!(new.kind(), Kind::Empty) {
+            return None;
+        }
+        if !self.has_prefix_node(old)? {
+            return Some(None);
+        }
+        if old.same(new) {
+            return Some(Some(self.clone()));
+        }
+        let mut below = Vec::new();
+        let mut at = self;
+        while at.node.len > old.node.len {
+            below.push(at);
+            at = at.node.parent.as_ref()?;
+        }
+        let mut out = new.clone();
+        for p in below.into_iter().rev() {
+            out = match p.kind() {
+                Kind::Prim => out.child_prim(&p.node.seg),
+                Kind::Variant => p.variant_parts().and_then(|(set, sel)| out.child_variant(set, sel)),
+                Kind::Property => out.child_property(&p.node.seg[1..]),
+                _ => None,
+            }?;
+        }
+        Some(Some(out))
+    }
+
+    /// [`Path::strip_all_variant_selections`] by the nodes, or `None` for an opaque path.
+    pub(super) fn strip_variants_nodes(&self) -> Option<Path> {
+        if !self.is_structured() {
+            return None;
+        }
+        if !self.node.variants {
+            return Some(self.clone());
+        }
+        let mut out = Path::root();
+        for p in self.chain().into_iter().skip(1) {
+            out = match p.kind() {
+                Kind::Prim => out.child_prim(&p.node.seg)?,
+                Kind::Property => out.child_property(&p.node.seg[1..])?,
+                _ => out,
+            };
+        }
+        Some(out)
+    }
+}
