@@ -157,6 +157,12 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
 
 type Failure = (String, String);
 
+/// The failure of `prim` with message `m`, for `map_err`: the path is written out only
+/// on failure (it is as long as the prim is deep).
+fn fail(prim: &PrimPath) -> impl FnOnce(String) -> Failure + '_ {
+    move |m| (prim.to_string(), m)
+}
+
 impl Importer<'_> {
     fn skip(&mut self, path: &(impl std::fmt::Display + ?Sized), what: impl Into<String>) {
         self.scene.skipped.push(Skip { path: path.to_string(), what: what.into() });
@@ -164,10 +170,6 @@ impl Importer<'_> {
 
     fn walk(&mut self, prims: &[PrimPath], options: &Options) -> Result<(), Failure> {
         let stage = self.stage;
-        let fail = |prim: &PrimPath| {
-            let prim = prim.to_string();
-            move |m: String| (prim, m)
-        };
         // Each prim's type, read once for both passes.
         let types = prims.iter().map(|p| stage.type_name(p).map_err(fail(p))).collect::<Result<Vec<_>, _>>()?;
         // Prototypes render only through their instancers.
@@ -237,10 +239,6 @@ impl Importer<'_> {
 
     fn instancer(&mut self, prim: &PrimPath, prims: &[PrimPath], world: &DMat4) -> Result<(), Failure> {
         let stage = self.stage;
-        let fail = |p: &PrimPath| {
-            let p = p.to_string();
-            move |m: String| (p, m)
-        };
         let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
         // Each prototype's renderable prims, with their transform relative to the
         // prototype root's parent.
