@@ -38,9 +38,12 @@ fn is_prim_name_char(c: char) -> bool {
 /// long as its depth; as a tree, a path shares its ancestors, and taking its parent or
 /// prim path, appending to it, and testing or replacing a prefix cost the elements
 /// involved, not its text. The text is made on demand ([`Path::as_str`] keeps it).
+/// The hash is also kept beside the node pointer, so that hashing a path and telling two
+/// apart, what path-keyed maps do most, read no node.
 #[derive(Clone)]
 pub struct Path {
     node: Arc<node::Node>,
+    hash: u64,
 }
 
 impl Path {
@@ -180,8 +183,14 @@ impl Path {
         Ok(self.child_property(property).unwrap_or_else(|| Path::parse(&[self.as_str(), ".", property].concat())))
     }
 
-    pub fn append_path(&self, path: impl Into<Path>) -> Result<Path> {
-        let append: Path = path.into();
+    pub fn append_path<'a>(&self, path: impl Into<PathArg<'a>>) -> Result<Path> {
+        let append = match path.into() {
+            PathArg::Text(name) => match self.child_prim(name) {
+                Some(child) => return Ok(child),
+                None => Path::parse(name),
+            },
+            PathArg::Path(path) => path,
+        };
 
         if self.is_abs() && append.is_abs() {
             bail!("Cannot append absolute path to absolute path");
@@ -1020,6 +1029,43 @@ impl<'a> Iterator for PathComponents<'a> {
         self.expect_slash = true;
         self.emitted = true;
         Some(PathComponent::Prim(name))
+    }
+}
+
+/// What [`Path::append_path`] appends: a path, or its text. A text is most often a
+/// child's name, which then needs no path of its own.
+pub enum PathArg<'a> {
+    Text(&'a str),
+    Path(Path),
+}
+
+impl<'a> From<&'a str> for PathArg<'a> {
+    fn from(text: &'a str) -> Self {
+        PathArg::Text(text)
+    }
+}
+
+impl<'a> From<&'a String> for PathArg<'a> {
+    fn from(text: &'a String) -> Self {
+        PathArg::Text(text)
+    }
+}
+
+impl From<String> for PathArg<'_> {
+    fn from(text: String) -> Self {
+        PathArg::Path(Path::from(text))
+    }
+}
+
+impl From<Path> for PathArg<'_> {
+    fn from(path: Path) -> Self {
+        PathArg::Path(path)
+    }
+}
+
+impl From<&Path> for PathArg<'_> {
+    fn from(path: &Path) -> Self {
+        PathArg::Path(path.clone())
     }
 }
 

@@ -84,7 +84,9 @@ fn leaf(kind: Kind, text: &str) -> Path {
     // A fixed-key SipHash, so equal paths hash equal in every map and process.
     let mut hasher = DefaultHasher::new();
     text.hash(&mut hasher);
+    let hash = hasher.finish();
     Path {
+        hash,
         node: Arc::new(Node {
             parent: None,
             seg: text.into(),
@@ -93,11 +95,46 @@ fn leaf(kind: Kind, text: &str) -> Path {
             elems: 0,
             variants: false,
             len: text.len(),
-            hash: hasher.finish(),
+            hash,
             interned: false,
             text: OnceLock::new(),
         }),
     }
+}
+
+/// The hash of a child node from its parent's: a multiply-rotate over the segment's
+/// bytes, finished by Murmur3's mixer. It is computed for every path made (the intern
+/// table and every path-keyed map use it), on segments of a few bytes, where SipHash's
+/// setup would dominate; fixed, so equal paths hash equal in every process.
+fn hash_child(parent: u64, kind: Kind, pieces: &[&str]) -> u64 {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut h = (parent ^ kind as u64).wrapping_mul(K);
+    for piece in pieces {
+        let bytes = piece.as_bytes();
+        h = (h.rotate_left(5) ^ bytes.len() as u64).wrapping_mul(K);
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            h = (h.rotate_left(5) ^ u64::from_le_bytes(word)).wrapping_mul(K);
+        }
+    }
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^ (h >> 33)
+}
+
+/// Whether `seg` is `pieces` in a row.
+fn seg_is(seg: &str, pieces: &[&str]) -> bool {
+    let mut rest = seg;
+    for piece in pieces {
+        match rest.strip_prefix(piece) {
+            Some(r) => rest = r,
+            None => return false,
+        }
+    }
+    rest.is_empty()
 }
 
 fn is_prim_name(name: &str) -> bool {
@@ -172,23 +209,22 @@ impl Path {
         Some(at)
     }
 
-    fn child(&self, kind: Kind, seg: &str) -> Path {
+    /// The child of `kind` whose `seg` is `pieces` in a row (always cut the same way for
+    /// a kind, so that the hash, taken piece by piece, is a function of the segment).
+    fn child(&self, kind: Kind, pieces: &[&str]) -> Path {
         let up = &self.node;
-        let mut hasher = DefaultHasher::new();
-        hasher.write_u64(up.hash);
-        hasher.write_u8(kind as u8);
-        seg.hash(&mut hasher);
-        let hash = hasher.finish();
+        let hash = hash_child(up.hash, kind, pieces);
+        let seg_len: usize = pieces.iter().map(|p| p.len()).sum();
         let make = |interned| {
             let separator = usize::from(kind == Kind::Prim && up.kind == Kind::Prim);
             Arc::new(Node {
                 parent: Some(self.clone()),
-                seg: seg.into(),
+                seg: pieces.concat().into_boxed_str(),
                 kind,
                 prims: up.prims + u32::from(kind == Kind::Prim),
                 elems: up.elems + u32::from(matches!(kind, Kind::Prim | Kind::Variant)),
                 variants: up.variants || kind == Kind::Variant,
-                len: up.len + separator + seg.len(),
+                len: up.len + separator + seg_len,
                 hash,
                 interned,
                 text: OnceLock::new(),
@@ -198,33 +234,34 @@ impl Path {
         // ancestors are all interned, so its parent pointer names its parent path.
         let parent_interned = up.interned || matches!(up.kind, Kind::Root | Kind::Empty);
         if !parent_interned {
-            return Path { node: make(false) };
+            return Path { node: make(false), hash };
         }
         let same = |n: &Node| {
-            n.kind == kind && n.seg.as_ref() == seg && n.parent.as_ref().is_some_and(|p| Arc::ptr_eq(&p.node, up))
+            n.kind == kind && n.parent.as_ref().is_some_and(|p| Arc::ptr_eq(&p.node, up)) && seg_is(&n.seg, pieces)
         };
         Path {
             node: intern::find_or_insert(hash, same, make),
+            hash,
         }
     }
 
     /// The prim child `name`, when both are structured.
     pub(super) fn child_prim(&self, name: &str) -> Option<Path> {
         let fits = matches!(self.node.kind, Kind::Root | Kind::Prim | Kind::Variant);
-        (fits && is_prim_name(name)).then(|| self.child(Kind::Prim, name))
+        (fits && is_prim_name(name)).then(|| self.child(Kind::Prim, &[name]))
     }
 
     /// The variant selection `{set=selection}`, when both are structured.
     pub(super) fn child_variant(&self, set: &str, selection: &str) -> Option<Path> {
         let fits = matches!(self.node.kind, Kind::Prim | Kind::Variant);
         (fits && is_prim_name(set) && is_selection(selection))
-            .then(|| self.child(Kind::Variant, &["{", set, "=", selection, "}"].concat()))
+            .then(|| self.child(Kind::Variant, &["{", set, "=", selection, "}"]))
     }
 
     /// The property `name`, when both are structured.
     pub(super) fn child_property(&self, name: &str) -> Option<Path> {
         let fits = matches!(self.node.kind, Kind::Prim | Kind::Variant);
-        (fits && is_property_name(name)).then(|| self.child(Kind::Property, &[".", name].concat()))
+        (fits && is_property_name(name)).then(|| self.child(Kind::Property, &[".", name]))
     }
 
     /// The nodes from the root (or opaque text) down to this one.
@@ -281,6 +318,9 @@ impl Path {
     }
 
     pub(super) fn same(&self, other: &Path) -> bool {
+        if self.hash != other.hash {
+            return false;
+        }
         let (mut a, mut b) = (self, other);
         loop {
             if Arc::ptr_eq(&a.node, &b.node) {
@@ -302,7 +342,7 @@ impl Path {
     }
 
     pub(super) fn hash_value(&self) -> u64 {
-        self.node.hash
+        self.hash
     }
 
     pub(super) fn text_cmp(&self, other: &Path) -> Ordering {
