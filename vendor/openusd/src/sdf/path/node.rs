@@ -12,10 +12,11 @@
 //! that grammar (relative paths, relationship targets `[..]`, unusual characters) is
 //! one opaque [`Kind::Text`] node, on which [`Path`]'s methods work on the text.
 //!
-//! Structured nodes are interned (`intern.rs`): a path made again, by parsing its text
-//! or by appending to its parent, is the node already made, so equal paths are nearly
-//! always one node and compare in one step. A node left out of the table (on a 64-bit
-//! hash collision) is still compared by its chain.
+//! Prim and variant nodes are interned (`intern.rs`): a path made again, by parsing its
+//! text or by appending to its parent, is the node already made, so equal paths are
+//! nearly always one node and compare in one step. A node left out of the table (a
+//! property, or a node on a 64-bit hash collision) is compared by its chain, which stops
+//! at the first two interned ancestors.
 //!
 //! The grammar of structured paths: `/`, then a prim name, then any sequence of
 //! `/name` (after a prim), `name` (directly after a variant selection), `{set=sel}`
@@ -232,8 +233,10 @@ impl Path {
         };
         // Below a node left out of the table nothing is interned: an interned node's
         // ancestors are all interned, so its parent pointer names its parent path.
+        // Properties are not interned: most are made for one query and dropped, and two
+        // of them compare in one step past their interned prims.
         let parent_interned = up.interned || matches!(up.kind, Kind::Root | Kind::Empty);
-        if !parent_interned {
+        if !parent_interned || kind == Kind::Property {
             return Path { node: make(false), hash };
         }
         let same = |n: &Node| {
