@@ -3,6 +3,7 @@ use std::sync::Arc;
 
 mod intern;
 mod node;
+mod prefix;
 use node::Kind;
 use std::{cmp, fmt, result, str::FromStr};
 
