@@ -4,11 +4,11 @@
 
 use crate::scene::Camera;
 use crate::shapes::number;
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::{DMat4, DVec3, Vec3};
 
 /// Reads a Camera prim whose world transform (renderer frame) is `world`.
-pub fn read(stage: &Stage, prim: &str, world: &DMat4) -> Result<(Camera, Vec<String>), String> {
+pub fn read(stage: &Stage, prim: &PrimPath, world: &DMat4) -> Result<(Camera, Vec<String>), String> {
     let mut notes = Vec::new();
     let focal_length = number(stage, prim, "focalLength", 50.0)? as f32;
     let horizontal_aperture = number(stage, prim, "horizontalAperture", 20.955)? as f32;

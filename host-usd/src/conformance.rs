@@ -7,7 +7,7 @@
 use crate::import;
 use crate::instancer;
 use crate::mesh;
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use crate::xform::WorldTransforms;
 use glam::DMat4;
 use serde_json::Value as Json;
@@ -54,7 +54,7 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     check_stage(&stage, &want["stage"], &mut mismatch)?;
 
     // A set: the traversals hold 100 000 prims and more.
-    let ours: std::collections::HashSet<String> = stage.all_prims()?.into_iter().collect();
+    let ours: std::collections::HashSet<String> = stage.all_prims()?.iter().map(PrimPath::to_string).collect();
     let Some(prims) = want["prims"].as_object() else {
         return Err(format!("{}: no \"prims\" object", expected.display()));
     };
@@ -81,7 +81,7 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
         }
         if want.get("world").is_some() {
             n_mat += 1;
-            let prim_err = matrix_error(&worlds.world(&stage, path)?, &want["world"]);
+            let prim_err = matrix_error(&worlds.world(&stage, &PrimPath::new(path)?)?, &want["world"]);
             if prim_err > MATRIX_TOLERANCE {
                 mismatch(format!("{path}: world matrix differs from Pixar's by {prim_err:.3e}"));
             }
@@ -161,7 +161,7 @@ fn check_mesh(stage: &Stage, path: &str, want: &Json, mismatch: &mut impl FnMut(
     if !same {
         mismatch(format!("{path}: faceVertexCounts differ from Pixar's {fvc}"));
     }
-    if let Err(e) = mesh::read(stage, path, Some("st")) {
+    if let Err(e) = mesh::read(stage, &PrimPath::new(path)?, Some("st")) {
         mismatch(format!("{path}: {e}"));
     }
     Ok(())
@@ -192,7 +192,7 @@ fn check_instancer(
     w: &Json,
     mismatch: &mut impl FnMut(String),
 ) -> Result<(usize, f64), String> {
-    let (protos, instances) = instancer::read(stage, path)?;
+    let (protos, instances) = instancer::read(stage, &PrimPath::new(path)?)?;
     let mask: Vec<bool> = w["mask"].as_array().into_iter().flatten().filter_map(Json::as_bool).collect();
     let visible: Vec<usize> = instances.iter().map(|i| i.index).collect();
     // An empty mask: every instance is visible.

@@ -5,11 +5,11 @@
 //! DomeLight ignores upAxis. Radiance = texture · color · intensity · 2^exposure.
 
 use crate::scene::Dome;
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::{DMat3, DMat4, Vec3};
 
 /// A light input: `inputs:<name>`, or the pre-UsdLux-2021 `<name>`.
-fn light_input(stage: &Stage, prim: &str, name: &str) -> Result<Option<Value>, String> {
+fn light_input(stage: &Stage, prim: &PrimPath, name: &str) -> Result<Option<Value>, String> {
     match stage.value(prim, &format!("inputs:{name}"))? {
         Some(v) => Ok(Some(v)),
         None => stage.value(prim, name),
@@ -20,7 +20,7 @@ fn light_input(stage: &Stage, prim: &str, name: &str) -> Result<Option<Value>, S
 /// up-axis rotation into the renderer's frame. Returns the dome and what was not honoured.
 pub fn read(
     stage: &Stage,
-    prim: &str,
+    prim: &PrimPath,
     type_name: &str,
     z_up: bool,
     world: &DMat4,

@@ -4,7 +4,7 @@
 use crate::error::UsdError;
 use crate::inherit::Hidden;
 use crate::scene::{Counts, Skip, UpAxis, UsdScene};
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use crate::xform::{WorldTransforms, up_axis_conversion};
 use crate::{camera, dome, instancer, render_settings};
 use glam::DMat4;
@@ -157,27 +157,29 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
 
 type Failure = (String, String);
 
+/// The failure of `prim` with message `m`, for `map_err`: the path is written out only
+/// on failure (it is as long as the prim is deep).
+fn fail(prim: &PrimPath) -> impl FnOnce(String) -> Failure + '_ {
+    move |m| (prim.to_string(), m)
+}
+
 impl Importer<'_> {
-    fn skip(&mut self, path: &str, what: impl Into<String>) {
+    fn skip(&mut self, path: &(impl std::fmt::Display + ?Sized), what: impl Into<String>) {
         self.scene.skipped.push(Skip { path: path.to_string(), what: what.into() });
     }
 
-    fn walk(&mut self, prims: &[String], options: &Options) -> Result<(), Failure> {
+    fn walk(&mut self, prims: &[PrimPath], options: &Options) -> Result<(), Failure> {
         let stage = self.stage;
-        let fail = |prim: &str| {
-            let prim = prim.to_string();
-            move |m: String| (prim, m)
-        };
         // Each prim's type, read once for both passes.
         let types = prims.iter().map(|p| stage.type_name(p).map_err(fail(p))).collect::<Result<Vec<_>, _>>()?;
         // Prototypes render only through their instancers.
-        let mut prototypes: Vec<String> = Vec::new();
+        let mut prototypes: Vec<PrimPath> = Vec::new();
         for (prim, t) in prims.iter().zip(&types) {
             if t == "PointInstancer" {
                 prototypes.extend(stage.targets(prim, "prototypes").map_err(fail(prim))?);
             }
         }
-        let in_prototype = |p: &str| prototypes.iter().any(|r| p == r || p.starts_with(&format!("{r}/")));
+        let in_prototype = |p: &PrimPath| prototypes.iter().any(|r| p.is_at_or_below(r));
         for (prim, type_name) in prims.iter().zip(&types) {
             self.scene.counts.prims += 1;
             if in_prototype(prim) {
@@ -195,10 +197,10 @@ impl Importer<'_> {
                 } else {
                     let proxy = stage.is_instance_proxy(prim).map_err(fail(prim))?;
                     self.scene.counts.instances += usize::from(proxy);
-                    self.gprim(prim, t, prim, &(self.conversion * world)).map_err(fail(prim))?;
+                    self.gprim(prim, t, &prim.to_string(), &(self.conversion * world)).map_err(fail(prim))?;
                 }
             } else if t == "Camera" {
-                let wanted = options.camera.as_deref().is_none_or(|c| c == prim);
+                let wanted = options.camera.as_deref().is_none_or(|c| *c == prim.to_string());
                 if self.scene.camera.is_none() && wanted {
                     let world = self.conversion * self.worlds.world(stage, prim).map_err(fail(prim))?;
                     let (c, notes) = camera::read(stage, prim, &world).map_err(fail(prim))?;
@@ -231,23 +233,19 @@ impl Importer<'_> {
     }
 
     /// Invisible, or a proxy/guide purpose.
-    fn hidden(&mut self, prim: &str) -> Result<bool, String> {
+    fn hidden(&mut self, prim: &PrimPath) -> Result<bool, String> {
         self.hidden.hidden(self.stage, prim)
     }
 
-    fn instancer(&mut self, prim: &str, prims: &[String], world: &DMat4) -> Result<(), Failure> {
+    fn instancer(&mut self, prim: &PrimPath, prims: &[PrimPath], world: &DMat4) -> Result<(), Failure> {
         let stage = self.stage;
-        let fail = |p: &str| {
-            let p = p.to_string();
-            move |m: String| (p, m)
-        };
         let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
         // Each prototype's renderable prims, with their transform relative to the
         // prototype root's parent.
-        let mut parts: Vec<Vec<(String, String, DMat4)>> = Vec::new();
+        let mut parts: Vec<Vec<(PrimPath, String, DMat4)>> = Vec::new();
         for root in &protos {
             let mut list = Vec::new();
-            for p in prims.iter().filter(|p| *p == root || p.starts_with(&format!("{root}/"))) {
+            for p in prims.iter().filter(|p| p.is_at_or_below(root)) {
                 let t = stage.type_name(p).map_err(fail(p))?;
                 if GPRIMS.contains(&t.as_str()) && !self.hidden(p).map_err(fail(p))? {
                     let rel = self.worlds.relative_to(stage, p, root).map_err(fail(p))?;

@@ -2,8 +2,7 @@
 //! memoised per path and resolved top-down: a prim costs one step from its parent's
 //! answer, never a walk to the root, and no recursion, however deep the namespace.
 
-use crate::stage::Stage;
-use crate::xform::parent_path;
+use crate::stage::{PrimPath, Stage};
 use std::collections::HashMap;
 
 /// The value of `prim`: the unresolved ancestors (nearest memoised one or the
@@ -11,28 +10,30 @@ use std::collections::HashMap;
 /// `step(path, parent's value)`, and memoised. `prim` itself is not: the walk asks
 /// once per prim, and only ancestors are asked again (by each prim below them), so
 /// a stage's leaves, most of its prims, take no memory.
+#[allow(clippy::mutable_key_type, reason = "a path's interior mutability is its text cache, outside Eq and Hash")]
 pub fn resolve_down<T: Clone>(
-    memo: &mut HashMap<String, T>,
-    prim: &str,
+    memo: &mut HashMap<PrimPath, T>,
+    prim: &PrimPath,
     root: T,
-    mut step: impl FnMut(&str, &T) -> Result<T, String>,
+    mut step: impl FnMut(&PrimPath, &T) -> Result<T, String>,
 ) -> Result<T, String> {
     let mut chain = Vec::new();
-    let mut here = prim;
+    let mut here = prim.clone();
     let mut value = loop {
-        if here == "/" {
+        if here.is_root() {
             break root;
         }
-        if let Some(v) = memo.get(here) {
+        if let Some(v) = memo.get(&here) {
             break v.clone();
         }
+        let up = here.parent().unwrap_or_else(PrimPath::root);
         chain.push(here);
-        here = parent_path(here).unwrap_or("/");
+        here = up;
     };
     for (i, path) in chain.into_iter().enumerate().rev() {
-        value = step(path, &value)?;
+        value = step(&path, &value)?;
         if i > 0 {
-            memo.insert(path.to_string(), value.clone());
+            memo.insert(path, value.clone());
         }
     }
     Ok(value)
@@ -41,14 +42,14 @@ pub fn resolve_down<T: Clone>(
 /// Computed visibility and purpose (UsdGeomImageable's rules), memoised.
 #[derive(Default)]
 pub struct Hidden {
-    invisible: HashMap<String, bool>,
-    purpose: HashMap<String, &'static str>,
+    invisible: HashMap<PrimPath, bool>,
+    purpose: HashMap<PrimPath, &'static str>,
 }
 
 impl Hidden {
     /// Invisible (the prim or an ancestor authors `visibility = invisible`), or of
     /// purpose `proxy` or `guide` (the nearest authored purpose).
-    pub fn hidden(&mut self, stage: &Stage, prim: &str) -> Result<bool, String> {
+    pub fn hidden(&mut self, stage: &Stage, prim: &PrimPath) -> Result<bool, String> {
         let invisible =
             resolve_down(&mut self.invisible, prim, false, |p, above| Ok(*above || stage.authored_invisible(p)?))?;
         if invisible {

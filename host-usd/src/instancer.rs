@@ -2,7 +2,7 @@
 //! the instancer's world; each prototype's own subtree transform (root included) applies
 //! first. `invisibleIds` hide instances; prototypes are not rendered in place.
 
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::{DMat4, DQuat, DVec3};
 
 /// One instance: which prototype, and its transform relative to the instancer.
@@ -24,7 +24,7 @@ fn numbers(v: Option<Value>) -> Vec<f64> {
 }
 
 /// The prototypes (paths) and the visible instances of a PointInstancer.
-pub fn read(stage: &Stage, prim: &str) -> Result<(Vec<String>, Vec<Instance>), String> {
+pub fn read(stage: &Stage, prim: &PrimPath) -> Result<(Vec<PrimPath>, Vec<Instance>), String> {
     let prototypes = stage.targets(prim, "prototypes")?;
     let proto_indices = numbers(stage.value(prim, "protoIndices")?);
     let positions = numbers(stage.value(prim, "positions")?);

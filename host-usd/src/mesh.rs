@@ -5,7 +5,7 @@
 //! none` only, as USD specifies.
 
 use crate::primvar::Primvar;
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::{DVec3, Vec2};
 
 /// A mesh in its prim's local space.
@@ -34,7 +34,7 @@ fn ints(v: Option<Value>, what: &str) -> Result<Vec<i64>, String> {
 }
 
 /// Reads a Mesh prim, with texture coordinates from `primvars:<uv_primvar>` when asked.
-pub fn read(stage: &Stage, prim: &str, uv_primvar: Option<&str>) -> Result<LocalMesh, String> {
+pub fn read(stage: &Stage, prim: &PrimPath, uv_primvar: Option<&str>) -> Result<LocalMesh, String> {
     let positions: Vec<DVec3> = match stage.value(prim, "points")? {
         None => Vec::new(),
         Some(Value::Numbers { values, shape: 3, .. }) => {

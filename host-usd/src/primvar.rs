@@ -1,7 +1,7 @@
 //! Primvars: a value array, optional `:indices`, and an interpolation, expanded to one value
 //! per face-vertex (corner) of a mesh.
 
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 
 /// How a primvar's elements map onto a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,7 +49,12 @@ impl Primvar {
     /// Reads `primvars:<name>` (with `primvars:<name>:indices`), or, when `fallback_attr` is
     /// given and the primvar is not authored, that plain attribute (e.g. `normals`, whose
     /// interpolation defaults to `vertex`).
-    pub fn read(stage: &Stage, prim: &str, name: &str, fallback_attr: Option<&str>) -> Result<Option<Self>, String> {
+    pub fn read(
+        stage: &Stage,
+        prim: &PrimPath,
+        name: &str,
+        fallback_attr: Option<&str>,
+    ) -> Result<Option<Self>, String> {
         let pv = format!("primvars:{name}");
         let (attr_name, value, interp_default) = match stage.value(prim, &pv)? {
             Some(v) => (pv, v, Interpolation::Constant),

@@ -4,7 +4,7 @@
 //! `aspectRatioConformPolicy` and `camera` override the settings' own (UsdRenderSettingsBase
 //! is shared by both and a product is the more specific), as Hydra renderers read them.
 
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 
 /// How the camera's aperture is fitted to an image of another aspect ratio
 /// (`aspectRatioConformPolicy`).
@@ -78,35 +78,35 @@ const MAX_SIDE: f64 = 16384.0;
 /// explicitly must exist; the stage's metadata naming none is a note.
 fn settings_prim(
     stage: &Stage,
-    prims: &[String],
+    prims: &[PrimPath],
     wanted: Option<&str>,
-) -> Result<(Option<String>, Option<String>), String> {
-    let typed = |p: &str| stage.type_name(p).is_ok_and(|t| t == "RenderSettings");
-    let is_settings = |p: &str| prims.iter().any(|q| q == p) && typed(p);
+) -> Result<(Option<PrimPath>, Option<String>), String> {
+    let typed = |p: &PrimPath| stage.type_name(p).is_ok_and(|t| t == "RenderSettings");
+    let settings = |p: &str| PrimPath::new(p).ok().filter(|p| prims.contains(p) && typed(p));
     if let Some(w) = wanted {
-        return match is_settings(w) {
-            true => Ok((Some(w.to_string()), None)),
-            false => Err(format!("{w}: no such RenderSettings prim")),
+        return match settings(w) {
+            Some(w) => Ok((Some(w), None)),
+            None => Err(format!("{w}: no such RenderSettings prim")),
         };
     }
     if let Some(Value::Token(p)) = stage.metadata("renderSettingsPrimPath")?.as_ref()
         && !p.is_empty()
     {
-        return Ok(match is_settings(p) {
-            true => (Some(p.clone()), None),
-            false => (None, Some(format!("renderSettingsPrimPath {p} names no RenderSettings prim; none applied"))),
+        return Ok(match settings(p) {
+            Some(p) => (Some(p), None),
+            None => (None, Some(format!("renderSettingsPrimPath {p} names no RenderSettings prim; none applied"))),
         });
     }
-    let all: Vec<&String> = prims.iter().filter(|p| typed(p)).collect();
+    let all: Vec<&PrimPath> = prims.iter().filter(|p| typed(p)).collect();
     Ok(match all.as_slice() {
         [] => (None, None),
-        [one] => (Some(one.to_string()), None),
+        [one] => (Some((*one).clone()), None),
         [first, ..] => {
             let note = format!(
                 "{} RenderSettings prims and no renderSettingsPrimPath: {first} applied (--render-settings chooses)",
                 all.len()
             );
-            (Some(first.to_string()), Some(note))
+            (Some((*first).clone()), Some(note))
         }
     })
 }
@@ -120,7 +120,7 @@ struct Authored {
     camera: Option<String>,
 }
 
-fn authored(stage: &Stage, prim: &str) -> Result<Authored, String> {
+fn authored(stage: &Stage, prim: &PrimPath) -> Result<Authored, String> {
     let resolution = match stage.value(prim, "resolution")? {
         None => None,
         Some(Value::Numbers { values, shape: 2, array: false })
@@ -144,7 +144,7 @@ fn authored(stage: &Stage, prim: &str) -> Result<Authored, String> {
             None => return Err(format!("{prim}.aspectRatioConformPolicy: unknown policy {v:?}")),
         },
     };
-    let camera = stage.targets(prim, "camera")?.into_iter().next();
+    let camera = stage.targets(prim, "camera")?.first().map(PrimPath::to_string);
     Ok(Authored { resolution, pixel_aspect, conform, camera })
 }
 
@@ -152,7 +152,7 @@ fn authored(stage: &Stage, prim: &str) -> Result<Authored, String> {
 /// what of them is not honoured. `wanted` names a settings prim explicitly.
 pub fn read(
     stage: &Stage,
-    prims: &[String],
+    prims: &[PrimPath],
     wanted: Option<&str>,
 ) -> Result<(Option<RenderSettings>, Vec<String>), (String, String)> {
     let (path, note) = settings_prim(stage, prims, wanted).map_err(|e| ("/".to_string(), e))?;
@@ -160,7 +160,7 @@ pub fn read(
     let Some(path) = path else {
         return Ok((None, notes));
     };
-    let at = |prim: &str| {
+    let at = |prim: &PrimPath| {
         let prim = prim.to_string();
         move |e: String| (prim, e)
     };
@@ -182,7 +182,7 @@ pub fn read(
         notes.push("dataWindowNDC ignored: the whole image is rendered".into());
     }
     let settings = RenderSettings {
-        path,
+        path: path.to_string(),
         resolution: a.resolution.unwrap_or(FALLBACK_RESOLUTION),
         pixel_aspect: a.pixel_aspect.unwrap_or(1.0),
         conform: a.conform.unwrap_or_default(),

@@ -3,7 +3,7 @@
 //! transform is intersected exactly instead (see `import.rs`).
 
 use crate::mesh::LocalMesh;
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
@@ -12,11 +12,11 @@ const SEGMENTS: usize = 64;
 const RINGS: usize = 32;
 
 /// A number attribute with the schema's fallback.
-pub fn number(stage: &Stage, prim: &str, attr: &str, fallback: f64) -> Result<f64, String> {
+pub fn number(stage: &Stage, prim: &PrimPath, attr: &str, fallback: f64) -> Result<f64, String> {
     Ok(stage.value(prim, attr)?.and_then(|v| v.scalar()).unwrap_or(fallback))
 }
 
-fn axis_frame(stage: &Stage, prim: &str) -> Result<[DVec3; 3], String> {
+fn axis_frame(stage: &Stage, prim: &PrimPath) -> Result<[DVec3; 3], String> {
     let axis = stage.value(prim, "axis")?;
     // (e1, e2, axis), right-handed.
     Ok(match axis.as_ref().and_then(Value::token).unwrap_or("Z") {
@@ -27,7 +27,7 @@ fn axis_frame(stage: &Stage, prim: &str) -> Result<[DVec3; 3], String> {
 }
 
 /// The local mesh of an implicit gprim, or `None` for a type this file does not know.
-pub fn tessellate(stage: &Stage, prim: &str, type_name: &str) -> Result<Option<LocalMesh>, String> {
+pub fn tessellate(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Option<LocalMesh>, String> {
     let mut b = Builder::default();
     match type_name {
         "Sphere" => {

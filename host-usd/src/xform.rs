@@ -3,28 +3,19 @@
 //! Matrices are glam's column-vector form (the transpose of USD's row-vector matrices), so
 //! `world = parent · local`.
 
-use crate::stage::Stage;
+use crate::stage::{PrimPath, Stage};
 use glam::{DMat3, DMat4, DVec3};
 use std::collections::HashMap;
 
 /// Each prim's world transform, memoised by path.
 #[derive(Default)]
 pub struct WorldTransforms {
-    cache: HashMap<String, DMat4>,
-}
-
-/// The parent path of a prim path (`/a/b` → `/a`, `/a` → `/`).
-pub fn parent_path(path: &str) -> Option<&str> {
-    if path == "/" {
-        return None;
-    }
-    let cut = path.rfind('/')?;
-    Some(if cut == 0 { "/" } else { &path[..cut] })
+    cache: HashMap<PrimPath, DMat4>,
 }
 
 impl WorldTransforms {
     /// Local-to-world of `prim` in the stage's own frame (before any up-axis conversion).
-    pub fn world(&mut self, stage: &Stage, prim: &str) -> Result<DMat4, String> {
+    pub fn world(&mut self, stage: &Stage, prim: &PrimPath) -> Result<DMat4, String> {
         crate::inherit::resolve_down(&mut self.cache, prim, DMat4::IDENTITY, |p, parent| {
             let (local, resets) = crate::xform_ops::local_transform(stage, p)?;
             Ok(if resets { local } else { *parent * local })
@@ -34,16 +25,16 @@ impl WorldTransforms {
     /// The transform of `prim` relative to `root`'s parent: the locals from `prim` up to and
     /// including `root` (a PointInstancer prototype's own transform is part of each
     /// instance).
-    pub fn relative_to(&mut self, stage: &Stage, prim: &str, root: &str) -> Result<DMat4, String> {
+    pub fn relative_to(&mut self, stage: &Stage, prim: &PrimPath, root: &PrimPath) -> Result<DMat4, String> {
         let mut m = DMat4::IDENTITY;
-        let mut p = prim;
+        let mut p = prim.clone();
         loop {
-            let (local, resets) = crate::xform_ops::local_transform(stage, p)?;
+            let (local, resets) = crate::xform_ops::local_transform(stage, &p)?;
             m = local * m;
-            if p == root || resets {
+            if p == *root || resets {
                 return Ok(m);
             }
-            p = parent_path(p).ok_or_else(|| format!("{prim} is not under {root}"))?;
+            p = p.parent().filter(|up| !up.is_root()).ok_or_else(|| format!("{prim} is not under {root}"))?;
         }
     }
 }
@@ -85,13 +76,6 @@ pub fn uniform_scale(m: &DMat4) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn parents() {
-        assert_eq!(parent_path("/a/b/c"), Some("/a/b"));
-        assert_eq!(parent_path("/a"), Some("/"));
-        assert_eq!(parent_path("/"), None);
-    }
 
     #[test]
     fn z_up_becomes_y_up() {

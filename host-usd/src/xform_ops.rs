@@ -4,7 +4,7 @@
 //! an axis and an angle, which matters at 1e-8 for an authored `quatf`). Matrices are
 //! glam's column-vector form, the transpose of USD's row-vector matrices.
 
-use crate::stage::{Stage, Value};
+use crate::stage::{PrimPath, Stage, Value};
 use glam::{DMat4, DQuat, DVec3};
 
 const INVERT: &str = "!invert!";
@@ -64,7 +64,7 @@ fn op_matrix(kind: &str, v: &Value) -> Result<DMat4, String> {
 }
 
 /// The local-to-parent transform of `prim` and whether it resets the parent's transform.
-pub fn local_transform(stage: &Stage, prim: &str) -> Result<(DMat4, bool), String> {
+pub fn local_transform(stage: &Stage, prim: &PrimPath) -> Result<(DMat4, bool), String> {
     let Some(order) = stage.xform_op_order(prim)? else {
         return Ok((DMat4::IDENTITY, false));
     };

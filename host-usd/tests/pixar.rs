@@ -38,7 +38,8 @@ fn instancer_transforms_match_pixar() {
         let stage = host_usd::import::open(&usd).unwrap();
         let mut worlds = WorldTransforms::default();
         for (path, w) in want["instancers"].as_object().unwrap() {
-            let (protos, instances) = host_usd::instancer::read(&stage, path).unwrap();
+            let (protos, instances) =
+                host_usd::instancer::read(&stage, &host_usd::stage::PrimPath::new(path).unwrap()).unwrap();
             let mask: Vec<bool> = w["mask"].as_array().unwrap().iter().map(|b| b.as_bool().unwrap()).collect();
             let visible: Vec<usize> = instances.iter().map(|i| i.index).collect();
             let want_visible: Vec<usize> = (0..mask.len()).filter(|&i| mask[i]).collect();

@@ -5,13 +5,14 @@ use super::Importer;
 use crate::mesh::{self, LocalMesh};
 use crate::scene::{Mesh, Sphere};
 use crate::shapes;
+use crate::stage::PrimPath;
 use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::collections::HashMap;
 
 impl Importer<'_> {
     /// One gprim with its local-to-renderer transform `m`.
-    pub(super) fn gprim(&mut self, prim: &str, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
+    pub(super) fn gprim(&mut self, prim: &PrimPath, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
         let stage = self.stage;
         let double_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let material = self.material_for(prim)?;

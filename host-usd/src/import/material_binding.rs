@@ -4,13 +4,13 @@
 
 use super::Importer;
 use crate::material::Material;
-use crate::stage::Value;
+use crate::stage::{PrimPath, Value};
 use glam::Vec3;
 use std::collections::HashSet;
 
 impl Importer<'_> {
     /// (faces, material) of the mesh's `materialBind` GeomSubsets that bind a material.
-    pub(super) fn subset_materials(&mut self, prim: &str) -> Result<Vec<(HashSet<i64>, usize)>, String> {
+    pub(super) fn subset_materials(&mut self, prim: &PrimPath) -> Result<Vec<(HashSet<i64>, usize)>, String> {
         let mut out = Vec::new();
         for child in self.stage.children(prim)? {
             if self.stage.type_name(&child)? != "GeomSubset" {
@@ -34,7 +34,7 @@ impl Importer<'_> {
     }
 
     /// The index of the material bound to `prim` (imported on first use), or of a fallback.
-    pub(super) fn material_for(&mut self, prim: &str) -> Result<usize, String> {
+    pub(super) fn material_for(&mut self, prim: &PrimPath) -> Result<usize, String> {
         let bound = self.stage.bound_material(prim)?;
         // Unbound gprims show their displayColor (its mean over the elements), as viewers do.
         let display = match &bound {

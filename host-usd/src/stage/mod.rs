@@ -4,9 +4,11 @@
 //! version bump of openusd touches this module only; the rest of host-usd sees [`Stage`] and
 //! [`Value`].
 
+mod prim_path;
 mod shading;
 mod value;
 
+pub use prim_path::{PrimPath, PrimRef};
 pub use shading::{Input, PreviewInputs, TextureRef};
 pub use value::Value;
 use value::convert;
@@ -35,11 +37,9 @@ pub struct Stage {
     inner: usd::Stage,
     time: usd::TimeCode,
     /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
-    binding_api: RefCell<HashMap<String, bool>>,
+    binding_api: RefCell<HashMap<sdf::Path, bool>>,
     /// The composed property names of the prim asked about last (see [`Stage::authors`]).
-    properties: RefCell<(String, Vec<openusd::tf::Token>)>,
-    /// The path of the prim asked about last (see [`Stage::path`]).
-    last_path: RefCell<Option<sdf::Path>>,
+    properties: RefCell<Option<(PrimPath, Vec<openusd::tf::Token>)>>,
 }
 
 type Result<T> = std::result::Result<T, String>;
@@ -59,26 +59,12 @@ impl Stage {
         let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
         let inner = usd::Stage::open(name).map_err(err)?;
         let time = usd::TimeCode::new(inner.start_time_code());
-        Ok(Self {
-            inner,
-            time,
-            binding_api: RefCell::default(),
-            properties: RefCell::default(),
-            last_path: RefCell::default(),
-        })
+        Ok(Self { inner, time, binding_api: RefCell::default(), properties: RefCell::default() })
     }
 
-    /// `prim`'s path. The importer asks about one prim many times in a row, and making a
-    /// path hashes and copies its whole text (as long as the prim is deep): the last one
-    /// made is kept.
-    fn path(&self, prim: &str) -> Result<sdf::Path> {
-        let mut last = self.last_path.borrow_mut();
-        if let Some(p) = last.as_ref().filter(|p| p.as_str() == prim) {
-            return Ok(p.clone());
-        }
-        let p = path(prim)?;
-        *last = Some(p.clone());
-        Ok(p)
+    /// `prim`'s path in openusd's terms.
+    fn path(&self, prim: &(impl PrimRef + ?Sized)) -> Result<sdf::Path> {
+        Ok(prim.prim_path()?.0)
     }
 
     /// Recoverable composition problems (a missing reference, payload or sublayer).
@@ -104,51 +90,51 @@ impl Stage {
     /// Every active, loaded, defined, non-abstract prim, depth first, including the
     /// contents of instanceable prims (as instance proxies).
     /// A namespace deeper than [`MAX_DEPTH`] is an error naming the first such prim.
-    pub fn prims(&self) -> Result<Vec<String>> {
+    pub fn prims(&self) -> Result<Vec<PrimPath>> {
         let mut out = Vec::new();
-        self.inner.traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| out.push(p.as_str().to_string())).map_err(err)?;
+        self.inner.traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| out.push(PrimPath(p.clone()))).map_err(err)?;
         check_depth(&out)?;
         Ok(out)
     }
 
     /// Every composed prim, defined or not (`over`s, classes, inactive), without
     /// instance proxies: Pixar's `TraverseAll`.
-    pub fn all_prims(&self) -> Result<Vec<String>> {
+    pub fn all_prims(&self) -> Result<Vec<PrimPath>> {
         let mut out = Vec::new();
-        self.inner.traverse(usd::PrimPredicate::ALL, |p| out.push(p.as_str().to_string())).map_err(err)?;
+        self.inner.traverse(usd::PrimPredicate::ALL, |p| out.push(PrimPath(p.clone()))).map_err(err)?;
         Ok(out)
     }
 
     /// The prim's type name (empty for a typeless prim).
-    pub fn type_name(&self, prim: &str) -> Result<String> {
+    pub fn type_name(&self, prim: &(impl PrimRef + ?Sized)) -> Result<String> {
         let t = self.inner.prim(self.path(prim)?).type_name().map_err(err)?;
         Ok(t.map(|t| t.as_str().to_string()).unwrap_or_default())
     }
 
     /// The paths of the prim's children, in order.
-    pub fn children(&self, prim: &str) -> Result<Vec<String>> {
+    pub fn children(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Vec<PrimPath>> {
         let children = self.inner.prim(self.path(prim)?).children().map_err(err)?;
-        Ok(children.iter().map(|c| c.path().as_str().to_string()).collect())
+        Ok(children.iter().map(|c| PrimPath(c.path().clone())).collect())
     }
 
     /// True for an instanceable prim's instance.
-    pub fn is_instance(&self, prim: &str) -> Result<bool> {
+    pub fn is_instance(&self, prim: &(impl PrimRef + ?Sized)) -> Result<bool> {
         self.inner.prim(self.path(prim)?).is_instance().map_err(err)
     }
 
     /// True for a prim inside an instance (a proxy of the prototype's prim).
-    pub fn is_instance_proxy(&self, prim: &str) -> Result<bool> {
+    pub fn is_instance_proxy(&self, prim: &(impl PrimRef + ?Sized)) -> Result<bool> {
         self.inner.prim(self.path(prim)?).is_instance_proxy().map_err(err)
     }
 
     /// The prim's applied API schemas (`apiSchemas`).
-    pub fn applied_schemas(&self, prim: &str) -> Result<Vec<String>> {
+    pub fn applied_schemas(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Vec<String>> {
         let s = self.inner.prim(self.path(prim)?).api_schemas().map_err(err)?;
         Ok(s.iter().map(|t| t.as_str().to_string()).collect())
     }
 
     /// Names of the prim's properties.
-    pub fn property_names(&self, prim: &str) -> Result<Vec<String>> {
+    pub fn property_names(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Vec<String>> {
         let names = self.inner.prim(self.path(prim)?).property_names().map_err(err)?;
         Ok(names.iter().map(|t| t.as_str().to_string()).collect())
     }
@@ -158,18 +144,22 @@ impl Stage {
     /// unauthored (`doubleSided`, `visibility`, `purpose`, a mesh's optional arrays):
     /// the prim's names are composed once and an absent attribute costs no value
     /// resolution. Only the last prim's names are kept.
-    fn authors(&self, prim: &str, name: &str) -> Result<bool> {
+    fn authors(&self, prim: &(impl PrimRef + ?Sized), name: &str) -> Result<bool> {
+        let prim = prim.prim_path()?;
         let mut memo = self.properties.borrow_mut();
-        if memo.0 != prim {
-            let names = self.inner.prim(self.path(prim)?).property_names().map_err(err)?;
-            *memo = (prim.to_string(), names);
-        }
-        Ok(memo.1.iter().any(|n| n.as_str() == name))
+        let names = match memo.as_ref() {
+            Some((known, names)) if *known == prim => names,
+            _ => {
+                let names = self.inner.prim(prim.0.clone()).property_names().map_err(err)?;
+                &memo.insert((prim, names)).1
+            }
+        };
+        Ok(names.iter().any(|n| n.as_str() == name))
     }
 
     /// The composed value of `prim.attr` at the stage's start time (time samples
     /// interpolated), or its default; `None` when unauthored.
-    pub fn value(&self, prim: &str, attr: &str) -> Result<Option<Value>> {
+    pub fn value(&self, prim: &(impl PrimRef + ?Sized), attr: &str) -> Result<Option<Value>> {
         if !self.authors(prim, attr)? {
             return Ok(None);
         }
@@ -183,7 +173,7 @@ impl Stage {
     }
 
     /// A metadata field of an attribute (`interpolation`, `elementSize`).
-    pub fn attr_metadata(&self, prim: &str, attr: &str, key: &str) -> Result<Option<Value>> {
+    pub fn attr_metadata(&self, prim: &(impl PrimRef + ?Sized), attr: &str, key: &str) -> Result<Option<Value>> {
         if !self.authors(prim, attr)? {
             return Ok(None);
         }
@@ -192,16 +182,16 @@ impl Stage {
     }
 
     /// Targets of a relationship, as paths.
-    pub fn targets(&self, prim: &str, rel: &str) -> Result<Vec<String>> {
+    pub fn targets(&self, prim: &(impl PrimRef + ?Sized), rel: &str) -> Result<Vec<PrimPath>> {
         if !self.authors(prim, rel)? {
             return Ok(Vec::new());
         }
         let r = self.inner.prim(self.path(prim)?).relationship(rel);
-        Ok(r.targets().map_err(err)?.iter().map(|p| p.as_str().to_string()).collect())
+        Ok(r.targets().map_err(err)?.into_iter().map(PrimPath).collect())
     }
 
     /// The composed `xformOpOrder` (list edits applied), or `None` when unauthored.
-    pub fn xform_op_order(&self, prim: &str) -> Result<Option<Vec<String>>> {
+    pub fn xform_op_order(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Option<Vec<String>>> {
         if !self.authors(prim, "xformOpOrder")? {
             return Ok(None);
         }
@@ -209,21 +199,21 @@ impl Stage {
     }
 
     /// True when the prim or an ancestor is `invisible`.
-    pub fn is_invisible(&self, prim: &str) -> Result<bool> {
+    pub fn is_invisible(&self, prim: &(impl PrimRef + ?Sized)) -> Result<bool> {
         let x = AnyXformable(self.inner.prim(self.path(prim)?));
         Ok(x.compute_visibility().map_err(err)? == openusd::schemas::geom::Visibility::Invisible)
     }
 
     /// Whether the prim itself authors `visibility = invisible` (its default value, as
     /// UsdGeomImageable's ComputeVisibility reads it).
-    pub fn authored_invisible(&self, prim: &str) -> Result<bool> {
+    pub fn authored_invisible(&self, prim: &(impl PrimRef + ?Sized)) -> Result<bool> {
         let v = self.attr_metadata(prim, "visibility", "default")?;
         Ok(matches!(v, Some(Value::Token(t)) if t == "invisible"))
     }
 
     /// The purpose the prim itself authors, if any (an unknown token reads as
     /// `default`, as ComputePurpose does).
-    pub fn authored_purpose(&self, prim: &str) -> Result<Option<&'static str>> {
+    pub fn authored_purpose(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Option<&'static str>> {
         let v = self.attr_metadata(prim, "purpose", "default")?;
         Ok(v.map(|v| match v.token() {
             Some("render") => "render",
@@ -234,7 +224,7 @@ impl Stage {
     }
 
     /// The computed purpose token (`default`, `render`, `proxy`, `guide`).
-    pub fn purpose(&self, prim: &str) -> Result<String> {
+    pub fn purpose(&self, prim: &(impl PrimRef + ?Sized)) -> Result<String> {
         let x = AnyXformable(self.inner.prim(self.path(prim)?));
         Ok(x.compute_purpose().map_err(err)?.as_token().to_string())
     }
@@ -252,13 +242,9 @@ impl Stage {
 /// (each path is as long as its depth).
 pub const MAX_DEPTH: usize = openusd::usda::parser::MAX_NAMESPACE_DEPTH;
 
-fn check_depth(prims: &[String]) -> Result<()> {
-    let too_deep = prims.iter().find(|p| p.bytes().filter(|&b| b == b'/').count() > MAX_DEPTH);
-    match too_deep {
-        Some(p) => {
-            let cut = p.match_indices('/').nth(3).map_or(p.len(), |(i, _)| i);
-            Err(format!("{}/…: namespace deeper than {MAX_DEPTH} levels", &p[..cut]))
-        }
+fn check_depth(prims: &[PrimPath]) -> Result<()> {
+    match prims.iter().find(|p| p.depth() > MAX_DEPTH) {
+        Some(p) => Err(format!("{}/…: namespace deeper than {MAX_DEPTH} levels", p.ancestor_at(3))),
         None => Ok(()),
     }
 }

@@ -1,7 +1,7 @@
 //! Material bindings and UsdPreviewSurface networks: which material a prim is bound to, its
 //! surface shader, and each input's value or the UsdUVTexture it is connected to.
 
-use super::{Result, Stage, Value, convert, err, path};
+use super::{PrimPath, PrimRef, Result, Stage, Value, convert, err, path};
 use openusd::schemas::shade::{self, MaterialBindingAPI};
 use openusd::sdf;
 
@@ -75,7 +75,7 @@ impl Stage {
     /// (the topmost such wins). openusd 0.6 reads `bindMaterialAs` only when it is a token,
     /// which a usda file's string is not, so direct bindings are resolved here; chains with
     /// collection bindings go through openusd's resolver.
-    pub fn bound_material(&self, prim: &str) -> Result<Option<String>> {
+    pub fn bound_material(&self, prim: &(impl PrimRef + ?Sized)) -> Result<Option<String>> {
         let mut chain = Vec::new();
         let mut p = Some(self.path(prim)?);
         while let Some(here) = p {
@@ -102,12 +102,12 @@ impl Stage {
                 Some(api) => api.compute_bound_material("full").map_err(|e| format!("{prim}: {}", err(e)))?,
                 None => None,
             };
-            return Ok(m.map(|p| p.as_str().to_string()));
+            return Ok(m.map(|p| p.to_string()));
         }
         for rel in ["material:binding:full", "material:binding"] {
             let mut winner = None;
             for here in &with_api {
-                let Some(target) = self.targets(here.as_str(), rel)?.into_iter().next() else { continue };
+                let Some(target) = self.targets(&PrimPath(here.clone()), rel)?.into_iter().next() else { continue };
                 let rel_path = here.append_property(rel).map_err(err)?;
                 let strength = self.inner.attribute(rel_path).get_metadata::<sdf::Value>("bindMaterialAs");
                 let stronger = match strength.map_err(err)?.map(convert) {
@@ -115,7 +115,7 @@ impl Stage {
                     _ => false,
                 };
                 if winner.is_none() || stronger {
-                    winner = Some(target);
+                    winner = Some(target.to_string());
                 }
             }
             if winner.is_some() {
@@ -129,12 +129,12 @@ impl Stage {
     /// Whether the prim applies MaterialBindingAPI; memoised for `ancestor`s, which
     /// every prim below them asks about again (once per prim, not per prim and level).
     fn applies_binding_api(&self, prim: &sdf::Path, ancestor: bool) -> Result<bool> {
-        if let Some(&known) = self.binding_api.borrow().get(prim.as_str()) {
+        if let Some(&known) = self.binding_api.borrow().get(prim) {
             return Ok(known);
         }
         let applies = MaterialBindingAPI::get(&self.inner, prim.clone()).map_err(err)?.is_some();
         if ancestor {
-            self.binding_api.borrow_mut().insert(prim.as_str().to_string(), applies);
+            self.binding_api.borrow_mut().insert(prim.clone(), applies);
         }
         Ok(applies)
     }
@@ -190,7 +190,7 @@ impl Stage {
 
     /// The attribute a connection of `prim.attr` points at, following interface
     /// connections (NodeGraph / Material inputs) to the end; `None` when unconnected.
-    fn connection(&self, prim: &str, attr: &str) -> Result<Option<sdf::Path>> {
+    fn connection(&self, prim: &(impl PrimRef + ?Sized), attr: &str) -> Result<Option<sdf::Path>> {
         let mut current = self.path(prim)?.append_property(attr).map_err(err)?;
         let mut connected = None;
         for _ in 0..16 {
@@ -208,7 +208,7 @@ impl Stage {
 
     /// The value of `prim.attr`, or of the attribute its connections end at (an interface
     /// input of a Material or NodeGraph).
-    fn connected_value(&self, prim: &str, attr: &str) -> Result<Option<Value>> {
+    fn connected_value(&self, prim: &(impl PrimRef + ?Sized), attr: &str) -> Result<Option<Value>> {
         match self.connection(prim, attr)? {
             Some(p) => Ok(self.inner.attribute(p).get::<sdf::Value>().map_err(err)?.map(convert)),
             None => self.value(prim, attr),

@@ -675,7 +675,7 @@ impl IndexCache {
         };
 
         for node in index.nodes() {
-            let query_path = Path::from_parts(&[node.path.as_str(), suffix]);
+            let query_path = node.path.with_suffix(suffix);
             for &(layer, _) in graph.layer_stack(node.layer_stack_id()).iter() {
                 if !local_layers.contains(&layer) {
                     continue;

@@ -388,7 +388,7 @@ impl PrimIndex {
     /// Borrows the node's path when no suffix is needed (zero-copy).
     fn query_path<'a>(node: &'a Node, prop_suffix: Option<&str>) -> Result<Cow<'a, Path>> {
         match prop_suffix {
-            Some(suffix) => Ok(Cow::Owned(Path::from_parts(&[node.path.as_str(), suffix]))),
+            Some(suffix) => Ok(Cow::Owned(node.path.with_suffix(suffix))),
             None => Ok(Cow::Borrowed(&node.path)),
         }
     }

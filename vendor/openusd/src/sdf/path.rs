@@ -1,5 +1,10 @@
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
+
+mod intern;
+mod node;
+mod prefix;
+use node::Kind;
 use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};
@@ -28,58 +33,53 @@ fn is_prim_name_char(c: char) -> bool {
 /// - Brackets ("[" and "]") are used to indicate relationship target paths for
 ///   relational attributes.
 ///
-/// The text is shared (`Arc<str>`) and its hash computed once when the path is
-/// made: paths are cloned into and looked up in many maps (specs, prim indices,
-/// dependencies), and a prim's path is as long as its depth, so copying or
-/// hashing the text per use makes deep namespaces quadratic.
+/// A path is a node of a tree (`node.rs`): its parent and the element it adds, with
+/// the hash of the whole chain computed when it is made. Paths are cloned into and
+/// looked up in many maps (specs, prim indices, dependencies), and a prim's path is as
+/// long as its depth; as a tree, a path shares its ancestors, and taking its parent or
+/// prim path, appending to it, and testing or replacing a prefix cost the elements
+/// involved, not its text. The text is made on demand ([`Path::as_str`] keeps it).
+/// The hash is also kept beside the node pointer, so that hashing a path and telling two
+/// apart, what path-keyed maps do most, read no node.
 #[derive(Clone)]
 pub struct Path {
-    path: Arc<str>,
+    node: Arc<node::Node>,
     hash: u64,
 }
 
 impl Path {
     fn from_string(text: String) -> Path {
-        Path::from_str_unchecked(&text)
+        Path::parse(&text)
     }
 
-    /// The path whose text is `parts` in a row. Short texts are put together on
-    /// the stack, so the path's own allocation is the only one.
-    pub(crate) fn from_parts(parts: &[&str]) -> Path {
-        const STACK: usize = 256;
-        let len: usize = parts.iter().map(|p| p.len()).sum();
-        if len > STACK {
-            return Path::from_string(parts.concat());
+    /// This path with `suffix` (empty, or a property path's suffix such as
+    /// `.points`) appended: a property of the same name under another namespace.
+    pub(crate) fn with_suffix(&self, suffix: &str) -> Path {
+        if suffix.is_empty() {
+            return self.clone();
         }
-        let mut buf = [0u8; STACK];
-        let mut at = 0;
-        for part in parts {
-            buf[at..at + part.len()].copy_from_slice(part.as_bytes());
-            at += part.len();
+        if let Some(p) = suffix.strip_prefix('.').and_then(|name| self.child_property(name)) {
+            return p;
         }
-        match std::str::from_utf8(&buf[..len]) {
-            Ok(text) => Path::from_str_unchecked(text),
-            // Unreachable: a concatenation of `str`s is UTF-8.
-            Err(_) => Path::from_string(parts.concat()),
-        }
+        Path::parse(&[self.as_str(), suffix].concat())
     }
 }
 
 impl Default for Path {
     fn default() -> Self {
-        Path::from_str_unchecked("")
+        Path::empty()
     }
 }
 
 impl fmt::Debug for Path {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Path").field("path", &&*self.path).finish()
+        f.debug_struct("Path").field("path", &self.to_string()).finish()
     }
 }
 
 impl PartialEq for Path {
     fn eq(&self, other: &Self) -> bool {
-        self.hash == other.hash && (Arc::ptr_eq(&self.path, &other.path) || self.path == other.path)
+        self.same(other)
     }
 }
 
@@ -92,27 +92,34 @@ impl PartialOrd for Path {
 }
 
 impl Ord for Path {
+    /// The order of the texts.
     fn cmp(&self, other: &Self) -> cmp::Ordering {
-        self.path.cmp(&other.path)
+        self.text_cmp(other)
     }
 }
 
 impl Hash for Path {
     fn hash<H: Hasher>(&self, state: &mut H) {
-        state.write_u64(self.hash);
+        state.write_u64(self.hash_value());
     }
 }
 
 impl fmt::Display for Path {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.path)
+        let mut result = Ok(());
+        self.for_each_piece(|piece| {
+            if result.is_ok() {
+                result = f.write_str(piece);
+            }
+        });
+        result
     }
 }
 
 #[cfg(feature = "serde")]
 impl serde::Serialize for Path {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        self.path.serialize(serializer)
+        self.to_string().serialize(serializer)
     }
 }
 
@@ -120,7 +127,7 @@ impl FromStr for Path {
     type Err = anyhow::Error;
 
     fn from_str(s: &str) -> result::Result<Path, Self::Err> {
-        Ok(Path::from_str_unchecked(s))
+        Ok(Path::parse(s))
     }
 }
 
@@ -132,29 +139,26 @@ impl Path {
     /// The absolute root `/`, shared: it is made for many comparisons.
     #[inline]
     pub fn abs_root() -> Path {
-        static ROOT: std::sync::LazyLock<Path> = std::sync::LazyLock::new(|| Path::from_str_unchecked("/"));
-        ROOT.clone()
+        Path::root()
     }
 
     fn from_str_unchecked(path: &str) -> Path {
-        // A fixed-key SipHash, so equal texts hash equal in every map and process.
-        let mut hasher = std::hash::DefaultHasher::new();
-        path.hash(&mut hasher);
-        Path {
-            path: Arc::from(path),
-            hash: hasher.finish(),
-        }
+        Path::parse(path)
     }
 
     #[inline]
     pub fn is_abs(&self) -> bool {
-        self.path.starts_with('/')
+        match self.kind() {
+            Kind::Empty => false,
+            Kind::Text => self.as_str().starts_with('/'),
+            _ => true,
+        }
     }
 
     /// Returns `true` if this is the absolute root path `/` (pseudo-root).
     #[inline]
     pub fn is_abs_root(&self) -> bool {
-        &*self.path == "/"
+        self.kind() == Kind::Root
     }
 
     /// Whether this path's prim is a root prim — a direct child of the
@@ -167,7 +171,7 @@ impl Path {
 
     #[inline]
     pub fn is_empty(&self) -> bool {
-        self.path.is_empty()
+        self.kind() == Kind::Empty
     }
 
     pub fn append_property(&self, property: impl AsRef<str>) -> Result<Path> {
@@ -177,11 +181,17 @@ impl Path {
         ensure!(!self.is_property_path(), "Cannot append property to property path");
         ensure!(property != ".", "Property name cannot be '.'");
 
-        Ok(Path::from_parts(&[self.as_str(), ".", property]))
+        Ok(self.child_property(property).unwrap_or_else(|| Path::parse(&[self.as_str(), ".", property].concat())))
     }
 
-    pub fn append_path(&self, path: impl Into<Path>) -> Result<Path> {
-        let append: Path = path.into();
+    pub fn append_path<'a>(&self, path: impl Into<PathArg<'a>>) -> Result<Path> {
+        let append = match path.into() {
+            PathArg::Text(name) => match self.child_prim(name) {
+                Some(child) => return Ok(child),
+                None => Path::parse(name),
+            },
+            PathArg::Path(path) => path,
+        };
 
         if self.is_abs() && append.is_abs() {
             bail!("Cannot append absolute path to absolute path");
@@ -189,6 +199,11 @@ impl Path {
 
         ensure!(!self.is_property_path(), "Cannot append path to property path");
 
+        if append.kind() == Kind::Text {
+            if let Some(child) = self.child_prim(append.as_str()) {
+                return Ok(child);
+            }
+        }
         if append.as_str() == "." {
             return Ok(self.clone());
         }
@@ -196,20 +211,23 @@ impl Path {
         // If base is slash only.
         // "/" + "foo/bar" => "/foo/bar"
         let combined = if self.as_str() == "/" {
-            Path::from_parts(&["/", append.as_str()])
+            Path::parse(&["/", append.as_str()].concat())
         } else if self.is_prim_variant_selection_path() {
             // A prim child attaches directly to a variant selection with no
             // separator: "/A{v=s}" + "B" => "/A{v=s}B" (C++ SdfPath::AppendChild).
-            Path::from_parts(&[self.as_str(), append.as_str()])
+            Path::parse(&[self.as_str(), append.as_str()].concat())
         } else {
-            Path::from_parts(&[self.as_str(), "/", append.as_str()])
+            Path::parse(&[self.as_str(), "/", append.as_str()].concat())
         };
 
         Ok(combined)
     }
 
     pub fn is_property_path(&self) -> bool {
-        let pos = match self.path.rfind('.') {
+        if self.is_structured() {
+            return self.kind() == Kind::Property;
+        }
+        let pos = match self.as_str().rfind('.') {
             Some(index) => index,
             // No dot, not a property path
             None => return false,
@@ -219,7 +237,7 @@ impl Path {
         // selection closing brace or another dot) and followed by a valid
         // property name. Property names may contain alphanumerics, underscores,
         // and colons (for namespaced properties like `primvars:displayColor`).
-        let tail = &self.path[pos + 1..];
+        let tail = &self.as_str()[pos + 1..];
         !tail.is_empty() && tail.chars().all(|c| c.is_alphanumeric() || c == '_' || c == ':')
     }
 
@@ -230,7 +248,10 @@ impl Path {
     /// path identifies a variant spec, not a prim, so it is not a valid target
     /// for prim authoring.
     pub fn is_prim_variant_selection_path(&self) -> bool {
-        self.path.ends_with('}')
+        match self.kind() {
+            Kind::Text => self.as_str().ends_with('}'),
+            kind => kind == Kind::Variant,
+        }
     }
 
     /// Returns the variant set name of the deepest `{set=sel}` (or `{set=}`)
@@ -238,6 +259,16 @@ impl Path {
     /// variant-set path `/Prim{set=}`. `None` when the path carries no variant
     /// selection.
     pub fn variant_set_name(&self) -> Option<&str> {
+        if self.is_structured() {
+            let mut at = Some(self);
+            while let Some(p) = at {
+                if p.kind() == Kind::Variant {
+                    return p.node.seg[1..].split_once('=').map(|(set, _)| set);
+                }
+                at = p.node.parent.as_ref();
+            }
+            return None;
+        }
         self.components()
             .filter_map(|component| match component {
                 PathComponent::Variant { set, .. } => Some(set),
@@ -261,8 +292,11 @@ impl Path {
         // In a well-formed path a `{` outside a target bracket can only open a
         // `{set=sel}` segment, so a depth-0 scan decides without parsing
         // components (which relative `..` prefixes would stop short).
+        if self.is_structured() {
+            return self.node.variants;
+        }
         let mut depth = 0usize;
-        for byte in self.path.bytes() {
+        for byte in self.as_str().bytes() {
             match byte {
                 b'[' => depth += 1,
                 b']' => depth = depth.saturating_sub(1),
@@ -274,20 +308,25 @@ impl Path {
     }
 
     pub fn prim_path(&self) -> Path {
+        match self.kind() {
+            Kind::Property | Kind::Variant => return self.node.parent.clone().unwrap_or_default(),
+            Kind::Text => {}
+            _ => return self.clone(),
+        }
         // Split at last slash.
         // "/A/B/C.foo[target].bar:baz" will become "/A/B" and "C.foo[target].bar:baz"
-        let Some((before, after)) = self.path.rsplit_once('/') else {
+        let Some((before, after)) = self.as_str().rsplit_once('/') else {
             // Relative single segment (no slash): strip a trailing property or
             // variant selection. `is_property_path` separates `Foo.bar` from a
             // relative `..`, which has no property tail and is its own prim.
             if self.is_property_path() {
-                if let Some(dot) = self.path.find('.') {
-                    return Path::from_str_unchecked(&self.path[..dot]);
+                if let Some(dot) = self.as_str().find('.') {
+                    return Path::from_str_unchecked(&self.as_str()[..dot]);
                 }
             }
-            if self.path.ends_with('}') {
-                if let Some(open) = self.path.rfind('{') {
-                    return Path::from_str_unchecked(&self.path[..open]);
+            if self.as_str().ends_with('}') {
+                if let Some(open) = self.as_str().rfind('{') {
+                    return Path::from_str_unchecked(&self.as_str()[..open]);
                 }
             }
             return self.clone();
@@ -304,7 +343,7 @@ impl Path {
         if after.ends_with('}') {
             if let Some(pos) = after.rfind('{') {
                 let sz = before.len() + pos + 1;
-                return Path::from_str_unchecked(&self.path[..sz]);
+                return Path::from_str_unchecked(&self.as_str()[..sz]);
             }
         }
 
@@ -316,7 +355,7 @@ impl Path {
 
         // Return everything up to the first dot
         let sz = before.len() + first_dot + 1;
-        Path::from_str_unchecked(&self.path[..sz])
+        Path::from_str_unchecked(&self.as_str()[..sz])
     }
 
     /// Returns the property portion of this path — the trailing segment after
@@ -324,7 +363,11 @@ impl Path {
     /// `.foo[/T].bar` for a target/namespaced property). Empty for a prim
     /// (non-property) path.
     pub fn property_suffix(&self) -> &str {
-        &self.path[self.prim_path().as_str().len()..]
+        match self.kind() {
+            Kind::Property => &self.node.seg,
+            Kind::Variant | Kind::Text => &self.as_str()[self.prim_path().node.len..],
+            _ => "",
+        }
     }
 
     /// Splits a property path into its owning prim and the property name (the
@@ -341,11 +384,14 @@ impl Path {
     /// "/World/Mesh"          -> None
     /// ```
     pub fn split_property(&self) -> Option<(Path, &str)> {
+        if self.kind() == Kind::Property {
+            return Some((self.prim_path(), &self.node.seg[1..]));
+        }
         if !self.is_property_path() {
             return None;
         }
         let prim = self.prim_path();
-        let name = self.path[prim.as_str().len()..].strip_prefix('.')?;
+        let name = self.as_str()[prim.as_str().len()..].strip_prefix('.')?;
         Some((prim, name))
     }
 
@@ -364,7 +410,7 @@ impl Path {
     /// `.mapper[..]`) is left untouched.
     pub fn embedded_target_path(&self) -> Option<Path> {
         let (open, close) = self.target_brackets()?;
-        Some(Path::from_str_unchecked(&self.path[open + 1..close]))
+        Some(Path::from_str_unchecked(&self.as_str()[open + 1..close]))
     }
 
     /// Returns this path with the target path in its first `[..]` bracket
@@ -372,10 +418,10 @@ impl Path {
     /// inverse of [`embedded_target_path`](Self::embedded_target_path).
     pub fn replace_embedded_target(&self, new_target: &Path) -> Option<Path> {
         let (open, close) = self.target_brackets()?;
-        let mut replaced = String::with_capacity(self.path.len() + new_target.as_str().len());
-        replaced.push_str(&self.path[..=open]);
+        let mut replaced = String::with_capacity(self.as_str().len() + new_target.as_str().len());
+        replaced.push_str(&self.as_str()[..=open]);
         replaced.push_str(new_target.as_str());
-        replaced.push_str(&self.path[close..]);
+        replaced.push_str(&self.as_str()[close..]);
         Some(Path::from_str_unchecked(&replaced))
     }
 
@@ -383,9 +429,12 @@ impl Path {
     /// when there is no bracket or it is unclosed. Nested brackets are tracked by
     /// depth so a target carrying its own `[..]` is matched whole.
     fn target_brackets(&self) -> Option<(usize, usize)> {
-        let open = self.path.find('[')?;
+        if self.is_structured() {
+            return None;
+        }
+        let open = self.as_str().find('[')?;
         let mut depth = 0u32;
-        for (i, byte) in self.path.bytes().enumerate().skip(open) {
+        for (i, byte) in self.as_str().bytes().enumerate().skip(open) {
             match byte {
                 b'[' => depth += 1,
                 b']' => {
@@ -412,7 +461,18 @@ impl Path {
     /// "/A{set=sel}"   -> Some(Variant { set: "set", selection: "sel" })
     /// ```
     pub fn last_element(&self) -> Option<PathElement<'_>> {
-        if self.path.is_empty() || &*self.path == "/" {
+        let seg = &*self.node.seg;
+        match self.kind() {
+            Kind::Empty | Kind::Root => return None,
+            Kind::Prim => return Some(PathElement::Prim(seg)),
+            Kind::Property => return Some(PathElement::Property(&seg[1..])),
+            Kind::Variant => {
+                let (set, selection) = seg[1..seg.len() - 1].split_once('=')?;
+                return Some(PathElement::Variant { set, selection });
+            }
+            Kind::Text => {}
+        }
+        if self.as_str().is_empty() || self.as_str() == "/" {
             return None;
         }
         // A property's element is the whole property name (everything after
@@ -453,13 +513,16 @@ impl Path {
     /// ""            -> None
     /// ```
     pub fn parent(&self) -> Option<Path> {
-        if self.path.is_empty() || &*self.path == "/" {
+        if self.is_structured() {
+            return self.node.parent.clone();
+        }
+        if self.as_str().is_empty() || self.as_str() == "/" {
             return None;
         }
         // Drop a trailing `{set=sel}` variant selection.
         if self.is_prim_variant_selection_path() {
-            if let Some(open) = self.path.rfind('{') {
-                return Some(Path::from_str_unchecked(&self.path[..open]));
+            if let Some(open) = self.as_str().rfind('{') {
+                return Some(Path::from_str_unchecked(&self.as_str()[..open]));
             }
         }
         if self.is_property_path() {
@@ -468,16 +531,16 @@ impl Path {
         // Prim path: drop the final prim name. It is introduced either by a `/`
         // (a child of another prim) or directly by a `}` (a child of a variant
         // selection, `/A{v=s}B`), whichever is rightmost.
-        match self.path.rfind(['/', '}']) {
+        match self.as_str().rfind(['/', '}']) {
             // Child of a variant selection: keep up to and including the `}`. (ppis patch: a
             // path ending in a stray `}` has no such parent — it would be the path itself, and
             // every ancestor walk would loop; see PATCHED.md.)
-            Some(i) if self.path.as_bytes()[i] == b'}' => {
-                (i + 1 < self.path.len()).then(|| Path::from_str_unchecked(&self.path[..i + 1]))
+            Some(i) if self.as_str().as_bytes()[i] == b'}' => {
+                (i + 1 < self.as_str().len()).then(|| Path::from_str_unchecked(&self.as_str()[..i + 1]))
             }
             Some(0) => Some(Path::abs_root()),
             // Child of another prim: drop the `/` and the name.
-            Some(i) => Some(Path::from_str_unchecked(&self.path[..i])),
+            Some(i) => Some(Path::from_str_unchecked(&self.as_str()[..i])),
             None => None,
         }
     }
@@ -520,18 +583,21 @@ impl Path {
     /// ""       -> None
     /// ```
     pub fn name(&self) -> Option<&str> {
-        if self.path.is_empty() || &*self.path == "/" {
+        if self.kind() == Kind::Prim {
+            return Some(&self.node.seg);
+        }
+        if self.as_str().is_empty() || self.as_str() == "/" {
             return None;
         }
         // The final prim name begins after the rightmost `/` or `}` (a child of
         // a variant selection attaches directly, `/A{v=s}B`). A path that *ends*
         // in a variant selection (`/A{v=s}`) has no prim after the `}`, so its
         // final component is the prim-plus-selection segment after the last `/`.
-        let start = self.path.rfind(['/', '}']).map_or(0, |i| i + 1);
-        if start < self.path.len() {
-            Some(&self.path[start..])
+        let start = self.as_str().rfind(['/', '}']).map_or(0, |i| i + 1);
+        if start < self.as_str().len() {
+            Some(&self.as_str()[start..])
         } else {
-            Some(self.path.rsplit_once('/').map_or(self.as_str(), |(_, name)| name))
+            Some(self.as_str().rsplit_once('/').map_or(self.as_str(), |(_, name)| name))
         }
     }
 
@@ -556,7 +622,7 @@ impl Path {
     /// ```
     pub fn components(&self) -> PathComponents<'_> {
         PathComponents {
-            rest: self.path.strip_prefix('/').unwrap_or(&self.path),
+            rest: self.as_str().strip_prefix('/').unwrap_or(&self.as_str()),
             expect_slash: false,
             emitted: false,
         }
@@ -575,6 +641,9 @@ impl Path {
     /// "/"        -> 0
     /// ```
     pub fn prim_element_count(&self) -> usize {
+        if self.is_structured() {
+            return self.node.prims as usize;
+        }
         self.components()
             .filter(|c| matches!(c, PathComponent::Prim(_)))
             .count()
@@ -587,6 +656,9 @@ impl Path {
     /// prim names, a variant selection counts as its own element here, so
     /// `/A{x=y}B` is 3.
     pub fn element_count(&self) -> usize {
+        if self.is_structured() {
+            return self.node.elems as usize;
+        }
         self.components().count()
     }
 
@@ -600,10 +672,13 @@ impl Path {
     /// path and is left in place, as in C++, where target components are data
     /// on a path node rather than part of the outer prim chain.
     pub fn strip_all_variant_selections(&self) -> Path {
+        if let Some(p) = self.strip_variants_nodes() {
+            return p;
+        }
         if !self.contains_prim_variant_selection() {
             return self.clone();
         }
-        let mut out = String::with_capacity(self.path.len());
+        let mut out = String::with_capacity(self.as_str().len());
         let mut rest = self.as_str();
         let mut depth = 0usize;
         let mut chars = rest.char_indices();
@@ -654,6 +729,9 @@ impl Path {
     /// "/X".has_prefix("/")          -> true
     /// ```
     pub fn has_prefix(&self, prefix: &Path) -> bool {
+        if let Some(answer) = self.has_prefix_node(prefix) {
+            return answer;
+        }
         let old = prefix.as_str();
         let me = self.as_str();
         if me == old {
@@ -690,6 +768,9 @@ impl Path {
     /// "/Other".replace_prefix("/Ref", "/MyPrim")     -> None
     /// ```
     pub fn replace_prefix(&self, old_prefix: &Path, new_prefix: &Path) -> Option<Path> {
+        if let Some(answer) = self.replace_prefix_nodes(old_prefix, new_prefix) {
+            return answer;
+        }
         let old = old_prefix.as_str();
         let me = self.as_str();
 
@@ -754,7 +835,10 @@ impl Path {
     /// Appends a variant selection to a prim path, producing a path like
     /// `/MyPrim{variantSet=selection}`.
     pub fn append_variant_selection(&self, set: impl AsRef<str>, selection: impl AsRef<str>) -> Path {
-        Path::from_str_unchecked(&format!("{}{{{}={}}}", self.path, set.as_ref(), selection.as_ref()))
+        if let Some(p) = self.child_variant(set.as_ref(), selection.as_ref()) {
+            return p;
+        }
+        Path::from_str_unchecked(&format!("{}{{{}={}}}", self.as_str(), set.as_ref(), selection.as_ref()))
     }
 
     /// Appends a raw variant segment (e.g. `{set=sel}`) directly to this path.
@@ -763,7 +847,11 @@ impl Path {
     /// attach directly to the prim path to produce canonical forms like
     /// `/Prim{set=sel}`.
     pub fn append_variant_segment(&self, segment: &str) -> Path {
-        Path::from_str_unchecked(&format!("{}{segment}", self.path))
+        let variant = segment.strip_prefix('{').and_then(|s| s.strip_suffix('}'));
+        if let Some(p) = variant.and_then(|v| v.split_once('=')).and_then(|(set, sel)| self.child_variant(set, sel)) {
+            return p;
+        }
+        Path::from_str_unchecked(&format!("{}{segment}", self.as_str()))
     }
 
     /// Resolve a relative path against this path as anchor.
@@ -810,9 +898,11 @@ impl Path {
         Path::from_str_unchecked(&format!("{anchor}{sep}{rest}"))
     }
 
+    /// The path's text, made on the first call and kept with the path (`Display`
+    /// writes it piece by piece and keeps nothing).
     #[inline]
     pub fn as_str(&self) -> &str {
-        &self.path
+        self.text()
     }
 
     /// Validate identifier
@@ -940,6 +1030,43 @@ impl<'a> Iterator for PathComponents<'a> {
         self.expect_slash = true;
         self.emitted = true;
         Some(PathComponent::Prim(name))
+    }
+}
+
+/// What [`Path::append_path`] appends: a path, or its text. A text is most often a
+/// child's name, which then needs no path of its own.
+pub enum PathArg<'a> {
+    Text(&'a str),
+    Path(Path),
+}
+
+impl<'a> From<&'a str> for PathArg<'a> {
+    fn from(text: &'a str) -> Self {
+        PathArg::Text(text)
+    }
+}
+
+impl<'a> From<&'a String> for PathArg<'a> {
+    fn from(text: &'a String) -> Self {
+        PathArg::Text(text)
+    }
+}
+
+impl From<String> for PathArg<'_> {
+    fn from(text: String) -> Self {
+        PathArg::Path(Path::from(text))
+    }
+}
+
+impl From<Path> for PathArg<'_> {
+    fn from(path: Path) -> Self {
+        PathArg::Path(path)
+    }
+}
+
+impl From<&Path> for PathArg<'_> {
+    fn from(path: &Path) -> Self {
+        PathArg::Path(path.clone())
     }
 }
 
@@ -1253,7 +1380,7 @@ mod tests {
         let split = |s: &str| {
             Path::from_str_unchecked(s)
                 .split_property()
-                .map(|(p, n)| (p.path.to_string(), n.to_owned()))
+                .map(|(p, n)| (p.to_string(), n.to_owned()))
         };
         let owned = |p: &str, n: &str| Some((p.to_owned(), n.to_owned()));
 
