@@ -3,10 +3,13 @@
 # and 64 tiles in one process each, one after the other, all at one thread; per split the sum of
 # the processes' wall clocks, of their render_seconds and env_build_seconds (--stats-json), the
 # largest resident set (/usr/bin/time), and whether the merge is the frame byte for byte.
-# Usage: docs/farm_overhead.sh PPIS [SCENE] (SCENE: a JSON or USD file; default the built-in).
+# Usage: docs/farm_overhead.sh PPIS [SCENE [ARGS…]] (SCENE: a JSON or USD file, default the
+# built-in; ARGS go to every `ppis render` and `ppis tiles`, e.g. `--env SQUARE.exr
+# --env-rotate-y 30` for the environment cached by `ppis env`: give its path absolute).
 set -euo pipefail
 ppis="$(realpath "$1")"
 scene=(); if [ -n "${2:-}" ]; then scene=("$(realpath "$2")"); fi
+scene+=("${@:3}")
 frame=(--width 640 --height 360 --spp 8 --threads 1)
 dir="$(mktemp -d)"
 trap 'rm -rf "$dir"' EXIT

@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 mod args;
+mod env_cmd;
 mod info_cmd;
 mod load;
 mod merge_cmd;
@@ -13,6 +14,7 @@ mod report_cmd;
 mod stats;
 mod tiles_cmd;
 
+use env_cmd::{EnvArgs, env_command};
 use info_cmd::{InfoArgs, info_command};
 use merge_cmd::{MergeArgs, merge_command};
 use render_cmd::{RenderArgs, render_command};
@@ -45,6 +47,10 @@ enum Command {
     /// Assemble the tiles `ppis render --crop` wrote into the frame (EXR + PNG): the same bytes
     /// as the frame rendered in one process.
     Merge(MergeArgs),
+    /// Write the equal-area map `render --env` builds from a lat-long map, as a float32 EXR
+    /// square that `render --env` reads without resampling (the same pixels): built once for
+    /// all of a farm's tiles.
+    Env(EnvArgs),
 }
 
 /// The command line, or the one-line error (exit 2) a failure to parse it is; help and the
@@ -57,7 +63,7 @@ fn parse_command_line() -> Cli {
         Err(e) => {
             let line = match e.kind() {
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-                    "no command given: render, info, report, tiles or merge (see ppis --help)".to_string()
+                    "no command given: render, info, report, tiles, merge or env (see ppis --help)".to_string()
                 }
                 _ => {
                     let text = e.render().to_string();
@@ -85,6 +91,7 @@ fn main() {
         Command::Report(args) => report_command(args),
         Command::Tiles(args) => tiles_command(args),
         Command::Merge(args) => merge_command(args),
+        Command::Env(args) => env_command(args),
     };
     if let Err(e) = result {
         eprintln!("ppis: error: {e:#}");
