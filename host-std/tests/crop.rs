@@ -3,10 +3,12 @@
 //! whose pixels depend on the tile's earlier pixels through the product-MIS samplers they keep —
 //! and `auto`'s pilot decides from the whole frame whichever crop is rendered.
 
+mod common;
+
 use host_std::light::environment::Environment;
 use host_std::plan::{Method, Rendered, Settings, render, render_crop};
 use host_std::render::crop::Crop;
-use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, builtin};
+use host_std::scene::{Bsdf, builtin};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::RoughConductor;
 use sampler_core::glam::Vec3;
@@ -59,23 +61,7 @@ fn every_method_renders_a_crop_bit_for_bit_as_the_whole_frame() {
 #[test]
 fn autos_pilot_decides_from_the_whole_frame_whatever_the_crop() {
     // A glossy sphere filling a 96×96 view under the sky: large enough for the pilot to run.
-    let scene = Scene {
-        name: "pilot".into(),
-        camera: CameraSpec {
-            origin: Vec3::new(0.0, 0.0, 4.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 10.0,
-            width: 96,
-            height: 96,
-            pixel_aspect: 1.0,
-            near_clip: 1e-3,
-        },
-        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material::new(Bsdf::Conductor(RoughConductor::new(0.1, Vec3::ONE)), false)],
-        env: None,
-        hide_emitters: true,
-    };
+    let scene = common::pilot_sphere(Bsdf::Conductor(RoughConductor::new(0.1, Vec3::ONE)));
     let sky =
         Environment::build(&host_std::light::environment::EnvSource::Sky { level: 7 }, Default::default()).unwrap();
     let h = sky.hierarchy();

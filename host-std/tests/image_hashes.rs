@@ -12,11 +12,13 @@
 //! and replace [`EXPECTED`] with the table the failure prints, saying in the commit why the
 //! images changed.
 
+mod common;
+
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Rendered, Settings, render};
 use host_std::scene::builtin;
-use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::scene::{Bsdf, Scene};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
@@ -118,23 +120,7 @@ fn cases() -> Vec<(String, u64)> {
         out.push((format!("twins.json/{name}"), hash(&rendered(&twins, &map, &settings(method, 8, 2)))));
     }
     // `auto` with its pilot: one matte sphere filling a 96×96 view under the sky.
-    let sphere = Scene {
-        name: "pilot".into(),
-        camera: CameraSpec {
-            origin: Vec3::new(0.0, 0.0, 4.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 10.0,
-            width: 96,
-            height: 96,
-            pixel_aspect: 1.0,
-            near_clip: 1e-3,
-        },
-        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material::new(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), false)],
-        env: None,
-        hide_emitters: true,
-    };
+    let sphere = common::pilot_sphere(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))));
     let image = rendered(&sphere, &sky, &settings(Method::Auto, 16, 1));
     assert_eq!(image.pilot.len(), 1, "the pilot ran");
     out.push(("sphere/auto with pilot".into(), hash(&image)));

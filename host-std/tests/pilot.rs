@@ -3,36 +3,21 @@
 //! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
 //! matte studio where it measures twice as good as the rules' MIS.
 
+mod common;
+
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::Method;
 use host_std::plan::pilot;
 use host_std::plan::{Settings, render};
 use host_std::render::strategy::Strategy;
-use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
+use host_std::scene::{Bsdf, Material, Scene};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::{Lambert, RoughConductor};
 use sampler_core::glam::Vec3;
 
-/// One sphere filling a 96×96 view (about the smallest image whose pilot fits its share of a
-/// one-material render), of `bsdf`.
+/// One sphere filling a 96×96 view, of `bsdf`.
 fn sphere(bsdf: Bsdf) -> Scene {
-    Scene {
-        name: "pilot".into(),
-        camera: CameraSpec {
-            origin: Vec3::new(0.0, 0.0, 4.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 10.0,
-            width: 96,
-            height: 96,
-            pixel_aspect: 1.0,
-            near_clip: 1e-3,
-        },
-        objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
-        materials: vec![Material::new(bsdf, false)],
-        env: None,
-        hide_emitters: true,
-    }
+    common::pilot_sphere(bsdf)
 }
 
 /// The plan `auto` picks for the scene's one material at `spp` (16 per shading point).
