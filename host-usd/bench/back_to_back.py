@@ -12,19 +12,8 @@ steadier one.
 The files come from import_bench.py (its --dir).
 """
 import subprocess, sys, time, os
-PIXAR = r"""
-import sys, time
-from pxr import Usd, UsdGeom
-t = time.perf_counter(); c = time.process_time()
-stage = Usd.Stage.Open(sys.argv[1])
-cache = UsdGeom.XformCache(Usd.TimeCode.Default())
-n = 0
-for p in stage.Traverse():
-    if p.IsA(UsdGeom.Gprim):
-        cache.GetLocalToWorldTransform(p)
-        n += 1
-print(time.perf_counter() - t, time.process_time() - c, n)
-"""
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from import_bench import PIXAR  # Pixar's import and traversal: wall s, CPU s, gprims
 ppis = sys.argv[1]; R = int(sys.argv[2]); files = sys.argv[3:]
 print("| file | ppis s | Pixar s | ratio | ppis CPU s | Pixar CPU s | CPU ratio | peak MB |")
 print("|---|---:|---:|---:|---:|---:|---:|---:|")
