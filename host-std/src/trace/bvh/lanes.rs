@@ -91,6 +91,30 @@ mod imp {
             // SAFETY: SSE is part of the x86-64 baseline.
             unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
         }
+
+        /// −self per lane (the sign bit flipped, as `f32`'s negation).
+        #[inline(always)]
+        pub(crate) fn neg(self) -> F4 {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            F4(unsafe { _mm_xor_ps(self.0, _mm_set1_ps(-0.0)) })
+        }
+
+        /// √self per lane (correctly rounded, as `f32::sqrt`).
+        #[inline(always)]
+        pub(crate) fn sqrt(self) -> F4 {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            F4(unsafe { _mm_sqrt_ps(self.0) })
+        }
+
+        /// |self| with the sign of `sign` per lane, as `f32::copysign`.
+        #[inline(always)]
+        pub(crate) fn copysign(self, sign: F4) -> F4 {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            F4(unsafe {
+                let bit = _mm_set1_ps(-0.0);
+                _mm_or_ps(_mm_andnot_ps(bit, self.0), _mm_and_ps(bit, sign.0))
+            })
+        }
     }
 }
 
@@ -165,6 +189,24 @@ mod imp {
         pub(crate) fn le_mask(self, o: F4) -> u32 {
             (0..4).map(|k| u32::from(self.0[k] <= o.0[k]) << k).sum()
         }
+
+        /// −self per lane.
+        #[inline(always)]
+        pub(crate) fn neg(self) -> F4 {
+            F4(self.0.map(|x| -x))
+        }
+
+        /// √self per lane.
+        #[inline(always)]
+        pub(crate) fn sqrt(self) -> F4 {
+            F4(self.0.map(f32::sqrt))
+        }
+
+        /// |self| with the sign of `sign` per lane.
+        #[inline(always)]
+        pub(crate) fn copysign(self, sign: F4) -> F4 {
+            F4(std::array::from_fn(|k| self.0[k].copysign(sign.0[k])))
+        }
     }
 }
 
@@ -184,5 +226,14 @@ mod tests {
         assert_eq!(x.lt_mask(acc), 0b0100);
         assert_eq!(F4::splat(2.0).sub(acc).mul(acc).to_array(), [1.0, 0.0, -3.0, -8.0]);
         assert_eq!(F4::splat(-3.0).add(acc).div(acc).abs().to_array(), [2.0, 0.5, 0.0, 0.25]);
+        assert_eq!(
+            F4::load(&[0.0, -0.0, 1.0, -2.0]).neg().to_array().map(f32::to_bits),
+            [-0.0f32, 0.0, -1.0, 2.0].map(f32::to_bits)
+        );
+        let r = F4::load(&[4.0, -9.0, 2.25, 0.0]).sqrt().to_array();
+        assert!(r[0] == 2.0 && r[1].is_nan() && r[2] == 1.5 && r[3] == 0.0);
+        let signs = F4::load(&[-1.0, 0.0, -0.0, f32::NAN]);
+        let c = F4::load(&[2.0, -3.0, 4.0, -5.0]).copysign(signs).to_array();
+        assert_eq!(c.map(f32::to_bits), [-2.0f32, 3.0, -4.0, 5.0f32.copysign(f32::NAN)].map(f32::to_bits));
     }
 }

@@ -1,5 +1,5 @@
-//! A leaf's primitives four to a block: triangles as structure of arrays for one four-lane
-//! Möller–Trumbore test, spheres flagged for their scalar test. The lanes repeat
+//! A leaf's primitives four to a block, as structure of arrays: one four-lane Möller–Trumbore
+//! test for its triangles and one four-lane quadratic for its spheres. The lanes repeat
 //! [`Primitive::intersect`]'s operations in its order, so a lane's distance is bit for bit the
 //! scalar test's and the closest hit does not depend on which path found it.
 
@@ -14,8 +14,9 @@ const NONE: u32 = u32::MAX;
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub(super) struct Block {
-    /// v0, e1, e2 of triangle lanes, one row per coordinate; NaN in other lanes, which no
-    /// triangle test accepts.
+    /// v0, e1, e2 of triangle lanes, one row per coordinate. A sphere lane keeps its centre in
+    /// `v0` and its squared radius in `e1[0]`. NaN in the other lanes and rows, which no test
+    /// accepts.
     v0: [[f32; 4]; 3],
     e1: [[f32; 4]; 3],
     e2: [[f32; 4]; 3],
@@ -49,7 +50,13 @@ impl Block {
                         }
                         b.tris |= 1 << k;
                     }
-                    Primitive::Sphere { .. } => b.spheres |= 1 << k,
+                    Primitive::Sphere { center, radius, .. } => {
+                        for a in 0..3 {
+                            b.v0[a][k] = center[a];
+                        }
+                        b.e1[0][k] = radius * radius;
+                        b.spheres |= 1 << k;
+                    }
                 }
             }
             out.push(b);
@@ -78,13 +85,44 @@ impl Block {
         ok &= !(v.lt_mask(F4::splat(0.0)) | F4::splat(1.0).lt_mask(u.add(v)));
         let t = dot(e2, q).mul(inv);
         ok &= F4::splat(t_min).lt_mask(t) & t.lt_mask(F4::splat(t_max));
-        (ok & 0xf, t.to_array())
+        (ok & self.tris, t.to_array())
     }
 
-    /// Bit k set when lane k is a sphere.
+    /// The sphere lanes the ray hits in (t_min, t_max) (bit k for lane k) and their distances:
+    /// the nearer root where it is in the interval, else the farther.
     #[inline(always)]
-    pub(super) fn spheres(&self) -> u32 {
-        self.spheres
+    pub(super) fn spheres(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> (u32, [f32; 4]) {
+        if self.spheres == 0 {
+            return (0, [0.0; 4]);
+        }
+        let center = self.v0.each_ref().map(F4::load);
+        let r2 = F4::load(&self.e1[0]);
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let f = [o.x, o.y, o.z].map(F4::splat);
+        let f = [f[0].sub(center[0]), f[1].sub(center[1]), f[2].sub(center[2])];
+        let b = dot(f, d).neg();
+        let perp = [f[0].add(b.mul(d[0])), f[1].add(b.mul(d[1])), f[2].add(b.mul(d[2]))];
+        let disc = r2.sub(dot(perp, perp));
+        let c = dot(f, f).sub(r2);
+        let q = b.add(disc.sqrt().copysign(b));
+        let (q, cq, disc) = (q.to_array(), c.div(q).to_array(), disc.to_array());
+        let (mut hits, mut t) = (0, [0.0; 4]);
+        let mut lanes = self.spheres;
+        while lanes != 0 {
+            let k = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            if disc[k] < 0.0 {
+                continue;
+            }
+            let (t0, t1) = if q[k] != 0.0 { (q[k], cq[k]) } else { (0.0, 0.0) };
+            let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+            if near > t_min && near < t_max {
+                (hits, t[k]) = (hits | 1 << k, near);
+            } else if far > t_min && far < t_max {
+                (hits, t[k]) = (hits | 1 << k, far);
+            }
+        }
+        (hits, t)
     }
 }
 
@@ -120,22 +158,37 @@ mod tests {
             .collect();
         let mut blocks = Vec::new();
         Block::pack(&prims, 0, prims.len() as u32, &mut blocks);
-        let mut hits = 0;
+        let (mut hits, mut sphere_hits) = (0, 0);
         for (i, b) in blocks.iter().enumerate() {
             // Aimed near one lane's primitive, so that many rays hit and some graze edges.
             let (lo, hi) = prims[4 * i + i % 4].bounds();
             let o = v() * 3.0;
             let d = ((lo + hi) * 0.5 + v() * 0.02 - o).normalize();
-            let (mask, t) = b.triangles(o, d, 1e-3, 4.5);
+            let (tris, t_tri) = b.triangles(o, d, 1e-3, 4.5);
+            let (spheres, t_sphere) = b.spheres(o, d, 1e-3, 4.5);
+            assert_eq!(tris & spheres, 0, "block {i}: a lane is one primitive");
             for k in 0..4 {
-                let p = prims[4 * i + k];
-                let scalar = p.intersect(o, d, 1e-3, 4.5).filter(|_| matches!(p, Primitive::Triangle { .. }));
-                let lane = (mask & (1 << k) != 0).then_some(t[k]);
+                let scalar = prims[4 * i + k].intersect(o, d, 1e-3, 4.5);
+                let lane = match (tris & (1 << k) != 0, spheres & (1 << k) != 0) {
+                    (true, _) => Some(t_tri[k]),
+                    (_, true) => Some(t_sphere[k]),
+                    _ => None,
+                };
                 assert_eq!(scalar.map(f32::to_bits), lane.map(f32::to_bits), "block {i} lane {k}");
                 hits += usize::from(lane.is_some());
+                sphere_hits += usize::from(spheres & (1 << k) != 0);
             }
-            assert_eq!(b.spheres().count_ones() as usize, (0..4).filter(|k| (4 * i + k) % 5 == 0).count());
         }
-        assert!(hits > 150, "{hits} hits: too few to test the lanes");
+        // From inside a sphere only the far root is in the interval.
+        let inside = Primitive::Sphere { center: Vec3::new(0.5, -0.25, 2.0), radius: 0.75, material: 0 };
+        let mut one = Vec::new();
+        Block::pack(&[inside], 0, 1, &mut one);
+        for d in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+            let o = Vec3::new(0.6, -0.2, 1.9);
+            let scalar = inside.intersect(o, d, 1e-3, 4.5);
+            assert!(scalar.is_some());
+            assert_eq!(one[0].spheres(o, d, 1e-3, 4.5), (1, [scalar.unwrap(), 0.0, 0.0, 0.0]));
+        }
+        assert!(hits > 150 && sphere_hits > 30, "{hits} hits, {sphere_hits} on spheres: too few to test the lanes");
     }
 }

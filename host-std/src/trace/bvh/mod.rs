@@ -135,18 +135,19 @@ impl Bvh {
         let mut t_max = t_max;
         traverse::closest(&self.nodes, o, d, &mut t_max, |first, count, t_max| {
             for b in &self.blocks[first as usize..(first + count) as usize] {
-                let (hits, t) = b.triangles(o, d, t_min, *t_max);
+                let (tris, t_tri) = b.triangles(o, d, t_min, *t_max);
+                let (spheres, t_sphere) = b.spheres(o, d, t_min, *t_max);
                 // Lane by lane as a loop over the primitives would meet them, so that the first
                 // of equal distances wins either way.
                 for k in 0..4 {
-                    let t = if hits & (1 << k) != 0 {
-                        Some(t[k])
-                    } else if b.spheres() & (1 << k) != 0 {
-                        self.prims[b.prim[k] as usize].intersect(o, d, t_min, *t_max)
+                    let t = if tris & (1 << k) != 0 {
+                        t_tri[k]
+                    } else if spheres & (1 << k) != 0 {
+                        t_sphere[k]
                     } else {
-                        None
+                        continue;
                     };
-                    if let Some(t) = t.filter(|t| *t < *t_max) {
+                    if t < *t_max {
                         *t_max = t;
                         best = Some(b.prim[k] as usize);
                     }
@@ -190,18 +191,9 @@ impl Bvh {
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
         traverse::any(&self.nodes, o, d, t_max, |first, count| {
-            self.blocks[first as usize..(first + count) as usize].iter().any(|b| {
-                b.triangles(o, d, t_min, t_max).0 != 0 || {
-                    let mut spheres = b.spheres();
-                    let mut hit = false;
-                    while spheres != 0 && !hit {
-                        let k = spheres.trailing_zeros() as usize;
-                        spheres &= spheres - 1;
-                        hit = self.prims[b.prim[k] as usize].intersect(o, d, t_min, t_max).is_some();
-                    }
-                    hit
-                }
-            })
+            self.blocks[first as usize..(first + count) as usize]
+                .iter()
+                .any(|b| b.triangles(o, d, t_min, t_max).0 != 0 || b.spheres(o, d, t_min, t_max).0 != 0)
         })
     }
 
