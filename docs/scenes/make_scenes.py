@@ -12,9 +12,17 @@
                      structured lighting under a glossy lobe where the paper's product pays —
                      neither factor is a near-delta, so neither env nor BRDF sampling alone
                      finds where their product is large.
+  default_twin.json — the embedded default scene in the scene format, for renderers that read
+                     only files (Mitsuba): its sky with the sun written as a 4096×2048 lat-long
+                     map (default_sky.exr, the sun's edge by 8×8 coverage samples per pixel),
+                     its car-paint sphere a GGX conductor of α = 0.05 (the format has no car
+                     paint), at 384×216.
+  knot.json        — a 100 000-triangle torus knot (GGX α = 0.1, face normals) on a grey floor
+                     under the courtyard map: a scene whose cost is in its geometry
+                     (knot.ply, binary PLY).
 
   pip install mitsuba numpy; python3 docs/scenes/make_scenes.py
-The maps are generated (not committed). Orientation: the project's lat-long convention,
+The maps and the knot are generated (not committed). Orientation: the project's lat-long convention,
 u = atan2(x, −z)/2π, v = acos(y)/π (docs/conventions.md)."""
 import os
 import numpy as np
@@ -53,3 +61,76 @@ for _ in range(24):
     colour = rng.uniform(20.0, 200.0) * rng.uniform(0.8, 1.0, 3)
     img[d @ c > np.cos(radius)] = colour
 write("studio_env.exr", img)
+
+
+def default_sky(w=4096, h=2048, ss=8):
+    """host-std/src/light/sky.rs's default sky: a blue gradient above the horizon, a dim ground
+    below, a sun of 0.265° radius at 35° elevation and 40° azimuth, 1e5 × (1, 0.92, 0.82)."""
+    el, az = np.radians(35.0), np.radians(40.0)
+    sun = np.array([np.cos(el) * np.sin(az), np.sin(el), -np.cos(el) * np.cos(az)])
+    zenith, horizon, ground = np.array([0.12, 0.24, 0.5]), np.array([0.55, 0.62, 0.72]), np.array([0.09, 0.085, 0.08])
+    v, u = np.meshgrid((np.arange(h) + 0.5) / h, (np.arange(w) + 0.5) / w, indexing="ij")
+    y = np.cos(v * np.pi)
+    t = np.clip(y, 0.0, 1.0) ** 0.4
+    img = np.where((y >= 0.0)[..., None], horizon + (zenith - horizon) * t[..., None], ground)
+    # The sun's pixels: coverage by ss × ss samples in a window around it.
+    cos_r = np.cos(np.radians(0.265))
+    theta_s, phi_s = np.arccos(sun[1]), np.arctan2(sun[0], -sun[2]) % (2 * np.pi)
+    r0, c0 = int(theta_s / np.pi * h), int(phi_s / (2 * np.pi) * w)
+    win = 16
+    for r in range(r0 - win, r0 + win):
+        for c in range(c0 - win, c0 + win):
+            sv = (r + (np.arange(ss) + 0.5) / ss) / h * np.pi
+            su = (c + (np.arange(ss) + 0.5) / ss) / w * 2 * np.pi
+            th, ph = np.meshgrid(sv, su, indexing="ij")
+            dd = np.stack([np.sin(th) * np.sin(ph), np.cos(th), -np.sin(th) * np.cos(ph)], axis=-1)
+            cover = np.mean(dd @ sun >= cos_r)
+            img[r, c] += 1.0e5 * np.array([1.0, 0.92, 0.82]) * cover
+    return img
+
+
+write("default_sky.exr", default_sky())
+
+
+def torus_knot(p=2, q=3, segments=1250, sides=40, tube=0.16):
+    """A (p, q) torus knot tube: segments × sides quads, 2 triangles each (100 000 for the
+    defaults), centred on the origin, about 2.4 wide."""
+    t = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
+    def curve(t):
+        r = 0.8 + 0.35 * np.cos(q * t)
+        return np.stack([r * np.cos(p * t), 0.35 * np.sin(q * t), r * np.sin(p * t)], axis=-1)
+    c, cn = curve(t), curve(t + 1e-4)
+    tangent = (cn - c) / np.linalg.norm(cn - c, axis=-1, keepdims=True)
+    normal = np.cross(tangent, np.array([0.0, 1.0, 0.0]))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    binormal = np.cross(tangent, normal)
+    a = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+    ring = np.cos(a)[None, :, None] * normal[:, None, :] + np.sin(a)[None, :, None] * binormal[:, None, :]
+    verts = (c[:, None, :] + tube * ring).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(segments), np.arange(sides), indexing="ij")
+    v00 = i * sides + j
+    v10 = ((i + 1) % segments) * sides + j
+    v01 = i * sides + (j + 1) % sides
+    v11 = ((i + 1) % segments) * sides + (j + 1) % sides
+    # Wound so that e1 × e2 points out of the tube (the front face).
+    faces = np.concatenate([np.stack([v00, v11, v10], -1).reshape(-1, 3), np.stack([v00, v01, v11], -1).reshape(-1, 3)])
+    return verts.astype(np.float32), faces.astype(np.int32)
+
+
+def write_ply(name, verts, faces):
+    header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(verts)}\n"
+              "property float x\nproperty float y\nproperty float z\n"
+              f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n")
+    rows = np.zeros(len(faces), dtype=[("n", "u1"), ("i", "<i4", 3)])
+    rows["n"], rows["i"] = 3, faces
+    with open(os.path.join(HERE, name), "wb") as f:
+        f.write(header.encode())
+        f.write(verts.astype("<f4").tobytes())
+        f.write(rows.tobytes())
+
+
+verts, faces = torus_knot()
+# Lift it so that it rests above the floor at y = 0.
+verts[:, 1] += 0.6
+write_ply("knot.ply", verts, faces)
+print(f"knot: {len(faces)} triangles")
