@@ -3,7 +3,8 @@
 "Equal time against Mitsuba 3").
 
   python3 docs/equal_time.py --out DIR [--spp 256] [--ref-spp 8192] [--methods mis,product-mis,auto]
-                             [--threads 2] [--clock wall|cpu] [--ppis target/release/ppis] SCENE.json...
+                             [--seeds 7] [--threads 2] [--clock wall|cpu] [--ppis target/release/ppis]
+                             SCENE.json...
 
 Per scene: Mitsuba's converged image (`ldsampler`, --ref-spp) and ours (`mis`, --ref-spp, another
 seed), each renderer measured against its own (the two differ on uncovered pixels by the map's
@@ -13,7 +14,9 @@ with `ldsampler` and `independent` at --spp, timed; each of our methods at --spp
 that its first time predicts for Mitsuba-ldsampler's time, its relMSE interpolated log-log at
 that time. Prints one Markdown table of times, relMSE and ratios at equal time, and the
 throughput per core: our shading points and shadow rays per second beside Mitsuba's (one primary
-ray and two shadow rays per sample: `direct` samples the emitter and the BSDF once each).
+ray and two shadow rays per sample: `direct` samples the emitter and the BSDF once each). With
+several --seeds, every timed render (both renderers) is repeated per seed, a row per seed, and
+a last table gives each method's range of ratios over the seeds.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
@@ -74,7 +77,7 @@ def at_time(points, t):
     return math.exp(math.log(e1) + slope * (math.log(t) - math.log(t1)))
 
 
-def scene_rows(args, scene):
+def scene_rows(args, scene, seed):
     name = os.path.splitext(os.path.basename(scene))[0]
     d = lambda f: os.path.join(args.out, f'{name}_{f}')
     if not os.path.exists(d('mref.exr')):
@@ -85,19 +88,19 @@ def scene_rows(args, scene):
     mref, pref = load(d('mref.exr')), load(d('pref.exr'))
     rows = {}
     for sampler in ['ldsampler', 'independent']:
-        t = mitsuba(scene, args.spp, 7, d(f'mts_{sampler}.exr'), sampler)
-        rows[sampler] = (t, relmse(load(d(f'mts_{sampler}.exr')), mref, covered))
+        t = mitsuba(scene, args.spp, seed, d(f'mts_{sampler}_{seed}.exr'), sampler)
+        rows[sampler] = (t, relmse(load(d(f'mts_{sampler}_{seed}.exr')), mref, covered))
     target = rows['ldsampler'][0]
     h, w = covered.shape
     results = []
     for method in args.methods:
         points = []
-        stats = ours(args, scene, method, args.spp, 7, d(f'{method}.exr'))
-        points.append((seconds(stats), relmse(load(d(f'{method}.exr')), pref, covered)))
+        stats = ours(args, scene, method, args.spp, seed, d(f'{method}_{seed}.exr'))
+        points.append((seconds(stats), relmse(load(d(f'{method}_{seed}.exr')), pref, covered)))
         spp = max(1, 2 ** round(math.log2(args.spp * target / seconds(stats))))
         if spp != args.spp:
-            s2 = ours(args, scene, method, spp, 7, d(f'{method}_{spp}.exr'))
-            points.append((seconds(s2), relmse(load(d(f'{method}_{spp}.exr')), pref, covered)))
+            s2 = ours(args, scene, method, spp, seed, d(f'{method}_{spp}_{seed}.exr'))
+            points.append((seconds(s2), relmse(load(d(f'{method}_{spp}_{seed}.exr')), pref, covered)))
         per_core = seconds(stats) if CLOCK == 'cpu' else args.threads * seconds(stats)
         results.append((method, seconds(stats), points[0][1], at_time(points, target),
                         stats['shading_points'] / per_core, stats['shadow_rays'] / per_core))
@@ -112,6 +115,7 @@ def main():
     ap.add_argument('--spp', type=int, default=256)
     ap.add_argument('--ref-spp', type=int, default=8192)
     ap.add_argument('--methods', default='mis,product-mis,auto', type=lambda s: s.split(','))
+    ap.add_argument('--seeds', default=[7], type=lambda s: [int(x) for x in s.split(',')])
     ap.add_argument('--threads', type=int, default=2)
     ap.add_argument('--clock', choices=['wall', 'cpu'], default='wall',
                     help='time both renderers by wall clock (an idle machine) or by the CPU seconds of '
@@ -123,19 +127,28 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     print(f'{args.spp} spp, {args.threads} threads; relMSE on covered pixels, each renderer against its own '
           f'converged image ({args.ref_spp} spp); "at Mitsuba-ld time": ours interpolated log-log at its time.\n')
-    print('| scene | Mitsuba ldsampler | Mitsuba independent | method | ours | ours at Mitsuba-ld time '
+    print('| scene | seed | Mitsuba ldsampler | Mitsuba independent | method | ours | ours at Mitsuba-ld time '
           '| / ldsampler | / independent | our shading points/s/core | our shadow rays/s/core '
           '| Mitsuba-ld samples/s/core |')
-    print('|---|---|---|---|---|---|---:|---:|---:|---:|---:|')
+    print('|---|---:|---|---|---|---|---|---:|---:|---:|---:|---:|')
+    ratios = {}
     for scene in args.scenes:
-        name, rows, results, samples = scene_rows(args, scene)
-        (t_ld, e_ld), (t_in, e_in) = rows['ldsampler'], rows['independent']
-        for method, t, e, e_at, sp, sr in results:
-            # Mitsuba's independent sampler's error at ldsampler's time: error ∝ 1/time.
-            e_in_at = e_in * t_in / t_ld
-            print(f'| {name} | {t_ld:.2f} s, {e_ld:.2e} | {t_in:.2f} s, {e_in:.2e} | {method} | {t:.2f} s, {e:.2e} '
-                  f'| {e_at:.2e} | {e_at / e_ld:.2f} | {e_at / e_in_at:.2f} | {sp / 1e6:.2f} M | {sr / 1e6:.2f} M '
-                  f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M |', flush=True)
+        for seed in args.seeds:
+            name, rows, results, samples = scene_rows(args, scene, seed)
+            (t_ld, e_ld), (t_in, e_in) = rows['ldsampler'], rows['independent']
+            for method, t, e, e_at, sp, sr in results:
+                # Mitsuba's independent sampler's error at ldsampler's time: error ∝ 1/time.
+                e_in_at = e_in * t_in / t_ld
+                ratios.setdefault((name, method), []).append(e_at / e_ld)
+                print(f'| {name} | {seed} | {t_ld:.2f} s, {e_ld:.2e} | {t_in:.2f} s, {e_in:.2e} | {method} | {t:.2f} s, {e:.2e} '
+                      f'| {e_at:.2e} | {e_at / e_ld:.2f} | {e_at / e_in_at:.2f} | {sp / 1e6:.2f} M | {sr / 1e6:.2f} M '
+                      f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M |', flush=True)
+    if len(args.seeds) > 1:
+        print('\n| scene | method | / ldsampler over the seeds: min – max (median) |')
+        print('|---|---|---|')
+        for (name, method), r in ratios.items():
+            r = sorted(r)
+            print(f'| {name} | {method} | {r[0]:.2f} – {r[-1]:.2f} ({r[len(r) // 2]:.2f}) |')
 
 
 if __name__ == '__main__':
