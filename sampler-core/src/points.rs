@@ -98,6 +98,23 @@ const fn byte_tables(dim: usize) -> [[u32; 256]; 4] {
 
 static SOBOL_TABLES: [[[u32; 256]; 4]; 2] = [byte_tables(0), byte_tables(1)];
 
+/// The second dimension's byte tables with every entry's bits reversed: bit reversal commutes
+/// with XOR, so these give the reversed point that Owen scrambling starts from.
+static SOBOL_DIM1_REVERSED: [[u32; 256]; 4] = reversed(byte_tables(1));
+
+const fn reversed(mut t: [[u32; 256]; 4]) -> [[u32; 256]; 4] {
+    let mut b = 0;
+    while b < 4 {
+        let mut i = 0;
+        while i < 256 {
+            t[b][i] = t[b][i].reverse_bits();
+            i += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
 #[inline(always)]
 fn sobol(dim: usize, index: u32) -> u32 {
     let t = &SOBOL_TABLES[dim];
@@ -123,7 +140,12 @@ pub fn sobol_dim1(index: u32) -> u32 {
 #[inline]
 #[must_use]
 pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    let mut v = x.reverse_bits();
+    scramble_reversed(x.reverse_bits(), seed)
+}
+
+/// [`nested_uniform_scramble`] of the point whose bits reversed are `v`.
+#[inline(always)]
+fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
     v = v.wrapping_add(seed);
     v ^= v.wrapping_mul(0x6c50_b47c);
     v ^= v.wrapping_mul(0xb82f_1e52);
@@ -158,8 +180,14 @@ impl Sobol02 {
     pub fn fill(&self, first: u32, out: &mut [DVec2]) {
         for (k, p) in out.iter_mut().enumerate() {
             let i = first.wrapping_add(k as u32);
-            let x = nested_uniform_scramble(sobol_dim0(i), self.s0);
-            let y = nested_uniform_scramble(sobol_dim1(i), self.s1);
+            // The first dimension is the index with its bits reversed, so reversed it is the index.
+            let x = scramble_reversed(i, self.s0);
+            let b = i.to_le_bytes();
+            let t = &SOBOL_DIM1_REVERSED;
+            let y = scramble_reversed(
+                t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize],
+                self.s1,
+            );
             *p = DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32);
         }
     }
@@ -269,6 +297,21 @@ mod tests {
         let a: [u32; 8] = core::array::from_fn(|i| permutation_element(i as u32, 8, 1));
         let b: [u32; 8] = core::array::from_fn(|i| permutation_element(i as u32, 8, 2));
         assert_ne!(a, b);
+    }
+
+    #[test]
+    fn the_sequence_is_the_scrambled_sobol_points() {
+        let seq = Sobol02::new(77);
+        let mut pts = [DVec2::ZERO; 300];
+        for first in [0u32, 255, 65_530, 16_777_210, u32::MAX - 299] {
+            seq.fill(first, &mut pts);
+            for (k, p) in pts.iter().enumerate() {
+                let i = first.wrapping_add(k as u32);
+                let x = nested_uniform_scramble(sobol_dim0(i), seq.s0) as f64 * INV_2_32;
+                let y = nested_uniform_scramble(sobol_dim1(i), seq.s1) as f64 * INV_2_32;
+                assert_eq!(*p, DVec2::new(x, y), "point {i}");
+            }
+        }
     }
 
     #[test]
