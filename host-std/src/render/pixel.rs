@@ -190,7 +190,7 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
         };
         let shaded = if wavefront::fits(&sampling, budget) {
             let members = &members[..m];
-            let (out, traced) = shade_members(ctx, env, &sampling, hits, members, (&lead_sp, run_of), budget, waves);
+            let (out, traced) = shade_members(ctx, env, &sampling, hits, members, run_of, budget, waves);
             rays += traced;
             for (i, &k) in members.iter().enumerate() {
                 (values[k], done[k]) = (out[i], true);
@@ -221,8 +221,7 @@ fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scr
 }
 
 /// The estimates of a material's `members` shaded as one wavefront through `sampling` (see
-/// [`wavefront::fits`]), and the shadow rays traced. `lead` is the first member's shading
-/// point, standing in for the unused slots past the members, and the run of each hit.
+/// [`wavefront::fits`]), and the shadow rays traced; `run_of` gives each hit's run.
 #[allow(clippy::too_many_arguments)]
 fn shade_members(
     ctx: &Context<'_, '_>,
@@ -230,21 +229,15 @@ fn shade_members(
     sampling: &Sampling<'_, '_>,
     hits: &[Hit],
     members: &[usize],
-    (lead, run_of): (&ShadingPoint<'_, dyn Brdf + '_>, impl Fn(&Hit) -> Run),
+    run_of: impl Fn(&Hit) -> Run,
     budget: usize,
     waves: &mut WaveBuffers,
 ) -> ([DVec3; GROUP], u64) {
-    let m = members.len();
-    // Past the members, placeholders that nothing reads.
-    let points: [ShadingPoint<'_, dyn Brdf + '_>; GROUP] = std::array::from_fn(|i| match members.get(i) {
-        Some(&k) => shading_point(ctx.scene, &hits[k]),
-        None => ShadingPoint { frame: lead.frame, wo: lead.wo, brdf: lead.brdf },
-    });
-    let runs: [Run; GROUP] = std::array::from_fn(|i| match members.get(i) {
-        Some(&k) => run_of(&hits[k]),
-        None => Run { seed: run_of(&hits[members[0]]).seed, block: 0 },
-    });
-    let origins: [Vec3; GROUP] = std::array::from_fn(|i| members.get(i).map_or(Vec3::ZERO, |&k| hits[k].origin));
+    // Sized to the members: a group's full arrays would cost more to fill than its few points.
+    let points: Vec<ShadingPoint<'_, dyn Brdf + '_>> =
+        members.iter().map(|&k| shading_point(ctx.scene, &hits[k])).collect();
+    let runs: Vec<Run> = members.iter().map(|&k| run_of(&hits[k])).collect();
+    let origins: Vec<Vec3> = members.iter().map(|&k| hits[k].origin).collect();
     let mut out = [DVec3::ZERO; GROUP];
     let shadows = ctx.options.shadows;
     let occluded_many = |rays: &[ShadowRay], blocked: &mut [bool]| {
@@ -252,18 +245,9 @@ fn shade_members(
             ctx.bvh.occluded_many(rays, blocked);
         }
     };
-    let traced = wavefront::shade_wavefront(
-        sampling,
-        env,
-        &points[..m],
-        &runs[..m],
-        &origins[..m],
-        budget,
-        waves,
-        occluded_many,
-        &mut out,
-    )
-    .map_or(0, |r| r as u64);
+    let traced =
+        wavefront::shade_wavefront(sampling, env, &points, &runs, &origins, budget, waves, occluded_many, &mut out)
+            .map_or(0, |r| r as u64);
     (out, traced)
 }
 
