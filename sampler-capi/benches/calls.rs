@@ -23,11 +23,12 @@ use std::hint::black_box;
 use std::ptr::null_mut;
 
 /// The lat-long sky's size and the equal-area level it is resampled to.
-const WIDTH: usize = 1024;
-const HEIGHT: usize = 512;
-const LEVEL: u32 = 9;
-/// Points (and directions) a per-call block cycles through.
-const POINTS: usize = 64;
+const WIDTH: usize = 2048;
+const HEIGHT: usize = 1024;
+const LEVEL: u32 = 10;
+/// Points (and directions) a per-call block sweeps: enough that the descents leave the caches,
+/// as a render's do.
+const POINTS: usize = 4096;
 /// Shading points the builds cycle through.
 const SHADING_POINTS: usize = 16;
 
@@ -78,7 +79,7 @@ fn latlong_sky() -> Vec<[f32; 3]> {
     for (k, p) in t.iter_mut().enumerate() {
         let (i, j) = (k % WIDTH, k / WIDTH);
         let sky = 0.2 + 0.8 * (HEIGHT - j) as f32 / HEIGHT as f32;
-        let sun = (300..304).contains(&i) && (160..164).contains(&j);
+        let sun = (600..606).contains(&i) && (320..326).contains(&j);
         *p = if sun { [5e4, 4.8e4, 4.5e4] } else { [0.4 * sky, 0.6 * sky, sky] };
     }
     t
@@ -149,13 +150,13 @@ fn main() {
     let mut rgb_rust = vec![[0.0f32; 3]; 1 << (2 * LEVEL)];
     let ll = latlong.as_flattened();
     row(
-        "lat-long 1024 × 512 → equal-area 512², ss 2",
+        "lat-long 2048 × 1024 → equal-area 1024², ss 2",
         side_by_side(
             1,
             // SAFETY: the lengths are the buffers'.
             || unsafe {
-                let s =
-                    ppis_latlong_to_equal_area(ll.as_ptr(), 1024, 512, LEVEL, 2, rgb_out.as_mut_ptr(), rgb_out.len());
+                let (w, h) = (WIDTH as u32, HEIGHT as u32);
+                let s = ppis_latlong_to_equal_area(ll.as_ptr(), w, h, LEVEL, 2, rgb_out.as_mut_ptr(), rgb_out.len());
                 black_box(s);
             },
             || latlong_to_equal_area(&latlong, WIDTH, HEIGHT, LEVEL, 2, &mut rgb_rust).unwrap(),
@@ -164,7 +165,7 @@ fn main() {
     let mut pyr_out = vec![0.0f32; pyramid_len(LEVEL)];
     let mut pyr_rust = vec![0.0f32; pyramid_len(LEVEL)];
     row(
-        "pyramid build, 512² map",
+        "pyramid build, 1024² map",
         side_by_side(
             1,
             // SAFETY: the lengths are the buffers'.
@@ -263,7 +264,7 @@ fn per_call_rows(
         ),
     );
     row(
-        "product sample_many (64 at once), per sample",
+        "product sample_many (4 096 at once), per sample",
         side_by_side(
             POINTS,
             || unsafe { _ = black_box(ppis_product_sample_many(product, u_flat.as_ptr(), POINTS, out.as_mut_ptr())) },
