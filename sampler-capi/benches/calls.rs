@@ -90,65 +90,45 @@ fn memory(size: usize) -> Vec<u64> {
     vec![0u64; size.div_ceil(8)]
 }
 
-fn main() {
-    let latlong = latlong_sky();
-    let mut rgb = vec![[0.0f32; 3]; 1 << (2 * LEVEL)];
-    latlong_to_equal_area(&latlong, WIDTH, HEIGHT, LEVEL, 2, &mut rgb).unwrap();
-    sanitize_rgb(&mut rgb);
-    let mut pyramid = vec![0.0f32; pyramid_len(LEVEL)];
-    build_pyramid(LEVEL, &rgb, &mut pyramid).unwrap();
-    let (rgb_f, pyr_f) = (rgb.as_flattened(), pyramid.as_slice());
-    let rust_env = EnvHierarchy::new(LEVEL, &pyramid, &rgb).unwrap();
+/// The library's objects of the bench, in memory it owns.
+struct Objects {
+    env: *mut ppis_env,
+    brdf: *mut ppis_brdf,
+    product: *mut ppis_product,
+    two_level: *mut ppis_two_level,
+    cones: *mut ppis_cones,
+    _memory: [Vec<u64>; 5],
+}
 
-    let ok = ppis_status::PPIS_OK;
-    let (mut env_mem, mut brdf_mem, mut prod_mem, mut tl_mem, mut cones_mem) = (
-        memory(ppis_env_size()),
-        memory(ppis_brdf_size()),
-        memory(ppis_product_size()),
-        memory(ppis_two_level_size()),
-        memory(ppis_cones_size(4)),
-    );
-    let mem = |v: &mut Vec<u64>| v.as_mut_ptr().cast::<c_void>();
-    let (mut env, mut brdf, mut product, mut two_level, mut cones) =
-        (null_mut(), null_mut(), null_mut(), null_mut(), null_mut());
-    let metal = RoughConductor::new(0.1, Vec3::new(1.0, 0.78, 0.34));
-    let gold = ppis_vec3 { x: 1.0, y: 0.78, z: 0.34 };
-    // SAFETY: every buffer outlives the objects that borrow it; the sizes are the library's.
-    unsafe {
-        let (p, r) = (pyr_f.as_ptr(), rgb_f.as_ptr());
-        assert_eq!(
-            ppis_env_init(mem(&mut env_mem), ppis_env_size(), LEVEL, p, pyr_f.len(), r, rgb_f.len(), &mut env),
-            ok
-        );
-        assert_eq!(ppis_brdf_init_conductor(mem(&mut brdf_mem), ppis_brdf_size(), 0.1, gold, &mut brdf), ok);
-        assert_eq!(ppis_product_init(mem(&mut prod_mem), ppis_product_size(), &mut product), ok);
-        assert_eq!(ppis_two_level_init(mem(&mut tl_mem), ppis_two_level_size(), &mut two_level), ok);
-        assert_eq!(ppis_cones_init(mem(&mut cones_mem), ppis_cones_size(4), 4, &mut cones), ok);
+impl Objects {
+    /// The objects over `pyramid` and `rgb`, which must outlive them.
+    fn new(pyramid: &[f32], rgb: &[f32]) -> Self {
+        let ok = ppis_status::PPIS_OK;
+        let sizes = [ppis_env_size(), ppis_brdf_size(), ppis_product_size(), ppis_two_level_size(), ppis_cones_size(4)];
+        let mut memory = sizes.map(memory);
+        let [e, b, p, t, c] = memory.each_mut().map(|m| m.as_mut_ptr().cast::<c_void>());
+        let (mut env, mut brdf, mut product, mut two_level, mut cones) =
+            (null_mut(), null_mut(), null_mut(), null_mut(), null_mut());
+        let gold = ppis_vec3 { x: 1.0, y: 0.78, z: 0.34 };
+        // SAFETY: the memory is the library's sizes, kept with the objects; the caller keeps
+        // the map alive.
+        unsafe {
+            let (pp, rp) = (pyramid.as_ptr(), rgb.as_ptr());
+            assert_eq!(ppis_env_init(e, sizes[0], LEVEL, pp, pyramid.len(), rp, rgb.len(), &mut env), ok);
+            assert_eq!(ppis_brdf_init_conductor(b, sizes[1], 0.1, gold, &mut brdf), ok);
+            assert_eq!(ppis_product_init(p, sizes[2], &mut product), ok);
+            assert_eq!(ppis_two_level_init(t, sizes[3], &mut two_level), ok);
+            assert_eq!(ppis_cones_init(c, sizes[4], 4, &mut cones), ok);
+        }
+        Self { env, brdf, product, two_level, cones, _memory: memory }
     }
-    let mut rust_cones = vec![Cone::default(); cell_count(4)];
-    build_cell_cones(&mut rust_cones);
+}
 
-    // Shading points on a glossy sphere seen along +z, and uniform points.
-    let normals: Vec<Vec3> = (0..SHADING_POINTS)
-        .map(|k| {
-            let a = k as f32 * 2.39996;
-            let r = 0.9 * ((k as f32 + 0.5) / SHADING_POINTS as f32).sqrt();
-            Vec3::new(r * a.cos(), r * a.sin(), (1.0 - r * r).sqrt())
-        })
-        .collect();
-    let frames: Vec<Frame> = normals.iter().map(|n| Frame::from_normal(*n)).collect();
-    let c_frames: Vec<ppis_frame> = normals.iter().map(|n| ppis_frame_from_normal((*n).into())).collect();
-    let wo = Vec3::new(0.0, 0.2, 0.98).normalize();
-    let mut u = vec![DVec2::ZERO; POINTS];
-    sobol02(3, 0, &mut u);
-    let u_flat: Vec<f64> = u.iter().flat_map(|p| [p.x, p.y]).collect();
-    let dirs: Vec<Vec3> = u.iter().map(|p| rust_env.sample(*p).unwrap().dir).collect();
-
-    println!("| call | C ABI | Rust API | C / Rust |");
-    println!("|---|---:|---:|---:|");
+/// The map's preparation: lat-long resampling and the pyramid.
+fn environment_rows(latlong: &[[f32; 3]], rgb: &[[f32; 3]]) {
     let mut rgb_out = vec![0.0f32; 3 << (2 * LEVEL)];
     let mut rgb_rust = vec![[0.0f32; 3]; 1 << (2 * LEVEL)];
-    let ll = latlong.as_flattened();
+    let (ll, rgb_f) = (latlong.as_flattened(), rgb.as_flattened());
     row(
         "lat-long 2048 × 1024 → equal-area 1024², ss 2",
         side_by_side(
@@ -159,7 +139,7 @@ fn main() {
                 let s = ppis_latlong_to_equal_area(ll.as_ptr(), w, h, LEVEL, 2, rgb_out.as_mut_ptr(), rgb_out.len());
                 black_box(s);
             },
-            || latlong_to_equal_area(&latlong, WIDTH, HEIGHT, LEVEL, 2, &mut rgb_rust).unwrap(),
+            || latlong_to_equal_area(latlong, WIDTH, HEIGHT, LEVEL, 2, &mut rgb_rust).unwrap(),
         ),
     );
     let mut pyr_out = vec![0.0f32; pyramid_len(LEVEL)];
@@ -173,16 +153,34 @@ fn main() {
                 let s = ppis_build_pyramid(LEVEL, rgb_f.as_ptr(), rgb_f.len(), pyr_out.as_mut_ptr(), pyr_out.len());
                 black_box(s);
             },
-            || build_pyramid(LEVEL, &rgb, &mut pyr_rust).unwrap(),
+            || build_pyramid(LEVEL, rgb, &mut pyr_rust).unwrap(),
         ),
     );
+}
 
-    let mut arena: Box<ProductArena> = Box::default();
+/// Shading frames on a glossy sphere seen along +z, for Rust and for C.
+fn shading_frames() -> (Vec<Frame>, Vec<ppis_frame>) {
+    let normals: Vec<Vec3> = (0..SHADING_POINTS)
+        .map(|k| {
+            let a = k as f32 * 2.39996;
+            let r = 0.9 * ((k as f32 + 0.5) / SHADING_POINTS as f32).sqrt();
+            Vec3::new(r * a.cos(), r * a.sin(), (1.0 - r * r).sqrt())
+        })
+        .collect();
+    (
+        normals.iter().map(|n| Frame::from_normal(*n)).collect(),
+        normals.iter().map(|n| ppis_frame_from_normal((*n).into())).collect(),
+    )
+}
+
+/// The builds per shading point: the quadtree product at two K and the two-level product.
+fn build_rows(c: &Objects, env: &EnvHierarchy<'_>, cones: &[Cone], arenas: (&mut ProductArena, &mut TwoLevelArena)) {
+    let (arena, tl_arena) = arenas;
+    let (frames, c_frames) = shading_frames();
+    let (metal, wo) = (RoughConductor::new(0.1, Vec3::new(1.0, 0.78, 0.34)), view());
     for k in [64u32, 256] {
-        let params = ppis_product_params_for_mis(k);
-        let rust_params = ProductParams::for_mis(k as usize);
-        let mut seed = 0u64;
-        let mut rust_seed = 0u64;
+        let (params, rust_params) = (ppis_product_params_for_mis(k), ProductParams::for_mis(k as usize));
+        let (mut seed, mut rust_seed) = (0u64, 0u64);
         row(
             &format!("product build (quadtree, for MIS, K = {k})"),
             side_by_side(
@@ -191,19 +189,18 @@ fn main() {
                 || unsafe {
                     for f in &c_frames {
                         seed += 1;
-                        black_box(ppis_product_build(product, env, brdf, f, wo.into(), &params, seed));
+                        black_box(ppis_product_build(c.product, c.env, c.brdf, f, wo.into(), &params, seed));
                     }
                 },
                 || {
                     for f in &frames {
                         rust_seed += 1;
-                        black_box(arena.build(&rust_env, &metal, f, wo, &rust_params, rust_seed).is_ok());
+                        black_box(arena.build(env, &metal, f, wo, &rust_params, rust_seed).is_ok());
                     }
                 },
             ),
         );
     }
-    let mut tl_arena: Box<TwoLevelArena> = Box::default();
     row(
         "two-level build (16² cells)",
         side_by_side(
@@ -211,27 +208,59 @@ fn main() {
             // SAFETY: the objects come from their `init`s.
             || unsafe {
                 for f in &c_frames {
-                    black_box(ppis_two_level_build(two_level, env, cones, brdf, f, wo.into()));
+                    black_box(ppis_two_level_build(c.two_level, c.env, c.cones, c.brdf, f, wo.into()));
                 }
             },
             || {
                 for f in &frames {
-                    black_box(tl_arena.build(&rust_env, &rust_cones, &metal, f, wo).is_ok());
+                    black_box(tl_arena.build(env, cones, &metal, f, wo).is_ok());
                 }
             },
         ),
     );
+}
 
-    // Sampling from one built shading point.
-    let params = ppis_product_params_for_mis(64);
+/// The direction to the viewer.
+fn view() -> Vec3 {
+    Vec3::new(0.0, 0.2, 0.98).normalize()
+}
+
+fn main() {
+    let latlong = latlong_sky();
+    let mut rgb = vec![[0.0f32; 3]; 1 << (2 * LEVEL)];
+    latlong_to_equal_area(&latlong, WIDTH, HEIGHT, LEVEL, 2, &mut rgb).unwrap();
+    sanitize_rgb(&mut rgb);
+    let mut pyramid = vec![0.0f32; pyramid_len(LEVEL)];
+    build_pyramid(LEVEL, &rgb, &mut pyramid).unwrap();
+    let rust_env = EnvHierarchy::new(LEVEL, &pyramid, &rgb).unwrap();
+    let c = Objects::new(&pyramid, rgb.as_flattened());
+    let mut rust_cones = vec![Cone::default(); cell_count(4)];
+    build_cell_cones(&mut rust_cones);
+
+    println!("| call | C ABI | Rust API | C / Rust |");
+    println!("|---|---:|---:|---:|");
+    environment_rows(&latlong, &rgb);
+    let mut arena: Box<ProductArena> = Box::default();
+    let mut tl_arena: Box<TwoLevelArena> = Box::default();
+    build_rows(&c, &rust_env, &rust_cones, (&mut arena, &mut tl_arena));
+
+    // Sampling from one built shading point, over points that sweep the square.
+    let (frames, c_frames) = shading_frames();
+    let (metal, wo, params) =
+        (RoughConductor::new(0.1, Vec3::new(1.0, 0.78, 0.34)), view(), ppis_product_params_for_mis(64));
     // SAFETY: the objects come from their `init`s.
     unsafe {
-        assert_eq!(ppis_product_build(product, env, brdf, &c_frames[3], wo.into(), &params, 9), ok);
-        assert_eq!(ppis_two_level_build(two_level, env, cones, brdf, &c_frames[3], wo.into()), ok);
+        let ok = ppis_status::PPIS_OK;
+        assert_eq!(ppis_product_build(c.product, c.env, c.brdf, &c_frames[3], wo.into(), &params, 9), ok);
+        assert_eq!(ppis_two_level_build(c.two_level, c.env, c.cones, c.brdf, &c_frames[3], wo.into()), ok);
     }
     let rust_product = arena.build(&rust_env, &metal, &frames[3], wo, &ProductParams::for_mis(64), 9).unwrap();
     let rust_two_level = tl_arena.build(&rust_env, &rust_cones, &metal, &frames[3], wo).unwrap();
-    per_call_rows((product, two_level, env), &rust_product, &rust_two_level, &rust_env, &u, &u_flat, &dirs);
+    let mut u = vec![DVec2::ZERO; POINTS];
+    sobol02(3, 0, &mut u);
+    let u_flat: Vec<f64> = u.iter().flat_map(|p| [p.x, p.y]).collect();
+    let dirs: Vec<Vec3> = u.iter().map(|p| rust_env.sample(*p).unwrap().dir).collect();
+    per_call_rows((c.product, c.two_level, c.env), &rust_product, &rust_two_level, &rust_env, &u, &u_flat, &dirs);
 }
 
 /// The calls of a built shading point: sample, sample_many, pdf, and the env-only sampler's.
