@@ -117,7 +117,9 @@ int main(void) {
     ppis_vec3 gold = {1.0f, 0.78f, 0.34f};
     CHECK(ppis_brdf_init_conductor(object(ppis_brdf_size(), ppis_brdf_align()), ppis_brdf_size(), 0.1f, gold, &metal));
     static lambert clay = {{0.7f, 0.5f, 0.4f}};
-    ppis_brdf_callbacks callbacks = {&clay, lambert_eval, lambert_sample, lambert_pdf, 1};
+    /* Diffuse: its lobe is a hemisphere wide (pi/2); no cone bounds, so the two-level product
+       weighs its cells by evaluating it. */
+    ppis_brdf_callbacks callbacks = {&clay, lambert_eval, lambert_sample, lambert_pdf, 1, 1.5707964f, NULL};
     CHECK(ppis_brdf_init_callbacks(object(ppis_brdf_size(), ppis_brdf_align()), ppis_brdf_size(), &callbacks, &matte));
 
     /* Per thread: a product sampler and a two-level sampler; shared: the cones of 16 x 16 cells. */

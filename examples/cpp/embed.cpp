@@ -72,6 +72,7 @@ struct Clay {
             return static_cast<Clay *>(user)->sample(wo, u, *wi, *value, *pdf) ? 1 : 0;
         };
         c.is_diffuse = 1;
+        c.lobe_width = 1.5707964f;  // a hemisphere; no cone bounds: the two-level build evaluates
         return c;
     }
 };

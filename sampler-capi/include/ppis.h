@@ -71,6 +71,19 @@ typedef struct {
   float y;
 } ppis_vec2;
 
+// The directions within `angle` radians of the unit vector `axis`, with the angle's cosine
+// and sine.
+typedef struct {
+  // Unit direction at the cone's centre.
+  ppis_vec3 axis;
+  // Half-angle in radians, in [0, π].
+  float angle;
+  // cos(angle).
+  float cos;
+  // sin(angle).
+  float sin;
+} ppis_cone;
+
 // An engine's own BRDF: three functions and a pointer they receive. They may be called from
 // any thread that samples with the BRDF, so they must be safe to call concurrently.
 typedef struct {
@@ -91,6 +104,14 @@ typedef struct {
   float (*pdf)(void *user, ppis_vec3 wo, ppis_vec3 wi);
   // Non-zero when the BRDF is as smooth as a Lambertian one.
   int32_t is_diffuse;
+  // Angular width in radians, roughly, of the sharpest lobe (GGX α, π/2 for a diffuse
+  // BRDF): how far a shading point may move before a sampler built at another no longer
+  // fits (`ppis_brdf_lobe_width`). 0 is as sharp as a mirror.
+  float lobe_width;
+  // Optional: upper bounds of the luminance of `eval` over `count` cones of incident
+  // directions (local frame), `out[k]` for `cones[k]`. With it the two-level product weighs
+  // its cells by the bounds; without it (null) by evaluating `eval` at five points per cell.
+  void (*cone_bounds)(void *user, ppis_vec3 wo, const ppis_cone *cones, size_t count, float *out);
 } ppis_brdf_callbacks;
 
 // A direction drawn by a sampler.
@@ -183,8 +204,9 @@ ppis_status ppis_brdf_init_phong(void *mem,
                                  float exponent,
                                  ppis_brdf **out);
 
-// An engine's own BRDF from its callbacks (all three required). The two-level product bounds
-// it by evaluation (no analytic bound is known for it).
+// An engine's own BRDF from its callbacks (`eval`, `sample` and `pdf` required; `lobe_width`
+// finite and ≥ 0). The two-level product bounds it by `cone_bounds` if given, by evaluation
+// otherwise.
 //
 // # Safety
 // `mem` must be valid for `mem_size` bytes, `callbacks` for a read and `out` for a write; the
@@ -217,6 +239,30 @@ ppis_status ppis_brdf_sample(const ppis_brdf *brdf,
                              ppis_vec3 *wi,
                              ppis_vec3 *value,
                              float *pdf);
+
+// Angular width in radians, roughly, of the BRDF's sharpest lobe: GGX α, Phong √(2/(n+2)),
+// a car paint's coat, π/2 for a diffuse BRDF, a callback BRDF's own `lobe_width`. An engine
+// scales by it how far shading points may be apart and still share a sampler; 0 for a null
+// `brdf`.
+//
+// # Safety
+// `brdf` must be null or come from a `ppis_brdf_init_*`.
+float ppis_brdf_lobe_width(const ppis_brdf *brdf);
+
+// 1 when the BRDF is as smooth as a Lambertian one (product sampling gains little over
+// environment sampling there), 0 otherwise or for a null `brdf`.
+//
+// # Safety
+// `brdf` must be null or come from a `ppis_brdf_init_*`.
+int32_t ppis_brdf_is_diffuse(const ppis_brdf *brdf);
+
+// 1 when the BRDF bounds itself over cones of directions (every built-in BRDF; a callback
+// BRDF with `cone_bounds`), so the two-level product weighs cells by true bounds; 0
+// otherwise or for a null `brdf`.
+//
+// # Safety
+// `brdf` must be null or come from a `ppis_brdf_init_*`.
+int32_t ppis_brdf_has_cone_bounds(const ppis_brdf *brdf);
 
 // Floats in the pyramid of a `2^level × 2^level` map, or 0 above the largest level (14).
 size_t ppis_pyramid_len(uint32_t level);

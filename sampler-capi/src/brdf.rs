@@ -1,72 +1,12 @@
 //! BRDFs: the built-in materials by their parameters, and an engine's own material given as
 //! callbacks. All directions are in the local shading frame (normal = +z).
 
+use crate::callbacks::{Callbacks, ppis_brdf_callbacks};
 use crate::{borrow, finish, place, ppis_status, ppis_vec2, ppis_vec3};
 use core::ffi::c_void;
 use sampler_core::brdf::{Brdf, BrdfDraw, BrdfSample, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::cone::Cone;
 use sampler_core::glam::{Vec2, Vec3};
-
-/// An engine's own BRDF: three functions and a pointer they receive. They may be called from
-/// any thread that samples with the BRDF, so they must be safe to call concurrently.
-#[repr(C)]
-#[derive(Clone, Copy, Debug)]
-pub struct ppis_brdf_callbacks {
-    /// Passed to every callback as its first argument.
-    pub user: *mut c_void,
-    /// BRDF × cosθi (RGB) for the view `wo` and the incident direction `wi`; 0 below the
-    /// surface.
-    pub eval: Option<unsafe extern "C" fn(user: *mut c_void, wo: ppis_vec3, wi: ppis_vec3) -> ppis_vec3>,
-    /// Draws `wi` from the BRDF's sampling density with `u` ∈ [0,1)², writing the direction,
-    /// BRDF × cosθi there and its density; returns 0 when nothing can be drawn.
-    pub sample: Option<
-        unsafe extern "C" fn(
-            user: *mut c_void,
-            wo: ppis_vec3,
-            u: ppis_vec2,
-            wi: *mut ppis_vec3,
-            value: *mut ppis_vec3,
-            pdf: *mut f32,
-        ) -> i32,
-    >,
-    /// Density of `sample` at `wi` with respect to solid angle.
-    pub pdf: Option<unsafe extern "C" fn(user: *mut c_void, wo: ppis_vec3, wi: ppis_vec3) -> f32>,
-    /// Non-zero when the BRDF is as smooth as a Lambertian one.
-    pub is_diffuse: i32,
-}
-
-/// Callbacks checked to be present.
-#[derive(Clone, Copy)]
-struct Callbacks {
-    user: *mut c_void,
-    eval: unsafe extern "C" fn(*mut c_void, ppis_vec3, ppis_vec3) -> ppis_vec3,
-    sample: unsafe extern "C" fn(*mut c_void, ppis_vec3, ppis_vec2, *mut ppis_vec3, *mut ppis_vec3, *mut f32) -> i32,
-    pdf: unsafe extern "C" fn(*mut c_void, ppis_vec3, ppis_vec3) -> f32,
-    is_diffuse: bool,
-}
-
-impl Brdf for Callbacks {
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        // SAFETY: the engine vouches for its callback and `user` at `ppis_brdf_init_callbacks`.
-        unsafe { (self.eval)(self.user, wo.into(), wi.into()) }.into()
-    }
-
-    fn sample(&self, wo: Vec3, u: Vec2) -> Option<BrdfSample> {
-        let (mut wi, mut value, mut pdf) = (ppis_vec3::default(), ppis_vec3::default(), 0.0f32);
-        // SAFETY: as for `eval`; the out-pointers are live locals.
-        let drawn = unsafe { (self.sample)(self.user, wo.into(), u.into(), &mut wi, &mut value, &mut pdf) };
-        (drawn != 0 && pdf > 0.0 && pdf.is_finite()).then(|| BrdfSample { wi: wi.into(), value: value.into(), pdf })
-    }
-
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        // SAFETY: as for `eval`.
-        unsafe { (self.pdf)(self.user, wo.into(), wi.into()) }
-    }
-
-    fn is_diffuse(&self) -> bool {
-        self.is_diffuse
-    }
-}
 
 /// A BRDF: built-in or an engine's callbacks.
 pub struct ppis_brdf(Kind);
@@ -122,7 +62,13 @@ impl Brdf for ppis_brdf {
     fn is_diffuse(&self) -> bool {
         self.inner().is_diffuse()
     }
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    fn lobe_width(&self) -> f32 {
+        self.inner().lobe_width()
+    }
+    fn has_cone_bounds(&self) -> bool {
+        self.inner().has_cone_bounds()
+    }
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         self.inner().cone_bounds(wo, cones, out)
     }
     fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
@@ -254,8 +200,9 @@ pub unsafe extern "C" fn ppis_brdf_init_phong(
     unsafe { init(mem, mem_size, make, out) }
 }
 
-/// An engine's own BRDF from its callbacks (all three required). The two-level product bounds
-/// it by evaluation (no analytic bound is known for it).
+/// An engine's own BRDF from its callbacks (`eval`, `sample` and `pdf` required; `lobe_width`
+/// finite and ≥ 0). The two-level product bounds it by `cone_bounds` if given, by evaluation
+/// otherwise.
 ///
 /// # Safety
 /// `mem` must be valid for `mem_size` bytes, `callbacks` for a read and `out` for a write; the
@@ -270,16 +217,7 @@ pub unsafe extern "C" fn ppis_brdf_init_callbacks(
     let make = || {
         // SAFETY: the caller vouches for `callbacks`.
         let c = unsafe { borrow(callbacks)? };
-        match (c.eval, c.sample, c.pdf) {
-            (Some(eval), Some(sample), Some(pdf)) => Ok(ppis_brdf(Kind::Callbacks(Callbacks {
-                user: c.user,
-                eval,
-                sample,
-                pdf,
-                is_diffuse: c.is_diffuse != 0,
-            }))),
-            _ => Err(ppis_status::PPIS_BAD_VALUE),
-        }
+        Callbacks::try_from(c).map(|c| ppis_brdf(Kind::Callbacks(c)))
     };
     // SAFETY: forwarded.
     unsafe { init(mem, mem_size, make, out) }
@@ -335,4 +273,40 @@ pub unsafe extern "C" fn ppis_brdf_sample(
             ppis_status::PPIS_NOTHING_TO_SAMPLE
         }
     }
+}
+
+/// Angular width in radians, roughly, of the BRDF's sharpest lobe: GGX α, Phong √(2/(n+2)),
+/// a car paint's coat, π/2 for a diffuse BRDF, a callback BRDF's own `lobe_width`. An engine
+/// scales by it how far shading points may be apart and still share a sampler; 0 for a null
+/// `brdf`.
+///
+/// # Safety
+/// `brdf` must be null or come from a `ppis_brdf_init_*`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ppis_brdf_lobe_width(brdf: *const ppis_brdf) -> f32 {
+    // SAFETY: the caller vouches for `brdf`.
+    unsafe { borrow(brdf) }.map_or(0.0, |b| b.lobe_width())
+}
+
+/// 1 when the BRDF is as smooth as a Lambertian one (product sampling gains little over
+/// environment sampling there), 0 otherwise or for a null `brdf`.
+///
+/// # Safety
+/// `brdf` must be null or come from a `ppis_brdf_init_*`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ppis_brdf_is_diffuse(brdf: *const ppis_brdf) -> i32 {
+    // SAFETY: the caller vouches for `brdf`.
+    unsafe { borrow(brdf) }.map_or(0, |b| i32::from(b.is_diffuse()))
+}
+
+/// 1 when the BRDF bounds itself over cones of directions (every built-in BRDF; a callback
+/// BRDF with `cone_bounds`), so the two-level product weighs cells by true bounds; 0
+/// otherwise or for a null `brdf`.
+///
+/// # Safety
+/// `brdf` must be null or come from a `ppis_brdf_init_*`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ppis_brdf_has_cone_bounds(brdf: *const ppis_brdf) -> i32 {
+    // SAFETY: the caller vouches for `brdf`.
+    unsafe { borrow(brdf) }.map_or(0, |b| i32::from(b.has_cone_bounds()))
 }

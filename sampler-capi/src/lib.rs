@@ -24,12 +24,14 @@
 #![warn(missing_docs)]
 
 mod brdf;
+mod callbacks;
 mod env;
 mod product;
 mod two_level;
 mod util;
 
 pub use brdf::*;
+pub use callbacks::*;
 pub use env::*;
 pub use product::*;
 pub use two_level::*;

@@ -90,7 +90,15 @@ fn bad_arguments_are_error_codes() {
             ppis_brdf_init_conductor(aligned(&mut mem), ppis_brdf_size(), f32::NAN, grey, &mut brdf),
             PPIS_BAD_VALUE
         );
-        let callbacks = ppis_brdf_callbacks { user: null_mut(), eval: None, sample: None, pdf: None, is_diffuse: 0 };
+        let callbacks = ppis_brdf_callbacks {
+            user: null_mut(),
+            eval: None,
+            sample: None,
+            pdf: None,
+            is_diffuse: 0,
+            lobe_width: 0.1,
+            cone_bounds: None,
+        };
         assert_eq!(
             ppis_brdf_init_callbacks(aligned(&mut mem), ppis_brdf_size(), &callbacks, &mut brdf),
             PPIS_BAD_VALUE

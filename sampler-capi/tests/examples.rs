@@ -1,7 +1,7 @@
 //! The C and C++ examples (`examples/c/embed.c`, `examples/cpp/embed.cpp`) compile with the
 //! system's compilers against the static library, run, pass their own check against
 //! quadrature, and draw through the C ABI the same directions and pdfs as the Rust API, bit for
-//! bit.
+//! bit. The equal-time comparison (`examples/c/glossy.c`) compiles and runs its quick version.
 
 use sampler_core::brdf::{Brdf, BrdfSample, RoughConductor};
 use sampler_core::cone::{Cone, build_cell_cones, cell_count};
@@ -124,10 +124,11 @@ fn paths() -> (PathBuf, PathBuf) {
     (lib, Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf())
 }
 
-/// Compiles one example with `compiler` and runs it: its standard output.
-fn build_and_run(compiler: &str, standard: &str, source: &str, libs: &[&str]) -> String {
+/// Compiles one example with `compiler` and runs it with `args`: its standard output.
+fn build_and_run(compiler: &str, standard: &str, source: &str, libs: &[&str], args: &[&str]) -> String {
     let (lib, root) = paths();
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("embed-{compiler}"));
+    let name = Path::new(source).file_stem().unwrap().to_string_lossy();
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{compiler}"));
     let status = Command::new(compiler)
         .args([standard, "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror"])
         .arg(root.join(source))
@@ -140,22 +141,37 @@ fn build_and_run(compiler: &str, standard: &str, source: &str, libs: &[&str]) ->
         .status()
         .unwrap_or_else(|e| panic!("cannot run {compiler} (a C/C++ compiler is needed): {e}"));
     assert!(status.success(), "{compiler} failed on {source}");
-    let run = Command::new(&out).output().unwrap();
+    let run = Command::new(&out).args(args).output().unwrap();
     let stdout = String::from_utf8(run.stdout).unwrap();
     assert!(run.status.success(), "{source} failed:\n{stdout}{}", String::from_utf8_lossy(&run.stderr));
-    assert!(stdout.lines().any(|l| l.starts_with("estimate") && l.ends_with("PASS")), "{stdout}");
     stdout
+}
+
+/// The embedding examples end with their estimate's check against quadrature.
+fn passed(stdout: &str) -> bool {
+    stdout.lines().any(|l| l.starts_with("estimate") && l.ends_with("PASS"))
 }
 
 #[test]
 fn the_c_example_draws_what_the_rust_api_draws() {
-    let stdout = build_and_run("cc", "-std=c99", "examples/c/embed.c", &["-lm", "-lpthread", "-ldl"]);
+    let stdout = build_and_run("cc", "-std=c99", "examples/c/embed.c", &["-lm", "-lpthread", "-ldl"], &[]);
+    assert!(passed(&stdout), "{stdout}");
     assert_eq!(sample_lines(&stdout), expected());
 }
 
 #[test]
 fn the_cpp_example_draws_what_the_rust_api_draws() {
-    let stdout = build_and_run("c++", "-std=c++17", "examples/cpp/embed.cpp", &["-lpthread", "-ldl"]);
+    let stdout = build_and_run("c++", "-std=c++17", "examples/cpp/embed.cpp", &["-lpthread", "-ldl"], &[]);
+    assert!(passed(&stdout), "{stdout}");
     let two_level: Vec<String> = expected().into_iter().filter(|l| l.starts_with("two-level")).collect();
     assert_eq!(sample_lines(&stdout), two_level);
+}
+
+#[test]
+fn the_c_equal_time_comparison_runs_and_its_methods_agree_with_the_reference() {
+    let stdout = build_and_run("cc", "-std=c99", "examples/c/glossy.c", &["-lm", "-lpthread", "-ldl"], &["--quick"]);
+    // One table row per material and sample count, every method measured.
+    let rows = stdout.lines().filter(|l| l.starts_with("| ") && l.contains(" µs, ")).count();
+    assert_eq!(rows, 3 * 2, "{stdout}");
+    assert_eq!(stdout.lines().last(), Some("PASS"), "{stdout}");
 }

@@ -78,10 +78,7 @@ pub fn product_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
 /// The share of an MIS budget `auto` spends on env samples (see [`AUTO_DIFFUSE_ENV_SHARE`]).
 #[must_use]
 pub fn auto_env_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
-    match bsdf {
-        Bsdf::Diffuse(_) if env_peak < SUN_PEAK => AUTO_DIFFUSE_ENV_SHARE,
-        _ => 0.5,
-    }
+    if bsdf.as_brdf().is_diffuse() && env_peak < SUN_PEAK { AUTO_DIFFUSE_ENV_SHARE } else { 0.5 }
 }
 
 #[cfg(test)]

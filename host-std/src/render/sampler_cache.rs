@@ -13,7 +13,6 @@ use crate::render::Context;
 use crate::render::pixel::Hit;
 use crate::render::shade::Sampling;
 use crate::render::strategy::{MaterialPlan, Strategy};
-use crate::scene::Bsdf;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
@@ -34,13 +33,13 @@ pub const REUSE_SHARE: f32 = 0.5;
 const WIDEST_REUSED_LOBE: f32 = 0.4;
 
 /// Cosine of the largest angle at which a product-MIS sampler built at one shading point is
-/// reused at another of the same material: [`REUSE_SHARE`] of its sharpest lobe's width, and at
-/// most of `WIDEST_REUSED_LOBE` (diffuse). Sharing stays unbiased whatever the angle (MIS
+/// reused at another of the same material: [`REUSE_SHARE`] of its sharpest lobe's width
+/// ([`Brdf::lobe_width`]), and at most of `WIDEST_REUSED_LOBE` (diffuse). Sharing stays unbiased whatever the angle (MIS
 /// with BRDF sampling and the defensive part cover every direction); the angle trades build
 /// time for variance.
 #[must_use]
-pub fn reuse_cosine(bsdf: &Bsdf) -> f32 {
-    (REUSE_SHARE * bsdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
+pub fn reuse_cosine(brdf: &dyn Brdf) -> f32 {
+    (REUSE_SHARE * brdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
 }
 
 /// `--brdf-samples` is at most the arena's capacity (the command line's range).
@@ -172,11 +171,12 @@ fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Bsdf;
     use sampler_core::brdf::{Lambert, RoughConductor};
 
     #[test]
     fn samplers_are_reused_within_half_the_sharpest_lobe() {
-        let close = |bsdf: &Bsdf, angle: f32| (reuse_cosine(bsdf) - angle.cos()).abs() < 1e-6;
+        let close = |bsdf: &Bsdf, angle: f32| (reuse_cosine(bsdf.as_brdf()) - angle.cos()).abs() < 1e-6;
         assert!(close(&Bsdf::Conductor(RoughConductor::new(0.05, Vec3::ONE)), 0.025));
         assert!(close(&Bsdf::Diffuse(Lambert::new(Vec3::ONE)), 0.2));
         let paint = sampler_core::brdf::CarPaint::default();

@@ -72,6 +72,6 @@ impl MaterialPlan {
     /// The plan that samples `bsdf` with `strategy`.
     #[must_use]
     pub fn new(strategy: Strategy, bsdf: &Bsdf) -> Self {
-        Self { strategy, reuse_cosine: reuse_cosine(bsdf) }
+        Self { strategy, reuse_cosine: reuse_cosine(bsdf.as_brdf()) }
     }
 }

@@ -118,18 +118,6 @@ impl Bsdf {
         }
     }
 
-    /// Angular width (radians, roughly) of the material's sharpest lobe: GGX α, Phong
-    /// √(2/(n+2)), car paint's coat (its flakes without one); π/2 for diffuse.
-    pub fn lobe_width(&self) -> f32 {
-        match self {
-            Bsdf::Diffuse(_) => std::f32::consts::FRAC_PI_2,
-            Bsdf::Conductor(c) => c.ggx.alpha(),
-            Bsdf::Phong(p) => (2.0 / (p.exponent + 2.0)).sqrt(),
-            Bsdf::CarPaint(c) if c.coat > 0.0 => c.coat_ggx.alpha(),
-            Bsdf::CarPaint(c) => c.flake_ggx.alpha(),
-        }
-    }
-
     /// A short name for summaries.
     pub fn kind(&self) -> &'static str {
         match self {

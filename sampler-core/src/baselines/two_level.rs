@@ -125,7 +125,7 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
         }
         self.built = None;
         let cumulative = &mut self.cumulative[..cells];
-        let bounded = brdf.cone_bounds(Vec3::Z, &[], &mut []);
+        let bounded = brdf.has_cone_bounds();
         let wo = frame.to_local(wo);
         // No cell's mean B·cos exceeds the whole reflectance over the cell's solid angle.
         let cap = brdf.reflectance_bound(wo).map_or(f32::INFINITY, |r| r * cell_count(level) as f32 / SPHERE_AREA);

@@ -77,12 +77,32 @@ impl CarPaint {
 }
 
 impl Brdf for CarPaint {
+    /// Diffuse when neither the coat nor the flakes reflect anything.
+    fn is_diffuse(&self) -> bool {
+        self.coat <= 0.0 && luminance(self.flake) == 0.0
+    }
+
+    /// The coat's α where there is a coat, the flakes' otherwise.
+    fn lobe_width(&self) -> f32 {
+        if self.coat > 0.0 {
+            self.coat_ggx.alpha()
+        } else if luminance(self.flake) > 0.0 {
+            self.flake_ggx.alpha()
+        } else {
+            core::f32::consts::FRAC_PI_2
+        }
+    }
+
+    fn has_cone_bounds(&self) -> bool {
+        true
+    }
+
     /// Each lobe bounded on its own: the coat's Fresnel at the smallest ωo·h of the cone, the
     /// light entering the base through the coat at most 1 − c·F0.
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         if wo.z <= 0.0 {
             out.iter_mut().zip(cones).for_each(|(o, _)| *o = 0.0);
-            return true;
+            return;
         }
         let (c, f) = (&self.coat_ggx, &self.flake_ggx);
         let transmit = (1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z)) * (1.0 - self.coat * self.coat_f0);
@@ -100,7 +120,6 @@ impl Brdf for CarPaint {
                 0.0
             };
         }
-        true
     }
 
     /// Each GGX lobe reflects at most its weight (F ≤ 1, G1(ωi) ≤ 1), the base its albedo.

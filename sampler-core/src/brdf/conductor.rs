@@ -26,8 +26,17 @@ impl RoughConductor {
 }
 
 impl Brdf for RoughConductor {
+    /// The GGX α.
+    fn lobe_width(&self) -> f32 {
+        self.ggx.alpha()
+    }
+
+    fn has_cone_bounds(&self) -> bool {
+        true
+    }
+
     /// specular · D·G1(ωo)/(4 cosθo) with G1(ωi) ≤ 1 and D bounded over the cone's half vectors.
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         let scale = if wo.z > 0.0 { luminance(self.specular) * self.ggx.g1(wo) / (4.0 * wo.z) } else { 0.0 };
         for (o, c) in out.iter_mut().zip(cones) {
             *o = if scale > 0.0 && c.max_cos(Vec3::Z) > 0.0 {
@@ -36,7 +45,6 @@ impl Brdf for RoughConductor {
                 0.0
             };
         }
-        true
     }
 
     /// With G1(ωi) ≤ 1 the integrand is at most specular × the visible-normal density.

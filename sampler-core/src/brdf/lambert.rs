@@ -59,12 +59,15 @@ impl Brdf for Lambert {
         true
     }
 
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    fn has_cone_bounds(&self) -> bool {
+        true
+    }
+
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         let scale = if wo.z > 0.0 { luminance(self.albedo) * FRAC_1_PI } else { 0.0 };
         for (o, c) in out.iter_mut().zip(cones) {
             *o = scale * c.max_cos(Vec3::Z).max(0.0);
         }
-        true
     }
 
     fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {

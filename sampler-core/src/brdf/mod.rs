@@ -97,13 +97,28 @@ pub trait Brdf {
         false
     }
 
+    /// Angular width in radians, roughly, of the BRDF's sharpest lobe that reflects anything:
+    /// GGX α, Phong √(2/(n+2)), π/2 for a diffuse BRDF. Hosts scale by it how far a shading
+    /// point may move before a sampler built at another no longer fits, and which sampler to
+    /// pick. The default is π/2 for a diffuse BRDF and 0 otherwise: a BRDF that does not say
+    /// is taken to be as sharp as a mirror, which never reuses a sampler it should not.
+    fn lobe_width(&self) -> f32 {
+        if self.is_diffuse() { core::f32::consts::FRAC_PI_2 } else { 0.0 }
+    }
+
+    /// True when [`Brdf::cone_bounds`] gives true upper bounds; the two-level product
+    /// ([`crate::two_level`]) otherwise estimates its weights by evaluation and floors them.
+    fn has_cone_bounds(&self) -> bool {
+        false
+    }
+
     /// Upper bounds of the luminance of [`Brdf::eval`] over cones of incident directions (local
     /// frame): `out[k] ≥ luminance(eval(wo, ωi))` for every ωi of `cones[k]` (as many as both
-    /// hold), as tight as is cheap. Returns false when the BRDF has no such bound; the
-    /// two-level product ([`crate::two_level`]) then estimates its weights by evaluation.
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
-        let _ = (wo, cones, out);
-        false
+    /// hold), as tight as is cheap. A BRDF that implements it says so by
+    /// [`Brdf::has_cone_bounds`]; the default writes +∞, the bound that always holds.
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
+        let _ = wo;
+        out.iter_mut().zip(cones).for_each(|(o, _)| *o = f32::INFINITY);
     }
 
     /// An upper bound of the directional reflectance ∫ luminance(eval(wo, ωi)) dωi, or `None`.
@@ -141,7 +156,13 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     fn is_diffuse(&self) -> bool {
         (**self).is_diffuse()
     }
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    fn lobe_width(&self) -> f32 {
+        (**self).lobe_width()
+    }
+    fn has_cone_bounds(&self) -> bool {
+        (**self).has_cone_bounds()
+    }
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         (**self).cone_bounds(wo, cones, out)
     }
     fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {

@@ -158,7 +158,17 @@ impl Brdf for Phong {
     }
 
     /// cosθi and cos α at their largest over the cone.
-    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) -> bool {
+    /// √(2/(n+2)): the angle at which the lobe cosᵑ falls to about 1/e; π/2 without a specular
+    /// lobe.
+    fn lobe_width(&self) -> f32 {
+        if self.is_diffuse() { core::f32::consts::FRAC_PI_2 } else { libm::sqrtf(2.0 / (self.exponent + 2.0)) }
+    }
+
+    fn has_cone_bounds(&self) -> bool {
+        true
+    }
+
+    fn cone_bounds(&self, wo: Vec3, cones: &[Cone], out: &mut [f32]) {
         let (kd, ks) = (luminance(self.kd) * FRAC_1_PI, luminance(self.ks) * ((self.exponent + 2.0) / TWO_PI));
         let r = reflect_z(wo);
         for (o, c) in out.iter_mut().zip(cones) {
@@ -171,7 +181,6 @@ impl Brdf for Phong {
                 0.0
             };
         }
-        true
     }
 
     /// The lobe (n+2)/(2π)·cosⁿα integrates to (n+2)/(n+1) over its hemisphere; cosθi ≤ 1.
