@@ -7,6 +7,7 @@ use crate::light::environment::{EnvSource, Placement};
 use crate::light::image_file;
 use crate::scene::texture::{ImageTexture, Wrap};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
+pub use host_usd::TimeCode;
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::{Mat3, Vec2, Vec3};
@@ -28,7 +29,7 @@ pub struct Converted {
 }
 
 /// How a USD scene is to be imported and framed: the command line's choices.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Options {
     /// The camera prim (default: the render settings', else the stage's first camera).
     pub camera: Option<String>,
@@ -41,6 +42,15 @@ pub struct Options {
     /// Leave the composed stage allocated after the import (host-usd's
     /// `Options::leak_stage`): for a process that exits once it has shown the import.
     pub leak_stage: bool,
+    /// The time code the stage is read at (default: the earliest, as host-usd's).
+    pub time: TimeCode,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        let time = host_usd::Options::default().time;
+        Self { camera: None, render_settings: None, width: None, height: None, leak_stage: false, time }
+    }
 }
 
 /// Imports `path` and converts it.
@@ -49,6 +59,7 @@ pub fn load(path: &Path, options: &Options) -> anyhow::Result<Converted> {
         camera: options.camera.clone(),
         render_settings: options.render_settings.clone(),
         leak_stage: options.leak_stage,
+        time: options.time,
     };
     let usd = host_usd::load_with(path, &import)?;
     Ok(convert(usd, (options.width, options.height)))

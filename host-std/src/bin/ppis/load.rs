@@ -37,6 +37,10 @@ pub(crate) fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>), exi
                         width: size.0,
                         height: size.1,
                         leak_stage: exits_after,
+                        time: match &args.frame {
+                            Some(f) => f.parse().map_err(anyhow::Error::msg)?,
+                            None => host_std::scene::usd::TimeCode::Earliest,
+                        },
                     };
                     let c = host_std::scene::usd::load(path, &options)?;
                     notes = c.notes;

@@ -23,6 +23,9 @@ pub(crate) fn settings_text(args: &RenderArgs, settings: &Settings, frame: (usiz
         }
         None => lines.push(("scene", "builtin".into())),
     }
+    if let Some(frame) = &scene.frame {
+        lines.push(("frame", frame.clone()));
+    }
     lines.push(("camera", scene.camera.clone().unwrap_or_default()));
     lines.push(("render_settings", scene.render_settings.clone().unwrap_or_default()));
     if let Some(path) = &scene.env {
