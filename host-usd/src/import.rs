@@ -115,6 +115,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         meters_per_unit,
         time_code: stage.time(),
         time_code_range: stage.time_code_range(),
+        layers: Vec::new(),
         meshes: Vec::new(),
         spheres: Vec::new(),
         materials: Vec::new(),
@@ -146,6 +147,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
     }
     imp.walk(&prims, &options).map_err(fail)?;
     let mut scene = imp.scene;
+    scene.layers = stage.layers();
     if let Some(name) = &options.camera
         && scene.camera.as_ref().is_none_or(|c| &c.path != name)
     {

@@ -149,6 +149,9 @@ pub struct UsdScene {
     pub time_code: crate::stage::TimeCode,
     /// The stage's `startTimeCode` and `endTimeCode`, when both are authored.
     pub time_code_range: Option<(f64, f64)>,
+    /// The identifiers of every layer the import read (the root layer, its sublayers, the
+    /// layers of references and payloads; `pkg.usdz[inner.usdc]` inside a package).
+    pub layers: Vec<String>,
     /// Triangle meshes in world space.
     pub meshes: Vec<Mesh>,
     /// Exact spheres.

@@ -78,6 +78,12 @@ impl Stage {
         Ok(self.inner.stage_metadata(field).map_err(err)?.map(convert))
     }
 
+    /// The identifiers of the layers composed so far (root layer stack, then those reached
+    /// through references and payloads): after a traversal, every layer the stage reads.
+    pub fn layers(&self) -> Vec<String> {
+        self.inner.layer_identifiers()
+    }
+
     /// The stage's `defaultPrim`, if authored.
     pub fn default_prim(&self) -> Option<String> {
         self.inner.default_prim().map(|t| t.as_str().to_string())

@@ -57,6 +57,8 @@ pub(crate) struct Prepared {
     pub(crate) bvh_seconds: f64,
     /// The pixels to render: `--crop`, checked against the frame, or the whole frame.
     pub(crate) crop: Crop,
+    /// The files the scene refers to (`Loaded::files`).
+    pub(crate) files: Vec<PathBuf>,
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
@@ -82,7 +84,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
-    let record = provenance::settings_text(&args, &settings, frame)?;
+    let record = provenance::settings_text(&args, &settings, frame, &prepared.files)?;
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
     let image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
 
@@ -138,7 +140,7 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
     let t_load = Instant::now();
     let loaded = load_scene(&args.scene, args.sampling.size(), false)?;
     warn_notes(&loaded.scene, &loaded.notes);
-    let mut scene = loaded.scene;
+    let (mut scene, files) = (loaded.scene, loaded.files);
     args.sampling.resize(&mut scene);
     let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
     let crop = match args.crop {
@@ -161,7 +163,7 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
             env.stats.source, env.stats.sanitized
         );
     }
-    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop })
+    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop, files })
 }
 
 /// One line per material `auto`'s pilot measured.

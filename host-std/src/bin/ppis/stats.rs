@@ -16,6 +16,8 @@ pub(crate) struct Stats {
     brdf_samples: u32,
     bvh_seconds: f64,
     camera_rays: u64,
+    /// The pixels rendered, x0, y0, x1, y1 (half-open): `--crop`, or the whole frame.
+    crop: [usize; 4],
     env_build_seconds: f64,
     env_bytes: Option<usize>,
     env_level: Option<u32>,
@@ -27,6 +29,10 @@ pub(crate) struct Stats {
     env_peak: Option<f64>,
     env_sanitized_texels: Option<usize>,
     env_source_mean_rgb: Option<[f64; 3]>,
+    /// The whole frame's size; `width` and `height` are the crop's.
+    frame_height: usize,
+    frame_width: usize,
+    /// The image's height (the crop's).
     height: usize,
     /// The scene's and the environment's.
     load_seconds: f64,
@@ -47,7 +53,10 @@ pub(crate) struct Stats {
     shadow_rays: u64,
     spp: u32,
     threads: usize,
+    /// `--frame` as given (a USD time code), `null` without it.
+    time_code: Option<String>,
     unshadowed: bool,
+    /// The image's width (the crop's).
     width: usize,
 }
 
@@ -91,6 +100,7 @@ impl Stats {
             brdf_samples: args.sampling.brdf_samples,
             bvh_seconds: prepared.bvh_seconds,
             camera_rays: image.camera_rays,
+            crop: [prepared.crop.x0, prepared.crop.y0, prepared.crop.x1, prepared.crop.y1],
             env_build_seconds: env_build,
             env_bytes: env.map(|e| e.stats.bytes),
             env_level: env.map(|e| e.level),
@@ -103,6 +113,8 @@ impl Stats {
             env_peak: hierarchy.map(|h| f64::from(h.peak(5))),
             env_sanitized_texels: env.map(|e| e.stats.sanitized),
             env_source_mean_rgb: env.map(|e| e.stats.source_mean),
+            frame_height: scene.camera.height as usize,
+            frame_width: scene.camera.width as usize,
             height: image.height,
             load_seconds: prepared.load_seconds + env_load,
             method: args.method.name(),
@@ -119,6 +131,7 @@ impl Stats {
             shadow_rays: image.shadow_rays,
             spp: args.spp,
             threads,
+            time_code: args.scene.frame.clone(),
             unshadowed: args.sampling.unshadowed,
             width: image.width,
         }
