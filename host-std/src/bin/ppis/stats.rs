@@ -14,11 +14,16 @@ pub(crate) struct Stats {
     /// `auto`: per material its pilot's plan and scores (empty otherwise).
     auto_plans: Vec<AutoPlan>,
     brdf_samples: u32,
+    /// The process's CPU seconds (every thread) building the BVH.
+    bvh_cpu_seconds: Option<f64>,
     bvh_seconds: f64,
     camera_rays: u64,
     /// The pixels rendered, x0, y0, x1, y1 (half-open): `--crop`, or the whole frame.
     crop: [usize; 4],
     env_build_seconds: f64,
+    /// The process's CPU seconds (every thread) reading the environment map and building the
+    /// equal-area map and its pyramid.
+    env_cpu_seconds: Option<f64>,
     env_bytes: Option<usize>,
     env_level: Option<u32>,
     env_map_mean_rgb: Option<[f64; 3]>,
@@ -34,6 +39,8 @@ pub(crate) struct Stats {
     frame_width: usize,
     /// The image's height (the crop's).
     height: usize,
+    /// The process's CPU seconds (every thread) loading the scene.
+    load_cpu_seconds: Option<f64>,
     /// The scene's and the environment's.
     load_seconds: f64,
     method: &'static str,
@@ -98,10 +105,12 @@ impl Stats {
                 })
                 .collect(),
             brdf_samples: args.sampling.brdf_samples,
+            bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
             bvh_seconds: prepared.bvh_seconds,
             camera_rays: image.camera_rays,
             crop: [prepared.crop.x0, prepared.crop.y0, prepared.crop.x1, prepared.crop.y1],
             env_build_seconds: env_build,
+            env_cpu_seconds: prepared.cpu_seconds.filter(|_| env.is_some()).map(|c| c[1]),
             env_bytes: env.map(|e| e.stats.bytes),
             env_level: env.map(|e| e.level),
             env_map_mean_rgb: env.map(|e| e.stats.map_mean),
@@ -116,6 +125,7 @@ impl Stats {
             frame_height: scene.camera.height as usize,
             frame_width: scene.camera.width as usize,
             height: image.height,
+            load_cpu_seconds: prepared.cpu_seconds.map(|c| c[0]),
             load_seconds: prepared.load_seconds + env_load,
             method: args.method.name(),
             non_finite_pixels: image.non_finite,
