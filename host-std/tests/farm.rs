@@ -156,7 +156,7 @@ fn a_merge_refuses_tiles_of_other_frames_and_of_changed_referenced_files() {
     small_tile(dir, "scene.json", &["--frame", "1", "--stats-json", "left.json"], left, "left.exr");
     // Another frame of the same scene.
     small_tile(dir, "scene.json", &["--frame", "2"], right, "second.exr");
-    fn merge<'a>(tiles: [&'a str; 2]) -> [&'a str; 5] {
+    fn merge(tiles: [&str; 2]) -> [&str; 5] {
         ["merge", tiles[0], tiles[1], "-o", "frame.exr"]
     }
     fails(
