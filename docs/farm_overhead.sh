@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # The cost of tiling (docs/farm.md, "Overhead"): a frame rendered in one process, then as 4, 16
-# and 64 tiles in one process each, one after the other, all at one thread; per split the sum of
-# the processes' wall clocks, of their render_seconds and env_build_seconds (--stats-json), the
-# largest resident set (/usr/bin/time), and whether the merge is the frame byte for byte.
+# and 64 tiles in one process each, one after the other, all at one thread; per split the sum
+# over the processes of their CPU time (user + system, /usr/bin/time), of the render's
+# (render_cpu_seconds), the environment's (env_cpu_seconds: reading the map, the equal-area
+# resampling and the pyramid) and the scene load's (load_cpu_seconds) from --stats-json, the
+# rest (start-up, BVH, writing the files), the sum of wall clocks, the largest and the mean
+# resident set (/usr/bin/time), and whether the merge is the frame byte for byte. CPU time, not
+# wall clock: on a machine shared with other work a process's wall clock grows with the load.
 # Usage: docs/farm_overhead.sh PPIS [SCENE [ARGS…]] (SCENE: a JSON or USD file, default the
 # built-in; ARGS go to every `ppis render` and `ppis tiles`, e.g. `--env SQUARE.exr
 # --env-rotate-y 30` for the environment cached by `ppis env`: give its path absolute).
@@ -16,21 +20,25 @@ trap 'rm -rf "$dir"' EXIT
 cd "$dir"
 run() { # run NAME ARGS…: one process, its wall clock and max RSS appended to NAME.time
   local name=$1; shift
-  /usr/bin/time -f "%e %M" -a -o "$name.time" "$ppis" render "${scene[@]}" "${frame[@]}" "$@" \
+  /usr/bin/time -f "%e %U %S %M" -a -o "$name.time" "$ppis" render "${scene[@]}" "${frame[@]}" "$@" \
     --stats-json "$name.$RANDOM$RANDOM.json" 2>/dev/null
 }
-sum() { # sum PREFIX: wall, render, env build, max RSS over PREFIX's processes
+sum() { # sum PREFIX: over PREFIX's processes, CPU s (all, render, env, load, rest), wall s, RSS MB
   python3 - "$1" <<'PY'
 import glob, json, sys
 p = sys.argv[1]
-times = [l.split() for l in open(p + ".time")]
+times = [[float(x) for x in l.split()] for l in open(p + ".time") if l[0].isdigit()]
 stats = [json.load(open(f)) for f in glob.glob(p + ".*.json")]
-print("%-6s %5d %8.2f %8.2f %8.3f %7.1f" % (p, len(times), sum(float(t[0]) for t in times),
-      sum(s["render_seconds"] for s in stats), sum(s["env_build_seconds"] for s in stats),
-      max(int(t[1]) for t in times) / 1024))
+cpu = sum(t[1] + t[2] for t in times)
+render = sum(s["render_cpu_seconds"] for s in stats)
+env = sum(s["env_cpu_seconds"] or 0.0 for s in stats)
+load = sum(s["load_cpu_seconds"] for s in stats)
+rss = [t[3] / 1024 for t in times]
+print("%-6s %5d %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.1f %7.1f" % (p, len(times), cpu, render, env, load,
+      cpu - render - env - load, sum(t[0] for t in times), max(rss), sum(rss) / len(rss)))
 PY
 }
-echo "split  procs   wall s render s  env s  max RSS MB"
+echo "split  procs    CPU s   render      env     load     rest   wall s  maxRSS meanRSS"
 run frame -o frame.exr
 sum frame
 for n in 4 16 64; do

@@ -128,3 +128,79 @@ fn a_crop_outside_the_frame_empty_or_reversed_is_refused() {
     fails(dir, &["tiles", "--width", "4", "--height", "4", "--count", "32"], "--count 32");
     fails(dir, &["tiles", "--width", "64", "--height", "48", "--count", "4", "--index", "4"], "--index 4");
 }
+
+/// A 32×16 frame of `scene` (in `dir`) lit by its map, as tile `crop`.
+fn small_tile(dir: &Path, scene: &str, extra: &[&str], crop: &str, out: &str) {
+    let mut args = vec!["render", scene, "--width", "32", "--height", "16", "--spp", "1", "--method", "env"];
+    args.extend(["--threads", "1", "--crop", crop, "-o", out]);
+    args.extend(extra);
+    ok(dir, &args);
+}
+
+#[test]
+fn a_merge_refuses_tiles_of_other_frames_and_of_changed_referenced_files() {
+    let tmp = tempfile::Builder::new().prefix("ppis-inputs-").tempdir().unwrap();
+    let dir = tmp.path();
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host-usd/tests/fixtures");
+    let map = std::fs::read(fixtures.join("twins_env.exr")).unwrap();
+    std::fs::write(dir.join("sky.exr"), &map).unwrap();
+    std::fs::write(
+        dir.join("scene.json"),
+        r#"{"envmap": {"file": "sky.exr"},
+            "camera": {"origin": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40, "width": 32, "height": 16},
+            "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                        "material": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}]}"#,
+    )
+    .unwrap();
+    let (left, right) = ("0,0,16,16", "16,0,32,16");
+    small_tile(dir, "scene.json", &["--frame", "1", "--stats-json", "left.json"], left, "left.exr");
+    // Another frame of the same scene.
+    small_tile(dir, "scene.json", &["--frame", "2"], right, "second.exr");
+    fn merge(tiles: [&str; 2]) -> [&str; 5] {
+        ["merge", tiles[0], tiles[1], "-o", "frame.exr"]
+    }
+    fails(
+        dir,
+        &merge(["left.exr", "second.exr"]),
+        "second.exr: a tile of another render than left.exr (frame=2 against frame=1)",
+    );
+    // The map the scene file names, changed between the tiles (a texel brighter).
+    let mut brighter = map.clone();
+    let last = brighter.len() - 8;
+    brighter[last] ^= 0x40;
+    std::fs::write(dir.join("sky.exr"), &brighter).unwrap();
+    small_tile(dir, "scene.json", &["--frame", "1"], right, "changed.exr");
+    fails(
+        dir,
+        &merge(["left.exr", "changed.exr"]),
+        "changed.exr: a tile of another render than left.exr (reads=sky.exr ",
+    );
+    std::fs::write(dir.join("sky.exr"), &map).unwrap();
+    small_tile(dir, "scene.json", &["--frame", "1"], right, "right.exr");
+    ok(dir, &merge(["left.exr", "right.exr"]));
+    std::fs::remove_file(dir.join("frame.exr")).unwrap();
+    std::fs::remove_file(dir.join("frame.png")).unwrap();
+    // A crop's stats: its own size, and the frame's.
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("left.json")).unwrap()).unwrap();
+    assert_eq!((stats["width"].as_u64(), stats["height"].as_u64()), (Some(16), Some(16)));
+    assert_eq!((stats["frame_width"].as_u64(), stats["frame_height"].as_u64()), (Some(32), Some(16)));
+    assert_eq!((stats["crop"].to_string(), stats["time_code"].as_str()), ("[0,0,16,16]".into(), Some("1")));
+
+    // A USD stage's sublayer, changed between the tiles.
+    let layer = |x: f64| {
+        format!(
+            "#usda 1.0\ndef Sphere \"Ball\" {{\n    double3 xformOp:translate = ({x}, 0, -6)\n    uniform token[] xformOpOrder = [\"xformOp:translate\"]\n}}\n"
+        )
+    };
+    std::fs::write(dir.join("root.usda"), "#usda 1.0\n(\n    subLayers = [@ball.usda@]\n)\n").unwrap();
+    std::fs::write(dir.join("ball.usda"), layer(0.0)).unwrap();
+    let env = ["--env", "sky.exr"];
+    small_tile(dir, "root.usda", &env, left, "usd_left.exr");
+    std::fs::write(dir.join("ball.usda"), layer(0.5)).unwrap();
+    small_tile(dir, "root.usda", &env, right, "usd_changed.exr");
+    fails(dir, &merge(["usd_left.exr", "usd_changed.exr"]), "(reads=ball.usda ");
+    std::fs::write(dir.join("ball.usda"), layer(0.0)).unwrap();
+    small_tile(dir, "root.usda", &env, right, "usd_right.exr");
+    ok(dir, &merge(["usd_left.exr", "usd_right.exr"]));
+}

@@ -1,13 +1,14 @@
 //! Conformance against Pixar's answers: a `*.expected.json` beside a USD file holds what
 //! Pixar's own library computes (stage metadata; per prim its type, world matrix, bound
 //! material, point and face counts; PointInstancer instance transforms; how many gprims,
-//! meshes and instances a renderer draws). [`check`] recomputes each with host-usd and
+//! meshes and instances a renderer draws), all at the default time code, and optionally world
+//! matrices at other time codes (`frames`). [`check`] recomputes each with host-usd and
 //! reports every difference; world matrices must agree to 1e-9.
 
 use crate::import;
 use crate::instancer;
 use crate::mesh;
-use crate::stage::{PrimPath, Stage, Value};
+use crate::stage::{PrimPath, Stage, TimeCode, Value};
 use crate::xform::WorldTransforms;
 use glam::DMat4;
 use serde_json::Value as Json;
@@ -46,7 +47,7 @@ pub fn check(usd: &Path, expected: &Path) -> Result<Report, String> {
 fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     let text = std::fs::read_to_string(expected).map_err(|e| format!("{}: {e}", expected.display()))?;
     let want: Json = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", expected.display()))?;
-    let stage = import::open(usd).map_err(|e| e.to_string())?;
+    let stage = import::open(usd, TimeCode::Default).map_err(|e| e.to_string())?;
     let mut r = Report::default();
     let mut mismatches = Vec::new();
     let mut mismatch = |m: String| mismatches.push(m);
@@ -108,6 +109,11 @@ fn check_unguarded(usd: &Path, expected: &Path) -> Result<Report, String> {
     }
     if let Some(counts) = want.get("counts") {
         check_counts(usd, counts, &mut mismatch)?;
+    }
+    if let Some(frames) = want["frames"].as_object() {
+        let (n, err) = check_frames(usd, frames, &mut mismatch)?;
+        n_mat += n;
+        max_err = max_err.max(err);
     }
     r.mismatches = mismatches;
     r.prims = prims.len();
@@ -229,10 +235,35 @@ fn check_instancer(
     Ok((transforms.len(), max_err))
 }
 
+/// World matrices at other time codes: `frames` maps a time code (`earliest` or a number) to
+/// the world matrices of prims at it. Returns the matrices compared and their largest error.
+fn check_frames(
+    usd: &Path,
+    frames: &serde_json::Map<String, Json>,
+    mismatch: &mut impl FnMut(String),
+) -> Result<(usize, f64), String> {
+    let (mut n, mut max_err) = (0, 0.0f64);
+    for (time, prims) in frames {
+        let time: TimeCode = time.parse()?;
+        let stage = import::open(usd, time).map_err(|e| e.to_string())?;
+        let mut worlds = WorldTransforms::default();
+        for (path, rows) in prims.as_object().into_iter().flatten() {
+            let err = matrix_error(&worlds.world(&stage, &PrimPath::new(path)?)?, rows);
+            if err > MATRIX_TOLERANCE {
+                mismatch(format!("{path} at time code {time}: world matrix differs from Pixar's by {err:.3e}"));
+            }
+            max_err = max_err.max(err);
+            n += 1;
+        }
+    }
+    Ok((n, max_err))
+}
+
 /// How many gprims, meshes and instances the import draws, against Pixar's count of those a
 /// viewer draws.
 fn check_counts(usd: &Path, want: &Json, mismatch: &mut impl FnMut(String)) -> Result<(), String> {
-    let scene = import::load(usd).map_err(|e| e.to_string())?;
+    let options = import::Options { time: TimeCode::Default, ..Default::default() };
+    let scene = import::load_with(usd, &options).map_err(|e| e.to_string())?;
     let c = &scene.counts;
     for (key, ours) in [("gprims", c.gprims), ("meshes", c.meshes), ("instances", c.instances)] {
         if want[key].as_u64() != Some(ours as u64) {

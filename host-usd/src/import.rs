@@ -4,7 +4,7 @@
 use crate::error::UsdError;
 use crate::inherit::Hidden;
 use crate::scene::{Counts, Skip, UpAxis, UsdScene};
-use crate::stage::{PrimPath, Stage, Value};
+use crate::stage::{PrimPath, Stage, TimeCode, Value};
 use crate::xform::{WorldTransforms, up_axis_conversion};
 use crate::{camera, dome, instancer, render_settings};
 use glam::DMat4;
@@ -16,7 +16,7 @@ mod gprim;
 mod material_binding;
 
 /// Import options.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Options {
     /// The camera prim to use (default: the render settings' camera, else the stage's first).
     pub camera: Option<String>,
@@ -26,6 +26,15 @@ pub struct Options {
     /// Freeing a large stage is a tenth to a fifth of its import; a process about to exit
     /// (`ppis info`) need not pay it. The stage's memory is never returned.
     pub leak_stage: bool,
+    /// The time code the stage is read at (default: [`TimeCode::Earliest`], as `usdrecord`
+    /// renders without a frame).
+    pub time: TimeCode,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self { camera: None, render_settings: None, leak_stage: false, time: TimeCode::Earliest }
+    }
 }
 
 /// Gprim types the importer renders.
@@ -61,15 +70,15 @@ pub fn load(file: &Path) -> Result<UsdScene, UsdError> {
     load_with(file, &Options::default())
 }
 
-/// Opens the stage, with errors naming the file. A layer, reference or payload that cannot
-/// be found or read does not stop the import (Pixar's library opens such stages too): the
-/// import lists it among the skips.
-pub fn open(file: &Path) -> Result<Stage, UsdError> {
+/// Opens the stage to read at `time`, with errors naming the file. A layer, reference or
+/// payload that cannot be found or read does not stop the import (Pixar's library opens such
+/// stages too): the import lists it among the skips.
+pub fn open(file: &Path, time: TimeCode) -> Result<Stage, UsdError> {
     if !file.is_file() {
         return Err(UsdError::NotFound { file: file.to_owned() });
     }
     crate::guard::guarded(file, || {
-        Stage::open(file).map_err(|message| UsdError::Open { file: file.to_owned(), message })
+        Stage::open(file, time).map_err(|message| UsdError::Open { file: file.to_owned(), message })
     })
 }
 
@@ -80,7 +89,7 @@ pub fn load_with(file: &Path, options: &Options) -> Result<UsdScene, UsdError> {
 
 fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> {
     let t0 = Instant::now();
-    let stage = open(file)?;
+    let stage = open(file, options.time)?;
     let at = |prim: &str| {
         let (file, prim) = (file.to_owned(), prim.to_string());
         move |message: String| UsdError::Prim { file, prim, message }
@@ -105,6 +114,8 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         up_axis,
         meters_per_unit,
         time_code: stage.time(),
+        time_code_range: stage.time_code_range(),
+        layers: Vec::new(),
         meshes: Vec::new(),
         spheres: Vec::new(),
         materials: Vec::new(),
@@ -136,6 +147,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
     }
     imp.walk(&prims, &options).map_err(fail)?;
     let mut scene = imp.scene;
+    scene.layers = stage.layers();
     if let Some(name) = &options.camera
         && scene.camera.as_ref().is_none_or(|c| &c.path != name)
     {

@@ -25,3 +25,4 @@ pub mod xform_ops;
 pub use error::UsdError;
 pub use import::{Options, load, load_with};
 pub use scene::*;
+pub use stage::TimeCode;

@@ -145,8 +145,13 @@ pub struct UsdScene {
     pub up_axis: UpAxis,
     /// The stage's `metersPerUnit`.
     pub meters_per_unit: f64,
-    /// The time code values are read at (the stage's start).
-    pub time_code: f64,
+    /// The time code values were read at.
+    pub time_code: crate::stage::TimeCode,
+    /// The stage's `startTimeCode` and `endTimeCode`, when both are authored.
+    pub time_code_range: Option<(f64, f64)>,
+    /// The identifiers of every layer the import read (the root layer, its sublayers, the
+    /// layers of references and payloads; `pkg.usdz[inner.usdc]` inside a package).
+    pub layers: Vec<String>,
     /// Triangle meshes in world space.
     pub meshes: Vec<Mesh>,
     /// Exact spheres.

@@ -86,7 +86,9 @@ pub fn local_transform(stage: &Stage, prim: &PrimPath) -> Result<(DMat4, bool), 
         let kind = kind.ok_or_else(|| format!("xformOpOrder entry {op:?} is not an xformOp"))?;
         let op_m = match stage.value(prim, name)? {
             Some(v) => op_matrix(kind, &v)?,
-            None if inverted => DMat4::IDENTITY,
+            // Pixar's op transform is the identity where the op has no value: an inverted op
+            // whose attribute is absent, or a time-sampled op read at the default time code.
+            None if inverted || stage.is_time_sampled(prim, name)? => DMat4::IDENTITY,
             None => return Err(format!("{name} is listed in xformOpOrder but has no value")),
         };
         let op_m = if inverted {

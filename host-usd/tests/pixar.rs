@@ -35,7 +35,7 @@ fn instancer_transforms_match_pixar() {
         let usd = fixtures().join(file);
         let text = std::fs::read_to_string(fixtures().join("instancing.expected.json")).unwrap();
         let want: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let stage = host_usd::import::open(&usd).unwrap();
+        let stage = host_usd::import::open(&usd, host_usd::TimeCode::Default).unwrap();
         let mut worlds = WorldTransforms::default();
         for (path, w) in want["instancers"].as_object().unwrap() {
             let (protos, instances) =

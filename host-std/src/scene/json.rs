@@ -171,6 +171,20 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, path)
 }
 
+/// The files a scene file reads besides itself — its meshes and environment map — as
+/// [`load`] resolves them.
+pub fn files_read(path: &Path) -> Result<Vec<PathBuf>, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_owned(), error })?;
+    let json: JsonScene =
+        serde_json::from_str(&text).map_err(|e| SceneError::Json { path: path.to_owned(), message: e.to_string() })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let meshes = json.shapes.into_iter().filter_map(|s| match s {
+        JsonShape::Mesh { file, .. } => Some(dir.join(file)),
+        _ => None,
+    });
+    Ok(meshes.chain(json.envmap.map(|e| dir.join(e.file))).collect())
+}
+
 /// Parses scene JSON; `path` names the file in errors and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let json: JsonScene =

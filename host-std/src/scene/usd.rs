@@ -7,6 +7,7 @@ use crate::light::environment::{EnvSource, Placement};
 use crate::light::image_file;
 use crate::scene::texture::{ImageTexture, Wrap};
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
+pub use host_usd::TimeCode;
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
 use sampler_core::glam::{Mat3, Vec2, Vec3};
@@ -25,10 +26,13 @@ pub struct Converted {
     pub notes: Vec<String>,
     /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
     pub usd: UsdScene,
+    /// Every file the import read: its layers, the textures and the dome's map (a package
+    /// once for everything inside it), sorted.
+    pub files: Vec<PathBuf>,
 }
 
 /// How a USD scene is to be imported and framed: the command line's choices.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Options {
     /// The camera prim (default: the render settings', else the stage's first camera).
     pub camera: Option<String>,
@@ -41,6 +45,15 @@ pub struct Options {
     /// Leave the composed stage allocated after the import (host-usd's
     /// `Options::leak_stage`): for a process that exits once it has shown the import.
     pub leak_stage: bool,
+    /// The time code the stage is read at (default: the earliest, as host-usd's).
+    pub time: TimeCode,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        let time = host_usd::Options::default().time;
+        Self { camera: None, render_settings: None, width: None, height: None, leak_stage: false, time }
+    }
 }
 
 /// Imports `path` and converts it.
@@ -49,6 +62,7 @@ pub fn load(path: &Path, options: &Options) -> anyhow::Result<Converted> {
         camera: options.camera.clone(),
         render_settings: options.render_settings.clone(),
         leak_stage: options.leak_stage,
+        time: options.time,
     };
     let usd = host_usd::load_with(path, &import)?;
     Ok(convert(usd, (options.width, options.height)))
@@ -67,6 +81,21 @@ fn image_size(usd: &UsdScene, cam: &host_usd::Camera, size: (Option<u32>, Option
         (None, Some(h)) => (((h as f32 * aspect).round() as u32).max(1), h),
         (None, None) => (DEFAULT_WIDTH, ((DEFAULT_WIDTH as f32 / aspect).round() as u32).max(1)),
     }
+}
+
+/// The files behind the stage's layers, textures and dome map: an asset inside a package
+/// (`pkg.usdz[tex/a.png]`) is the package's file; identifiers that are not files (anonymous
+/// layers) are left out.
+fn files_read(usd: &UsdScene) -> Vec<PathBuf> {
+    let textures = usd.materials.iter().flat_map(|m| &m.textures).filter_map(|t| t.source.resolved.as_deref());
+    let dome = usd.dome.iter().filter_map(|d| d.texture.as_ref().map(|(name, _)| name.as_str()));
+    let mut files: Vec<PathBuf> = (usd.layers.iter().map(String::as_str).chain(textures).chain(dome))
+        .map(|id| PathBuf::from(id.split_once('[').map_or(id, |(file, _)| file)))
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    files.dedup();
+    files
 }
 
 /// A texture's file name with a usable extension (`pkg.usdz[tex/a.png]` → `pkg.usdz/tex/a.png`).
@@ -175,6 +204,7 @@ fn bsdf(l: &Lobes) -> Bsdf {
 
 /// Converts an imported USD scene, rendered at `size` (width, height) where given.
 pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted {
+    let files = files_read(&usd);
     let mut notes: Vec<String> = usd.skipped.iter().map(|s| format!("{}: {}", s.path, s.what)).collect();
     // Decode each material's textures; the material's plain BRDF is its value at their means.
     let mut textured: Vec<Option<TextureHandle>> = Vec::with_capacity(usd.materials.len());
@@ -248,5 +278,5 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted
     });
     let name = usd.file.file_name().map_or_else(|| "usd".into(), |n| n.to_string_lossy().into_owned());
     let scene = Scene { name, camera, objects, materials, env, hide_emitters: false };
-    Converted { scene, notes, usd }
+    Converted { scene, notes, usd, files }
 }

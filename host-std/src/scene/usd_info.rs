@@ -12,7 +12,10 @@ pub fn print_import(u: &host_usd::UsdScene) {
         u.file.display(),
         u.up_axis,
         u.meters_per_unit,
-        u.time_code,
+        match u.time_code_range {
+            Some((start, end)) => format!("{} (the stage's range {start} to {end})", u.time_code),
+            None => u.time_code.to_string(),
+        },
         u.import_seconds
     );
     println!(

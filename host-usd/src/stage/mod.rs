@@ -6,10 +6,12 @@
 
 mod prim_path;
 mod shading;
+mod time;
 mod value;
 
 pub use prim_path::{PrimPath, PrimRef};
 pub use shading::{Input, PreviewInputs, TextureRef};
+pub use time::TimeCode;
 pub use value::Value;
 use value::convert;
 
@@ -35,7 +37,7 @@ impl Xformable for AnyXformable {}
 /// An opened, composed USD stage.
 pub struct Stage {
     inner: usd::Stage,
-    time: usd::TimeCode,
+    time: TimeCode,
     /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
     binding_api: RefCell<HashMap<sdf::Path, bool>>,
     /// The composed property names of the prim asked about last (see [`Stage::authors`]).
@@ -54,11 +56,10 @@ fn path(p: &str) -> Result<sdf::Path> {
 
 impl Stage {
     /// Opens `file` (usda, usdc or usdz), composing sublayers, references, payloads and
-    /// variants. Values are read at the stage's start time code.
-    pub fn open(file: &Path) -> Result<Self> {
+    /// variants. Values are read at `time`.
+    pub fn open(file: &Path, time: TimeCode) -> Result<Self> {
         let name = file.to_str().ok_or_else(|| "the path is not valid UTF-8".to_string())?;
         let inner = usd::Stage::open(name).map_err(err)?;
-        let time = usd::TimeCode::new(inner.start_time_code());
         Ok(Self { inner, time, binding_api: RefCell::default(), properties: RefCell::default() })
     }
 
@@ -77,14 +78,26 @@ impl Stage {
         Ok(self.inner.stage_metadata(field).map_err(err)?.map(convert))
     }
 
+    /// The identifiers of the layers composed so far (root layer stack, then those reached
+    /// through references and payloads): after a traversal, every layer the stage reads.
+    pub fn layers(&self) -> Vec<String> {
+        self.inner.layer_identifiers()
+    }
+
     /// The stage's `defaultPrim`, if authored.
     pub fn default_prim(&self) -> Option<String> {
         self.inner.default_prim().map(|t| t.as_str().to_string())
     }
 
     /// The time code values are read at.
-    pub fn time(&self) -> f64 {
-        self.time.value()
+    pub fn time(&self) -> TimeCode {
+        self.time
+    }
+
+    /// The stage's `startTimeCode` and `endTimeCode`, when both are authored.
+    pub fn time_code_range(&self) -> Option<(f64, f64)> {
+        let inner = &self.inner;
+        inner.has_authored_time_code_range().then(|| (inner.start_time_code(), inner.end_time_code()))
     }
 
     /// Every active, loaded, defined, non-abstract prim, depth first, including the
@@ -157,19 +170,24 @@ impl Stage {
         Ok(names.iter().any(|n| n.as_str() == name))
     }
 
-    /// The composed value of `prim.attr` at the stage's start time (time samples
-    /// interpolated), or its default; `None` when unauthored.
+    /// The composed value of `prim.attr` at the stage's time code (see [`TimeCode`]);
+    /// `None` when unauthored, blocked, or (at [`TimeCode::Default`]) time-sampled only.
     pub fn value(&self, prim: &(impl PrimRef + ?Sized), attr: &str) -> Result<Option<Value>> {
         if !self.authors(prim, attr)? {
             return Ok(None);
         }
         let a = self.inner.prim(self.path(prim)?).attribute(attr);
-        let v = a.get_at::<sdf::Value>(self.time).map_err(|e| format!("{prim}.{attr}: {}", err(e)))?;
-        let v = match v {
-            Some(v) => Some(v),
-            None => a.get::<sdf::Value>().map_err(|e| format!("{prim}.{attr}: {}", err(e)))?,
-        };
+        let v = a.get_at::<sdf::Value>(self.time.query()).map_err(|e| format!("{prim}.{attr}: {}", err(e)))?;
         Ok(v.map(convert))
+    }
+
+    /// Whether `prim.attr` has time samples (composed, from any layer).
+    pub fn is_time_sampled(&self, prim: &(impl PrimRef + ?Sized), attr: &str) -> Result<bool> {
+        if !self.authors(prim, attr)? {
+            return Ok(false);
+        }
+        let a = self.inner.prim(self.path(prim)?).attribute(attr);
+        Ok(a.num_time_samples().map_err(|e| format!("{prim}.{attr}: {}", err(e)))? > 0)
     }
 
     /// A metadata field of an attribute (`interpolation`, `elementSize`).
@@ -204,10 +222,10 @@ impl Stage {
         Ok(x.compute_visibility().map_err(err)? == openusd::schemas::geom::Visibility::Invisible)
     }
 
-    /// Whether the prim itself authors `visibility = invisible` (its default value, as
-    /// UsdGeomImageable's ComputeVisibility reads it).
+    /// Whether the prim itself authors `visibility = invisible` at the stage's time code (as
+    /// UsdGeomImageable's ComputeVisibility reads it: visibility may be animated).
     pub fn authored_invisible(&self, prim: &(impl PrimRef + ?Sized)) -> Result<bool> {
-        let v = self.attr_metadata(prim, "visibility", "default")?;
+        let v = self.value(prim, "visibility")?;
         Ok(matches!(v, Some(Value::Token(t)) if t == "invisible"))
     }
 

@@ -32,6 +32,24 @@ pub(crate) struct SceneArgs {
     /// Rotation of the environment about +Y in degrees (d_world = R_y·d_local).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) env_rotate_y: Option<f32>,
+    /// USD: the time code to render the stage at — a number (time samples interpolated
+    /// linearly, held outside their range), `earliest` (each attribute's first sample, the
+    /// default, as Pixar's usdrecord) or `default` (default values only, UsdTimeCode::Default).
+    /// A JSON or built-in scene is static: the same at every frame.
+    #[arg(long, value_name = "F", value_parser = parse_frame, allow_hyphen_values = true)]
+    pub(crate) frame: Option<String>,
+}
+
+/// `--frame`: a finite number (written back as Rust writes an f64, so `10` and `10.0` are the
+/// same frame), `earliest` or `default`.
+fn parse_frame(text: &str) -> Result<String, String> {
+    match text {
+        "earliest" | "default" => Ok(text.to_string()),
+        _ => match text.parse::<f64>() {
+            Ok(t) if t.is_finite() => Ok(t.to_string()),
+            _ => Err(format!("{text:?} is not a time code (a finite number, `earliest` or `default`)")),
+        },
+    }
 }
 
 /// How a render samples, shared by `render` and `report`.

@@ -4,11 +4,15 @@ use crate::args::SceneArgs;
 use anyhow::{Result, bail};
 use host_std::light::environment::{EnvSource, Placement};
 use host_std::scene::{Scene, builtin, json};
+use std::path::PathBuf;
 
 /// A loaded scene with what the importer left out or reduced (USD), for the user.
 pub(crate) struct Loaded {
     pub(crate) scene: Scene,
     pub(crate) notes: Vec<String>,
+    /// The files the scene file refers to (meshes, textures, maps, USD layers and packages;
+    /// the scene's own map even when `--env` replaces it), not the scene file and `--env`.
+    pub(crate) files: Vec<PathBuf>,
     #[cfg(feature = "usd")]
     pub(crate) usd: Option<host_usd::UsdScene>,
 }
@@ -23,12 +27,17 @@ pub(crate) fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>), exi
     let mut usd = None;
     #[cfg_attr(not(feature = "usd"), allow(unused_mut))]
     let mut notes = Vec::new();
+    let mut files = Vec::new();
     let mut scene = match &args.scene {
         None => builtin::scene(),
         Some(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
             match ext.as_str() {
-                "json" => json::load(path)?,
+                "json" => {
+                    let scene = json::load(path)?;
+                    files = json::files_read(path)?;
+                    scene
+                }
                 #[cfg(feature = "usd")]
                 "usd" | "usda" | "usdc" | "usdz" => {
                     let options = host_std::scene::usd::Options {
@@ -37,9 +46,14 @@ pub(crate) fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>), exi
                         width: size.0,
                         height: size.1,
                         leak_stage: exits_after,
+                        time: match &args.frame {
+                            Some(f) => f.parse().map_err(anyhow::Error::msg)?,
+                            None => host_std::scene::usd::TimeCode::Earliest,
+                        },
                     };
                     let c = host_std::scene::usd::load(path, &options)?;
                     notes = c.notes;
+                    files = c.files;
                     usd = Some(c.usd);
                     c.scene
                 }
@@ -84,6 +98,7 @@ pub(crate) fn load_scene(args: &SceneArgs, size: (Option<u32>, Option<u32>), exi
     Ok(Loaded {
         scene,
         notes,
+        files,
         #[cfg(feature = "usd")]
         usd,
     })

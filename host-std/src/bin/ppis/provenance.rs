@@ -3,17 +3,24 @@
 //! compares to refuse tiles of different renders. A whole frame's file holds the same text as
 //! each of its tiles', so a merged frame is byte for byte the one-process render. Files are
 //! named by their name and the FNV-1a hash of their bytes (not their folder: farm machines
-//! mount the same files at different paths); files a scene refers to (meshes, textures, a
-//! USD stage's sublayers) are not hashed.
+//! mount the same files at different paths), the scene file's and `--env`'s and every file the
+//! scene refers to (meshes, textures, maps, a USD stage's layers and packages), so that a
+//! change to any input of the pixels makes tiles of different renders.
 
 use crate::render_cmd::RenderArgs;
 use anyhow::{Context, Result};
 use host_std::plan::Settings;
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// The settings text for a render of a `width`×`height` frame.
-pub(crate) fn settings_text(args: &RenderArgs, settings: &Settings, frame: (usize, usize)) -> Result<String> {
+/// The settings text for a render of a `width`×`height` frame of a scene that reads `files`
+/// besides its own file.
+pub(crate) fn settings_text(
+    args: &RenderArgs,
+    settings: &Settings,
+    frame: (usize, usize),
+    files: &[PathBuf],
+) -> Result<String> {
     let scene = &args.scene;
     let mut lines: Vec<(&str, String)> = vec![("ppis", env!("CARGO_PKG_VERSION").to_string())];
     match &scene.scene {
@@ -22,6 +29,9 @@ pub(crate) fn settings_text(args: &RenderArgs, settings: &Settings, frame: (usiz
             lines.push(("scene_fnv1a64", file_hash(path)?));
         }
         None => lines.push(("scene", "builtin".into())),
+    }
+    if let Some(frame) = &scene.frame {
+        lines.push(("frame", frame.clone()));
     }
     lines.push(("camera", scene.camera.clone().unwrap_or_default()));
     lines.push(("render_settings", scene.render_settings.clone().unwrap_or_default()));
@@ -39,6 +49,14 @@ pub(crate) fn settings_text(args: &RenderArgs, settings: &Settings, frame: (usiz
     lines.push(("brdf_samples", settings.brdf_samples.to_string()));
     lines.push(("seed", settings.seed.to_string()));
     lines.push(("shadows", settings.shadows.to_string()));
+    // By name and content, not by folder or order: the same inputs on any machine.
+    let own = scene.scene.as_ref().and_then(|p| p.canonicalize().ok());
+    let mut reads = Vec::new();
+    for f in files.iter().filter(|f| f.canonicalize().ok() != own) {
+        reads.push(format!("{} {}", file_name(f), file_hash(f)?));
+    }
+    reads.sort();
+    lines.extend(reads.into_iter().map(|r| ("reads", r)));
     let mut text = String::new();
     for (key, value) in lines {
         // Latin-1 only in an EXR text attribute: anything else escaped.

@@ -57,6 +57,11 @@ pub(crate) struct Prepared {
     pub(crate) bvh_seconds: f64,
     /// The pixels to render: `--crop`, checked against the frame, or the whole frame.
     pub(crate) crop: Crop,
+    /// The files the scene refers to (`Loaded::files`).
+    pub(crate) files: Vec<PathBuf>,
+    /// The process's CPU seconds (every thread) loading the scene, reading and building the
+    /// environment, and building the BVH (`None` where the platform does not say).
+    pub(crate) cpu_seconds: Option<[f64; 3]>,
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
@@ -82,7 +87,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
-    let record = provenance::settings_text(&args, &settings, frame)?;
+    let record = provenance::settings_text(&args, &settings, frame, &prepared.files)?;
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
     let image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
 
@@ -135,10 +140,12 @@ fn output_paths(args: &RenderArgs) -> Result<(PathBuf, PathBuf)> {
 
 /// Loads the scene and builds (only what this render uses) on the pool's threads.
 fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
+    let cpu = || host_std::cpu_time::process_cpu_time().map(|d| d.as_secs_f64());
+    let cpu_start = cpu();
     let t_load = Instant::now();
     let loaded = load_scene(&args.scene, args.sampling.size(), false)?;
     warn_notes(&loaded.scene, &loaded.notes);
-    let mut scene = loaded.scene;
+    let (mut scene, files) = (loaded.scene, loaded.files);
     args.sampling.resize(&mut scene);
     let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
     let crop = match args.crop {
@@ -146,13 +153,19 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
         None => Crop::full(width, height),
     };
     let load_seconds = t_load.elapsed().as_secs_f64();
+    let cpu_loaded = cpu();
     let environment = match &scene.env {
         Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
         None => None,
     };
+    let cpu_env = cpu();
     let t_bvh = Instant::now();
     let bvh = pool.install(|| Bvh::build(&scene));
     let bvh_seconds = t_bvh.elapsed().as_secs_f64();
+    let cpu_seconds = match (cpu_start, cpu_loaded, cpu_env, cpu()) {
+        (Some(a), Some(b), Some(c), Some(d)) => Some([b - a, c - b, d - c]),
+        _ => None,
+    };
     if let Some(env) = &environment
         && env.stats.sanitized > 0
     {
@@ -161,7 +174,7 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
             env.stats.source, env.stats.sanitized
         );
     }
-    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop })
+    Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop, files, cpu_seconds })
 }
 
 /// One line per material `auto`'s pilot measured.

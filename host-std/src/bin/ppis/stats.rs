@@ -14,9 +14,16 @@ pub(crate) struct Stats {
     /// `auto`: per material its pilot's plan and scores (empty otherwise).
     auto_plans: Vec<AutoPlan>,
     brdf_samples: u32,
+    /// The process's CPU seconds (every thread) building the BVH.
+    bvh_cpu_seconds: Option<f64>,
     bvh_seconds: f64,
     camera_rays: u64,
+    /// The pixels rendered, x0, y0, x1, y1 (half-open): `--crop`, or the whole frame.
+    crop: [usize; 4],
     env_build_seconds: f64,
+    /// The process's CPU seconds (every thread) reading the environment map and building the
+    /// equal-area map and its pyramid.
+    env_cpu_seconds: Option<f64>,
     env_bytes: Option<usize>,
     env_level: Option<u32>,
     env_map_mean_rgb: Option<[f64; 3]>,
@@ -27,7 +34,13 @@ pub(crate) struct Stats {
     env_peak: Option<f64>,
     env_sanitized_texels: Option<usize>,
     env_source_mean_rgb: Option<[f64; 3]>,
+    /// The whole frame's size; `width` and `height` are the crop's.
+    frame_height: usize,
+    frame_width: usize,
+    /// The image's height (the crop's).
     height: usize,
+    /// The process's CPU seconds (every thread) loading the scene.
+    load_cpu_seconds: Option<f64>,
     /// The scene's and the environment's.
     load_seconds: f64,
     method: &'static str,
@@ -47,7 +60,10 @@ pub(crate) struct Stats {
     shadow_rays: u64,
     spp: u32,
     threads: usize,
+    /// `--frame` as given (a USD time code), `null` without it.
+    time_code: Option<String>,
     unshadowed: bool,
+    /// The image's width (the crop's).
     width: usize,
 }
 
@@ -89,9 +105,12 @@ impl Stats {
                 })
                 .collect(),
             brdf_samples: args.sampling.brdf_samples,
+            bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
             bvh_seconds: prepared.bvh_seconds,
             camera_rays: image.camera_rays,
+            crop: [prepared.crop.x0, prepared.crop.y0, prepared.crop.x1, prepared.crop.y1],
             env_build_seconds: env_build,
+            env_cpu_seconds: prepared.cpu_seconds.filter(|_| env.is_some()).map(|c| c[1]),
             env_bytes: env.map(|e| e.stats.bytes),
             env_level: env.map(|e| e.level),
             env_map_mean_rgb: env.map(|e| e.stats.map_mean),
@@ -103,7 +122,10 @@ impl Stats {
             env_peak: hierarchy.map(|h| f64::from(h.peak(5))),
             env_sanitized_texels: env.map(|e| e.stats.sanitized),
             env_source_mean_rgb: env.map(|e| e.stats.source_mean),
+            frame_height: scene.camera.height as usize,
+            frame_width: scene.camera.width as usize,
             height: image.height,
+            load_cpu_seconds: prepared.cpu_seconds.map(|c| c[0]),
             load_seconds: prepared.load_seconds + env_load,
             method: args.method.name(),
             non_finite_pixels: image.non_finite,
@@ -119,6 +141,7 @@ impl Stats {
             shadow_rays: image.shadow_rays,
             spp: args.spp,
             threads,
+            time_code: args.scene.frame.clone(),
             unshadowed: args.sampling.unshadowed,
             width: image.width,
         }

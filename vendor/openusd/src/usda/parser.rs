@@ -1359,7 +1359,23 @@ impl<'a> Parser<'a> {
         match self.peek_next() {
             Some(Ok(Token::Punctuation('('))) => is_tuple_type,
             Some(Ok(Token::Punctuation('['))) => is_tuple_type || info.is_array,
-            Some(Ok(Token::Number(_))) => info.ty == Type::TimeCode && !info.is_array,
+            // ppis patch (PATCHED.md): every numeric scalar type, not only `timecode`, so a
+            // `float` sample written `90` is a Float like its neighbours and interpolates.
+            Some(Ok(Token::Number(_))) => {
+                !info.is_array
+                    && matches!(
+                        info.ty,
+                        Type::TimeCode
+                            | Type::Half
+                            | Type::Float
+                            | Type::Double
+                            | Type::Uchar
+                            | Type::Int
+                            | Type::Uint
+                            | Type::Int64
+                            | Type::Uint64
+                    )
+            }
             _ => false,
         }
     }
