@@ -29,7 +29,7 @@ impl DistantLight {
     pub fn new(direction: Vec3, irradiance: Vec3, angle: f32) -> Result<Self, LightError> {
         let axis = unit(direction)?;
         let irradiance = checked_rgb(irradiance)?;
-        if !(angle >= 0.0 && angle < PI) {
+        if !(0.0..PI).contains(&angle) {
             return Err(LightError::BadAngle);
         }
         let half = 0.5 * angle;

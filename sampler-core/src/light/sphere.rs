@@ -52,7 +52,8 @@ impl SphereLight {
         let w = self.center - p;
         let d2 = w.length_squared();
         let r2 = self.radius * self.radius;
-        if !(d2 > r2) {
+        let outside = d2 > r2;
+        if !outside {
             return None;
         }
         let sin2_max = r2 / d2;
@@ -102,7 +103,8 @@ impl Light for SphereLight {
         let normal = Vec3::new(r * c, r * s, z);
         let to = self.center + self.radius * normal - p;
         let distance = to.length();
-        if !(distance > 0.0) {
+        let apart = distance > 0.0;
+        if !apart {
             return None;
         }
         let dir = to / distance;
@@ -136,7 +138,8 @@ impl Light for SphereLight {
     fn eval(&self, p: Vec3, dir: Vec3) -> Option<LightHit> {
         let (near, far) = self.intersect(p, dir, RIM_SLACK)?;
         let t = if near > 0.0 { near } else { far };
-        if !(t > 0.0) {
+        let ahead = t > 0.0;
+        if !ahead {
             return None;
         }
         let normal = (p + t * dir - self.center) / self.radius;

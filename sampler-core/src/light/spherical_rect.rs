@@ -12,6 +12,13 @@ use glam::{DVec3, Vec2, Vec3};
 /// is small and far enough that area sampling is uniform in solid angle to the same order.
 pub const MIN_SOLID_ANGLE: f64 = 1e-8;
 
+/// √(a² + b²): the scene's coordinates are far from f64's overflow, which `libm::hypot` guards
+/// against at several times the cost.
+#[inline]
+fn hypot(a: f64, b: f64) -> f64 {
+    libm::sqrt(a * a + b * b)
+}
+
 /// The rectangle `p0 + s·e1 + t·e2` seen from a reference point, in the rectangle's frame
 /// `(x, y, z)` with z pointing away from the point (z0 < 0).
 #[derive(Clone, Copy, Debug)]
@@ -42,15 +49,16 @@ impl SphericalRect {
             z0 = -z0;
             z = -z;
         }
-        if !(z0 < 0.0) {
+        let off_plane = z0 < 0.0;
+        if !off_plane {
             return None;
         }
         let (x1, y1) = (x0 + lengths.0, y0 + lengths.1);
         // The unit normals of the planes through `o` and each edge, in closed form.
-        let n0 = DVec3::new(0.0, z0, -y0) / libm::hypot(z0, y0);
-        let n1 = DVec3::new(-z0, 0.0, x1) / libm::hypot(z0, x1);
-        let n2 = DVec3::new(0.0, -z0, y1) / libm::hypot(z0, y1);
-        let n3 = DVec3::new(z0, 0.0, -x0) / libm::hypot(z0, x0);
+        let n0 = DVec3::new(0.0, z0, -y0) / hypot(z0, y0);
+        let n1 = DVec3::new(-z0, 0.0, x1) / hypot(z0, x1);
+        let n2 = DVec3::new(0.0, -z0, y1) / hypot(z0, y1);
+        let n3 = DVec3::new(z0, 0.0, -x0) / hypot(z0, x0);
         let angle = |a: DVec3, b: DVec3| libm::acos((-a.dot(b)).clamp(-1.0, 1.0));
         let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
         let k = 2.0 * PI - g2 - g3;
@@ -76,9 +84,9 @@ impl SphericalRect {
         let xu = -(cu * self.z0) / libm::sqrt((1.0 - cu * cu).max(0.0));
         let xu = if xu.is_nan() { self.x0 } else { xu.clamp(self.x0, self.x1) };
         // The y coordinate: uniform in the sine of the elevation along the line x = xu.
-        let d = libm::hypot(xu, self.z0);
-        let h0 = self.y0 / libm::hypot(d, self.y0);
-        let h1 = self.y1 / libm::hypot(d, self.y1);
+        let d = hypot(xu, self.z0);
+        let h0 = self.y0 / hypot(d, self.y0);
+        let h1 = self.y1 / hypot(d, self.y1);
         let hv = h0 + u1 * (h1 - h0);
         let hv2 = hv * hv;
         let yv = if hv2 < 1.0 - 1e-12 { (hv * d) / libm::sqrt(1.0 - hv2) } else { self.y1 };

@@ -40,7 +40,8 @@ impl SphericalTriangle {
         let [a, b, c] = v.map(|p| (p.as_dvec3() - o).normalize_or_zero());
         let triple = a.dot(b.cross(c)).abs();
         let solid_angle = 2.0 * libm::atan2(triple, 1.0 + a.dot(b) + b.dot(c) + c.dot(a));
-        if !(solid_angle >= MIN_SOLID_ANGLE) {
+        let large_enough = solid_angle >= MIN_SOLID_ANGLE;
+        if !large_enough {
             return None;
         }
         // The angle at `a` between the great circles towards `b` and towards `c`.
