@@ -4,7 +4,6 @@
 //! excess cancels catastrophically for small triangles, so the solid angle comes from Van
 //! Oosterom & Strackee's formula and the rest runs in f64.
 
-use core::f64::consts::PI;
 use glam::{DVec3, Vec2, Vec3};
 
 /// The smallest solid angle (sr) sampled this way; below it the sine rule's inversion loses
@@ -23,15 +22,6 @@ pub(super) struct SphericalTriangle {
     solid_angle: f64,
 }
 
-/// The angle between unit vectors, accurate near 0 and π (from the chord, not the dot product).
-fn angle_between(u: DVec3, v: DVec3) -> f64 {
-    if u.dot(v) < 0.0 {
-        PI - 2.0 * libm::asin(((u + v).length() * 0.5).min(1.0))
-    } else {
-        2.0 * libm::asin(((v - u).length() * 0.5).min(1.0))
-    }
-}
-
 impl SphericalTriangle {
     /// The triangle `v0 v1 v2` seen from `o`; `None` when it is seen edge-on or its solid angle
     /// is below [`MIN_SOLID_ANGLE`].
@@ -45,10 +35,11 @@ impl SphericalTriangle {
             return None;
         }
         // The angle at `a` between the great circles towards `b` and towards `c`.
+        // Its cosine and sine straight from the planes' unit normals: no inverse trigonometry.
         let (n_ab, n_ac) = (a.cross(b).normalize_or_zero(), a.cross(c).normalize_or_zero());
-        let alpha = angle_between(n_ab, n_ac);
-        let ok = n_ab != DVec3::ZERO && n_ac != DVec3::ZERO && alpha.is_finite();
-        ok.then_some(Self { a, b, c, alpha: (libm::cos(alpha), libm::sin(alpha)), solid_angle })
+        let alpha = (n_ab.dot(n_ac).clamp(-1.0, 1.0), n_ab.cross(n_ac).length().min(1.0));
+        let ok = n_ab != DVec3::ZERO && n_ac != DVec3::ZERO && alpha.1 > 0.0;
+        ok.then_some(Self { a, b, c, alpha, solid_angle })
     }
 
     /// The solid angle in steradians.
@@ -91,6 +82,6 @@ mod tests {
         assert!((t.sample(Vec2::new(1.0, 1.0)) - dir(v[2])).length() < 1e-6);
         // An octant subtends 4π/8.
         let octant = SphericalTriangle::new(Vec3::ZERO, [Vec3::X, Vec3::Y, Vec3::Z]).unwrap();
-        assert!((octant.solid_angle() - PI / 2.0).abs() < 1e-12);
+        assert!((octant.solid_angle() - core::f64::consts::FRAC_PI_2).abs() < 1e-12);
     }
 }
