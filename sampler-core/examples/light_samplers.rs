@@ -2,8 +2,10 @@
 //! 1. triangles — per-sample relative variance of the irradiance on a diffuse receiver with
 //!    area sampling and with spherical-triangle sampling, by decade of the solid angle the
 //!    triangle subtends (random triangles, receivers and normals);
-//! 2. rectangles — the relative error of the spherical rectangle's solid angle (f64) against
-//!    Van Oosterom & Strackee's formula, face-on and edge-on, by distance.
+//! 2. rectangles — the relative error of the solid angle 1/pdf implies (f64 spherical rectangle,
+//!    or area sampling below its smallest solid angle) against Van Oosterom & Strackee's
+//!    formula, face-on and edge-on, by distance.
+//!
 //! `cargo run --release -p sampler-core --example light_samplers` prints both tables;
 //! `… -- cost area|solid|rect` draws 200 000 samples of one sampler only, for
 //! `valgrind --tool=callgrind` (instructions per sample = the sampler's inclusive count / 200 000).
@@ -105,14 +107,16 @@ fn rect_solid_angle_error() {
         2.0 * a.dot(b.cross(c)).abs().atan2(la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la)
     };
     let light = RectLight::new(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE).unwrap().with_two_sided(true);
-    println!("\nunit square: distance, view, solid angle (sr), relative error of 1/pdf (f64 spherical rectangle)");
+    println!("\nunit square: distance, view, solid angle (sr), sampler, relative error of 1/pdf at the centre");
     for e in 0..=6 {
         let d = 10f32.powi(e);
-        for (view, p) in [("face-on", Vec3::new(0.5, 0.5, d)), ("edge-on", Vec3::new(0.5 + d, 0.5, 1e-2))] {
+        for (view, p) in [("oblique", Vec3::new(0.5 + 0.3 * d, 0.5, d)), ("edge-on", Vec3::new(0.5 + d, 0.5, 1e-2))] {
             let c = |x: f64, y: f64| DVec3::new(x, y, 0.0) - p.as_dvec3();
             let exact = tri(c(0.0, 0.0), c(1.0, 0.0), c(1.0, 1.0)) + tri(c(0.0, 0.0), c(1.0, 1.0), c(0.0, 1.0));
             let s = light.sample(p, Vec2::splat(0.5)).map_or(f64::NAN, |s| 1.0 / s.pdf as f64);
-            println!("{d:8.0e}  {view}  {exact:10.3e}  {:10.2e}", (s - exact).abs() / exact);
+            // The rectangle's threshold between the two samplers (`spherical_rect::MIN_SOLID_ANGLE`).
+            let sampler = if exact >= 1e-8 { "spherical" } else { "area" };
+            println!("{d:8.0e}  {view}  {exact:10.3e}  {sampler:9}  {:10.2e}", (s - exact).abs() / exact);
         }
     }
 }
