@@ -59,7 +59,7 @@ impl<'a> PowerSelector<'a> {
     }
 
     /// The light whose interval of the CDF holds the uniform `u` ∈ [0, 1): the last i with
-    /// cdf[i] ≤ u, which skips lights of weight 0.
+    /// `cdf[i] ≤ u`, which skips lights of weight 0.
     #[must_use]
     pub fn pick(&self, u: f64) -> SelectedLight {
         let n = self.len();

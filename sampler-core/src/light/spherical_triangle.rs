@@ -6,9 +6,9 @@
 
 use glam::{DVec3, Vec2, Vec3};
 
-/// The smallest solid angle (sr) sampled this way; below it the sine rule's inversion loses
-/// ~1e-6 of its precision and the triangle is small enough that area sampling is uniform in
-/// solid angle to the same order.
+/// The smallest solid angle (sr) sampled this way, the spherical rectangle's floor: below it a
+/// triangle is small and far enough that area sampling is uniform in solid angle to f32's
+/// precision ([`TriangleSampling::default`](super::TriangleSampling) switches far earlier).
 pub const MIN_SOLID_ANGLE: f64 = 1e-8;
 
 /// A triangle's vertices seen from a reference point, as unit directions.
