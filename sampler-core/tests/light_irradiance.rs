@@ -150,3 +150,42 @@ fn light_samplers_estimate_the_irradiance_without_bias() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// One light picked by power, then sampled: L cos / (pmf · pdf) estimates the sum of every
+/// light's irradiance (here each one's closed form), delta lights included.
+#[test]
+fn picking_lights_by_power_keeps_the_estimate_unbiased() {
+    use sampler_core::light::PowerSelector;
+    let (p, n) = (Vec3::ZERO, Vec3::Z);
+    let corners =
+        [Vec3::new(-0.5, 1.0, 2.0), Vec3::new(0.5, 1.0, 2.0), Vec3::new(0.5, 2.0, 2.0), Vec3::new(-0.5, 2.0, 2.0)];
+    let rect = RectLight::new(corners[0], corners[3] - corners[0], corners[1] - corners[0], Vec3::splat(2.0)).unwrap();
+    let lights: Vec<(SceneLight, f64)> = vec![
+        (PointLight::new(Vec3::new(0.0, 0.0, 2.0), Vec3::splat(3.0)).unwrap().into(), 0.75),
+        (SphereLight::new(Vec3::new(0.0, 0.0, 5.0), 1.0, Vec3::splat(4.0)).unwrap().into(), PI * 4.0 / 25.0),
+        (rect.into(), lambert_polygon(2.0, p, n, &corners)),
+        (DiskLight::new(Vec3::new(0.0, 0.0, 1.0), Vec3::NEG_Z, 0.5, Vec3::ONE).unwrap().into(), PI * 0.25 / 1.25),
+        (DistantLight::new(Vec3::new(0.0, 0.6, 0.8), Vec3::splat(0.5), 0.1).unwrap().into(), 0.4),
+        (DistantLight::new(Vec3::new(0.6, 0.0, 0.8), Vec3::splat(0.2), 0.0).unwrap().into(), 0.16),
+    ];
+    assert!(rect.normal().z < 0.0, "the rectangle faces the receiver");
+    let expected: f64 = lights.iter().map(|(_, e)| e).sum();
+    let weights: Vec<f32> = lights.iter().map(|(l, _)| l.power(10.0).x).collect();
+    let mut cdf = vec![0.0; weights.len() + 1];
+    let selector = PowerSelector::build(&weights, &mut cdf).unwrap();
+    let mut rng = Pcg32::new(31, 5);
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for _ in 0..SAMPLES {
+        let picked = selector.pick(rng.next_f64());
+        let light = &lights[picked.index].0;
+        let u = Vec2::new(picked.u_remapped as f32, rng.next_f32());
+        let v = light
+            .sample(p, u)
+            .map_or(0.0, |s| s.radiance.x as f64 * n.dot(s.dir).max(0.0) as f64 / (s.pdf as f64 * picked.pmf));
+        sum += v;
+        sum2 += v * v;
+    }
+    let mean = sum / SAMPLES as f64;
+    let se = ((sum2 / SAMPLES as f64 - mean * mean).max(0.0) / SAMPLES as f64).sqrt();
+    assert!((mean - expected).abs() <= 4.0 * se, "{mean} ± {se} against {expected}");
+}
