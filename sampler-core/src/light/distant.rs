@@ -8,6 +8,11 @@ use crate::sampling::{TWO_PI, sin_cos_2pi};
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
+/// Angular diameters (radians) below which a distant light is a delta light: its cone's
+/// directions would lie within a few f32 roundings of its axis, and no image tells the
+/// difference.
+pub const MIN_DISTANT_ANGLE: f32 = 1e-4;
+
 /// A light at infinity: the sun, the moon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DistantLight {
@@ -25,14 +30,14 @@ pub struct DistantLight {
 impl DistantLight {
     /// Light from the unit direction `direction` (from the scene towards the light), delivering
     /// the irradiance `irradiance` (RGB) on a surface facing it, of full angular diameter
-    /// `angle` radians (0: a delta light).
+    /// `angle` radians (a delta light below [`MIN_DISTANT_ANGLE`]).
     pub fn new(direction: Vec3, irradiance: Vec3, angle: f32) -> Result<Self, LightError> {
         let axis = unit(direction)?;
         let irradiance = checked_rgb(irradiance)?;
         if !(0.0..PI).contains(&angle) {
             return Err(LightError::BadAngle);
         }
-        let half = 0.5 * angle;
+        let half = if angle < MIN_DISTANT_ANGLE { 0.0 } else { 0.5 * angle };
         let sin_half = libm::sinf(half);
         let sin2_max = sin_half * sin_half;
         let s = libm::sinf(0.5 * half);
@@ -136,6 +141,8 @@ mod tests {
             }
         }
         assert_eq!(DistantLight::new(Vec3::Z, Vec3::ONE, -1.0), Err(LightError::BadAngle));
+        assert!(DistantLight::new(Vec3::Z, Vec3::ONE, 0.5 * MIN_DISTANT_ANGLE).unwrap().is_delta());
+        assert!(!DistantLight::new(Vec3::Z, Vec3::ONE, MIN_DISTANT_ANGLE).unwrap().is_delta());
         assert_eq!(DistantLight::new(Vec3::ZERO, Vec3::ONE, 0.0), Err(LightError::DegenerateDirection));
     }
 }

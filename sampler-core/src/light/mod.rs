@@ -30,7 +30,7 @@ mod spherical_triangle;
 mod triangle;
 
 pub use disk::DiskLight;
-pub use distant::DistantLight;
+pub use distant::{DistantLight, MIN_DISTANT_ANGLE};
 pub use point::PointLight;
 pub use rect::RectLight;
 pub use scene_light::SceneLight;
@@ -38,7 +38,7 @@ pub use select::{PowerSelector, SelectedLight};
 pub use sphere::SphereLight;
 pub use triangle::{TriangleLight, TriangleSampling};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// A direction drawn towards a light from a shading point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,7 +75,7 @@ pub trait Light {
     /// Draws a direction towards the light from `p` with the uniform point `u` ∈ [0,1)². `None`
     /// when no direction can carry light to `p` (behind a one-sided emitter, inside a sphere
     /// that emits outwards, a degenerate configuration).
-    fn sample(&self, p: Vec3, u: glam::Vec2) -> Option<LightSample>;
+    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample>;
 
     /// Density with respect to solid angle with which [`Light::sample`] draws the unit `dir`
     /// from `p`; 0 where it never draws and for delta lights.
@@ -131,6 +131,8 @@ impl core::fmt::Display for LightError {
         })
     }
 }
+
+impl core::error::Error for LightError {}
 
 /// `Ok(v)` when every component of the RGB `v` is finite and non-negative.
 fn checked_rgb(v: Vec3) -> Result<Vec3, LightError> {

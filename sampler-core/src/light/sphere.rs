@@ -91,7 +91,9 @@ impl Light for SphereLight {
             let distance = (d - r) * (d + r) / (d * (local.z + libm::sqrtf((sin2_max - sin2).max(0.0))));
             let dir = Frame::from_normal(axis).to_world(local);
             let pdf = 1.0 / (TWO_PI * one_minus_cos);
-            return Some(LightSample { dir, distance, radiance: self.emission.radiance, pdf, delta: false });
+            // A sphere too far for its cone to be represented adds nothing f32 can hold.
+            let ok = pdf.is_finite() && distance.is_finite();
+            return ok.then_some(LightSample { dir, distance, radiance: self.emission.radiance, pdf, delta: false });
         }
         if !self.emission.two_sided {
             return None;
@@ -121,7 +123,8 @@ impl Light for SphereLight {
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
         if let Some((axis, _, sin2_max, one_minus_cos)) = self.cone_from(p) {
             let inside = axis.dot(dir) > 0.0 && axis.cross(dir).length_squared() <= sin2_max * (1.0 + RIM_SLACK);
-            return if inside { 1.0 / (TWO_PI * one_minus_cos) } else { 0.0 };
+            let pdf = 1.0 / (TWO_PI * one_minus_cos);
+            return if inside && pdf.is_finite() { pdf } else { 0.0 };
         }
         if !self.emission.two_sided {
             return 0.0;
@@ -188,5 +191,8 @@ mod tests {
         let s = two.sample(p, Vec2::splat(0.3)).unwrap();
         assert!((two.pdf(p, s.dir) - s.pdf).abs() < 1e-4 * s.pdf);
         assert_eq!(SphereLight::new(Vec3::ZERO, 0.0, Vec3::ONE), Err(LightError::ZeroRadius));
+        // So far that its cone underflows: nothing to draw, density 0.
+        let speck = SphereLight::new(Vec3::new(0.0, 0.0, 1e25), 1.0, Vec3::ONE).unwrap();
+        assert!(speck.sample(Vec3::ZERO, Vec2::splat(0.5)).is_none() && speck.pdf(Vec3::ZERO, Vec3::Z) == 0.0);
     }
 }
