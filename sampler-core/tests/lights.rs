@@ -67,3 +67,67 @@ fn samples_and_rays_agree() {
         }
     }
 }
+
+/// Random and degenerate shading points (on a light's plane, at a sphere's centre, on its
+/// surface, NaN, far away) and uniform points including 0 and the largest below 1: nothing panics, every sample
+/// is finite with a positive density, and `pdf` agrees with the sample's density but for the
+/// rare direction drawn on a light's outline.
+#[test]
+fn odd_shading_points_give_finite_consistent_samples() {
+    use sampler_core::light::*;
+    let l = Vec3::new(1.0, 0.5, 0.25);
+    let lights: Vec<SceneLight> = vec![
+        PointLight::new(Vec3::new(0.0, 0.0, 1.0), l).unwrap().into(),
+        SphereLight::new(Vec3::new(0.5, 0.0, 0.0), 0.5, l).unwrap().into(),
+        SphereLight::new(Vec3::new(0.5, 0.0, 0.0), 0.5, l).unwrap().with_two_sided(true).into(),
+        RectLight::new(Vec3::ZERO, Vec3::X, Vec3::Y, l).unwrap().into(),
+        RectLight::new(Vec3::ZERO, Vec3::X, Vec3::Y, l).unwrap().with_two_sided(true).into(),
+        DiskLight::new(Vec3::ZERO, Vec3::Z, 0.5, l).unwrap().into(),
+        TriangleLight::new([Vec3::ZERO, Vec3::X, Vec3::Y], l).unwrap().into(),
+        TriangleLight::new([Vec3::ZERO, Vec3::X, Vec3::Y], l).unwrap().with_sampling(TriangleSampling::Area).into(),
+        DistantLight::new(Vec3::Z, l, 0.3).unwrap().into(),
+        DistantLight::new(Vec3::Z, l, 0.0).unwrap().into(),
+    ];
+    let fixed = [
+        Vec3::ZERO,
+        Vec3::new(0.5, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.3, 0.3, 0.0),
+        Vec3::new(2.0, 0.5, 0.0),
+        Vec3::new(0.3, 0.3, 1e-7),
+        Vec3::new(0.3, 0.3, -1e-7),
+        Vec3::splat(f32::NAN),
+        Vec3::new(1e30, 0.0, 1e30),
+        Vec3::new(0.2, 0.1, 1e9),
+    ];
+    let mut rng = sampler_core::rng::Pcg32::new(8, 8);
+    let (mut drawn, mut mismatched) = (0usize, 0usize);
+    for k in 0..40_000 {
+        let p = if k % 4 == 0 {
+            fixed[(k / 4) % fixed.len()]
+        } else {
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 3.0 - Vec3::splat(1.5)
+        };
+        let u = match k % 7 {
+            0 => glam::Vec2::ZERO,
+            1 => glam::Vec2::splat(1.0 - f32::EPSILON / 2.0),
+            _ => glam::Vec2::new(rng.next_f32(), rng.next_f32()),
+        };
+        for light in &lights {
+            let Some(s) = light.sample(p, u) else { continue };
+            drawn += 1;
+            let ok = s.dir.is_finite()
+                && (s.dir.length() - 1.0).abs() < 1e-4
+                && s.pdf.is_finite()
+                && s.pdf > 0.0
+                && s.distance > 0.0
+                && s.radiance.is_finite();
+            assert!(ok, "{light:?} from {p} with {u}: {s:?}");
+            if !s.delta {
+                let q = light.pdf(p, s.dir);
+                mismatched += usize::from((q - s.pdf).abs() > 1e-3 * s.pdf);
+            }
+        }
+    }
+    assert!(drawn > 100_000 && mismatched * 10_000 <= drawn, "{mismatched} of {drawn} densities disagree");
+}
