@@ -4,7 +4,7 @@
 
 use super::{Light, LightError, LightHit, LightSample, checked_rgb, unit};
 use crate::frame::Frame;
-use crate::sampling::{TWO_PI, sin_cos_2pi};
+use crate::sampling::{TWO_PI, square_to_uniform_cone};
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
@@ -81,7 +81,7 @@ impl Light for DistantLight {
                 delta: true,
             });
         }
-        let dir = self.frame.to_world(uniform_cone(self.one_minus_cos, u));
+        let dir = self.frame.to_world(square_to_uniform_cone(u, self.one_minus_cos));
         let pdf = 1.0 / (TWO_PI * self.one_minus_cos);
         Some(LightSample { dir, distance: f32::INFINITY, radiance: self.radiance, pdf, delta: false })
     }
@@ -102,17 +102,6 @@ impl Light for DistantLight {
     fn power(&self, scene_radius: f32) -> Vec3 {
         self.irradiance * (PI * scene_radius * scene_radius)
     }
-}
-
-/// A uniform direction in the cone about +z whose half-angle has 1 − cos = `one_minus_cos`:
-/// 1 − cos θ = u₀·(1 − cos θmax), the sine from (1 − cos θ)(1 + cos θ) so that it keeps its
-/// precision where cos θ rounds to 1.
-#[inline]
-pub(super) fn uniform_cone(one_minus_cos: f32, u: Vec2) -> Vec3 {
-    let t = u.x * one_minus_cos;
-    let sin_theta = libm::sqrtf((t * (2.0 - t)).max(0.0));
-    let (s, c) = sin_cos_2pi(u.y);
-    Vec3::new(sin_theta * c, sin_theta * s, 1.0 - t)
 }
 
 #[cfg(test)]

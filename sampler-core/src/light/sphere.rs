@@ -3,10 +3,10 @@
 //! distance to the sphere follows from the same sines. From inside only a two-sided sphere sends
 //! light in: points drawn uniformly on its area, converted to solid angle.
 
-use super::distant::uniform_cone;
 use super::{Emission, Light, LightError, LightHit, LightSample, area_to_solid_angle, checked_rgb, emitted, finite};
 use crate::frame::Frame;
-use crate::sampling::{TWO_PI, sin_cos_2pi};
+use crate::mapping::square_to_sphere;
+use crate::sampling::{TWO_PI, square_to_uniform_cone};
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
@@ -84,7 +84,7 @@ impl SphereLight {
 impl Light for SphereLight {
     fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         if let Some((axis, d, sin2_max, one_minus_cos)) = self.cone_from(p) {
-            let local = uniform_cone(one_minus_cos, u);
+            let local = square_to_uniform_cone(u, one_minus_cos);
             let sin2 = local.x * local.x + local.y * local.y;
             // The near root of |t·dir − w|² = r² with cos θ and the sines: no cancellation.
             let r = self.radius;
@@ -98,11 +98,9 @@ impl Light for SphereLight {
         if !self.emission.two_sided {
             return None;
         }
-        // From inside: a uniform point of the surface, which faces away from `p`.
-        let z = 1.0 - 2.0 * u.x;
-        let r = libm::sqrtf((1.0 - z * z).max(0.0));
-        let (s, c) = sin_cos_2pi(u.y);
-        let normal = Vec3::new(r * c, r * s, z);
+        // From inside: a uniform point of the surface (the equal-area map is uniform on the
+        // sphere), which faces away from `p`.
+        let normal = square_to_sphere(u);
         let to = self.center + self.radius * normal - p;
         let distance = to.length();
         let apart = distance > 0.0;
