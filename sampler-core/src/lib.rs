@@ -9,7 +9,8 @@
 //! pyramid ([`mod@env`]) is computed in the same traversal → hierarchical warping of uniform points
 //! ([`points`], [`warp`]) through the tree and on through the environment's levels, with the
 //! density of every direction available for MIS ([`sampler`]). [`estimator`] turns samples into
-//! radiance; [`brdf`] holds the BRDF interface and the built-in materials.
+//! radiance; [`brdf`] holds the BRDF interface and the built-in materials; [`light`] samples
+//! the other light sources (point, sphere, rectangle, disk, triangle, distant) by solid angle.
 //!
 //! ```
 //! use sampler_core::{brdf::RoughConductor, env::{build_pyramid, pyramid_len, EnvHierarchy},
@@ -54,6 +55,7 @@ pub mod direction;
 pub mod env;
 pub mod estimator;
 pub mod frame;
+pub mod light;
 pub mod points;
 pub mod rng;
 pub mod sampling;

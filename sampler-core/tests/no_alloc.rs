@@ -118,6 +118,49 @@ fn ten_thousand_shading_points_allocate_nothing() {
     assert_eq!(count, 0, "the core allocated {count} times");
 }
 
+/// Every light's sampling, density and ray query, and picking a light by power, at 10 000
+/// shading points.
+#[test]
+fn light_sampling_allocates_nothing() {
+    use sampler_core::light::*;
+    let l = Vec3::new(1.0, 2.0, 3.0);
+    let lights: [SceneLight; 8] = [
+        PointLight::new(Vec3::new(0.0, 0.0, 3.0), l).unwrap().into(),
+        SphereLight::new(Vec3::new(1.0, 0.0, 2.0), 0.5, l).unwrap().with_two_sided(true).into(),
+        RectLight::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::X * 2.0, Vec3::Y * 2.0, l)
+            .unwrap()
+            .with_two_sided(true)
+            .into(),
+        DiskLight::new(Vec3::new(0.0, 1.0, 1.0), Vec3::NEG_Z, 0.3, l).unwrap().into(),
+        TriangleLight::new([Vec3::ZERO, Vec3::X, Vec3::Y], l).unwrap().with_two_sided(true).into(),
+        TriangleLight::new([Vec3::ZERO, Vec3::X, Vec3::Y], l).unwrap().with_sampling(TriangleSampling::Area).into(),
+        DistantLight::new(Vec3::new(0.2, 0.3, 1.0), l, 0.01).unwrap().into(),
+        DistantLight::new(Vec3::new(0.2, 0.3, 1.0), l, 0.0).unwrap().into(),
+    ];
+    let weights = lights.map(|x| x.power(10.0).x);
+    let mut cdf = [0.0f64; 9];
+    let mut rng = Pcg32::new(2, 3);
+    let mut sink = 0.0f64;
+    ARMED.with(|a| a.set(true));
+    let selector = PowerSelector::build(&weights, &mut cdf).unwrap();
+    for _ in 0..10_000 {
+        let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - Vec3::splat(2.0);
+        let picked = selector.pick(rng.next_f64());
+        sink += picked.pmf + selector.pmf(picked.index);
+        for light in &lights {
+            let u = glam::Vec2::new(rng.next_f32(), rng.next_f32());
+            if let Some(s) = light.sample(p, u) {
+                sink += (s.pdf + light.pdf(p, s.dir)) as f64;
+                sink += light.eval(p, s.dir).map_or(0.0, |h| h.distance.min(1e9) as f64);
+            }
+        }
+    }
+    ARMED.with(|a| a.set(false));
+    let count = COUNT.with(|c| c.get());
+    assert!(sink.is_finite());
+    assert_eq!(count, 0, "the light samplers allocated {count} times");
+}
+
 /// The batched paths the renderer takes, at one shading point: the sum of what they return.
 fn batched(
     sampler: &ProductSampler<'_, '_>,

@@ -4,6 +4,7 @@
 
 mod brdfs;
 mod chi2;
+mod lights;
 mod quadrature;
 mod test_env;
 
@@ -12,6 +13,8 @@ mod test_env;
 pub use brdfs::*;
 #[allow(unused_imports)]
 pub use chi2::*;
+#[allow(unused_imports)]
+pub use lights::*;
 #[allow(unused_imports)]
 pub use quadrature::*;
 #[allow(unused_imports)]
