@@ -8,7 +8,7 @@ mod prim_path;
 mod shading;
 mod value;
 
-pub use prim_path::{PrimPath, PrimRef};
+pub use prim_path::{PrimMap, PrimPath, PrimRef};
 pub use shading::{Input, PreviewInputs, TextureRef};
 pub use value::Value;
 use value::convert;
@@ -17,7 +17,6 @@ use openusd::ar::{self, Resolver};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::{sdf, usd};
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -37,7 +36,7 @@ pub struct Stage {
     inner: usd::Stage,
     time: usd::TimeCode,
     /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
-    binding_api: RefCell<HashMap<sdf::Path, bool>>,
+    binding_api: RefCell<sdf::PathMap<bool>>,
     /// The composed property names of the prim asked about last (see [`Stage::authors`]).
     properties: RefCell<Option<(PrimPath, Vec<openusd::tf::Token>)>>,
 }

@@ -1,10 +1,12 @@
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
+mod hasher;
 mod intern;
 mod node;
 mod prefix;
 use node::Kind;
+pub use hasher::{BuildPathHasher, PathHasher, PathMap, PathSet};
 use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};

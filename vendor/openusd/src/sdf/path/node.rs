@@ -335,18 +335,36 @@ impl Path {
         self.hash
     }
 
+    /// The order of the texts. Two structured paths agree in their text down to their
+    /// deepest common node, so only the pieces below it are compared: for siblings (the
+    /// children of one prim, kept sorted by `PathTable`) that is their own names.
     pub(super) fn text_cmp(&self, other: &Path) -> Ordering {
         if Arc::ptr_eq(&self.node, &other.node) {
             return Ordering::Equal;
+        }
+        if self.is_structured() && other.is_structured() {
+            if let (Some(p), Some(q)) = (&self.node.parent, &other.node.parent) {
+                if Arc::ptr_eq(&p.node, &q.node) {
+                    return self.own_bytes().cmp(other.own_bytes());
+                }
+            }
+            let (a, b) = (self.chain(), other.chain());
+            let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+            let below_a = a[common..].iter().flat_map(|p| p.own_bytes());
+            return below_a.cmp(b[common..].iter().flat_map(|p| p.own_bytes()));
         }
         let pieces = |p: &Path| {
             let mut v: Vec<u8> = Vec::with_capacity(p.node.len);
             p.for_each_piece(|s| v.extend_from_slice(s.as_bytes()));
             v
         };
-        match (self.node.parent.is_none() || self.node.text.get().is_some(), other.node.parent.is_none()) {
-            (true, true) => self.text().cmp(other.text()),
-            _ => pieces(self).cmp(&pieces(other)),
-        }
+        pieces(self).cmp(&pieces(other))
+    }
+
+    /// The bytes this node adds to its parent's text: its separator, if any, and segment.
+    fn own_bytes(&self) -> impl Iterator<Item = u8> + '_ {
+        let slash = self.node.kind == Kind::Prim && self.node.parent.as_ref().is_some_and(|up| up.node.kind == Kind::Prim);
+        let separator: &[u8] = if slash { b"/" } else { b"" };
+        separator.iter().chain(self.node.seg.as_bytes()).copied()
     }
 }
