@@ -5,6 +5,7 @@ mod hasher;
 mod intern;
 mod node;
 mod prefix;
+mod text_cell;
 use node::Kind;
 pub use hasher::{BuildPathHasher, PathHasher, PathMap, PathSet};
 use std::{cmp, fmt, result, str::FromStr};

@@ -25,10 +25,11 @@
 //! property name may hold `:` and `.` but not end with `.`.
 
 use super::intern;
+use super::text_cell::TextCell;
 use super::{is_prim_name_char, Path};
 use std::cmp::Ordering;
 use std::hash::{DefaultHasher, Hash, Hasher};
-use std::sync::{Arc, LazyLock, OnceLock};
+use std::sync::{Arc, LazyLock};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -64,8 +65,12 @@ pub(super) struct Node {
     /// interned nodes are different paths.
     pub(super) interned: bool,
     /// The whole text, made on the first `Path::as_str` of a node with a parent.
-    text: OnceLock<Box<str>>,
+    text: TextCell,
 }
+
+// Every path is a node, most of them a property's (one per attribute of every spec in a
+// layer), so a node stays this small: 88 bytes with the `Arc`'s counts.
+const _: () = assert!(std::mem::size_of::<Node>() == 72);
 
 impl Drop for Node {
     /// Unlinks the chain one node at a time: dropping the last path of a deep chain
@@ -98,7 +103,7 @@ fn leaf(kind: Kind, text: &str) -> Path {
             len: text.len(),
             hash,
             interned: false,
-            text: OnceLock::new(),
+            text: TextCell::new(),
         }),
     }
 }
@@ -228,7 +233,7 @@ impl Path {
                 len: up.len + separator + seg_len,
                 hash,
                 interned,
-                text: OnceLock::new(),
+                text: TextCell::new(),
             })
         };
         // Below a node left out of the table nothing is interned: an interned node's
