@@ -26,8 +26,10 @@ impl Hasher for PathHasher {
         }
     }
 
+    /// The first write is the hash as it is; a key of several paths (a tuple) folds each
+    /// one in turned, so that `(a, b)` and `(b, a)` differ and `(a, a)` is not zero.
     fn write_u64(&mut self, n: u64) {
-        self.0 ^= n;
+        self.0 = self.0.rotate_left(29) ^ n;
     }
 }
 
@@ -52,6 +54,14 @@ mod tests {
         let mut map: PathMap<u32> = PathMap::default();
         map.insert(path.clone(), 7);
         assert_eq!(map.get(&Path::new("/World/Mesh.points").unwrap()), Some(&7));
+    }
+
+    #[test]
+    fn a_pair_of_paths_hashes_by_its_order() {
+        let (a, b) = (Path::new("/A").unwrap(), Path::new("/B").unwrap());
+        let build = BuildPathHasher::default();
+        assert_ne!(build.hash_one((&a, &b)), build.hash_one((&b, &a)));
+        assert_ne!(build.hash_one((&a, &a)), 0);
     }
 
     #[test]
