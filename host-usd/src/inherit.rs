@@ -2,8 +2,7 @@
 //! memoised per path and resolved top-down: a prim costs one step from its parent's
 //! answer, never a walk to the root, and no recursion, however deep the namespace.
 
-use crate::stage::{PrimPath, Stage};
-use std::collections::HashMap;
+use crate::stage::{PrimMap, PrimPath, Stage};
 
 /// The value of `prim`: the unresolved ancestors (nearest memoised one or the
 /// pseudo-root, whose value is `root`, excluded) are resolved top-down, each by
@@ -12,7 +11,7 @@ use std::collections::HashMap;
 /// a stage's leaves, most of its prims, take no memory.
 #[allow(clippy::mutable_key_type, reason = "a path's interior mutability is its text cache, outside Eq and Hash")]
 pub fn resolve_down<T: Clone>(
-    memo: &mut HashMap<PrimPath, T>,
+    memo: &mut PrimMap<T>,
     prim: &PrimPath,
     root: T,
     mut step: impl FnMut(&PrimPath, &T) -> Result<T, String>,
@@ -42,8 +41,8 @@ pub fn resolve_down<T: Clone>(
 /// Computed visibility and purpose (UsdGeomImageable's rules), memoised.
 #[derive(Default)]
 pub struct Hidden {
-    invisible: HashMap<PrimPath, bool>,
-    purpose: HashMap<PrimPath, &'static str>,
+    invisible: PrimMap<bool>,
+    purpose: PrimMap<&'static str>,
 }
 
 impl Hidden {

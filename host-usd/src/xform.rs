@@ -3,14 +3,13 @@
 //! Matrices are glam's column-vector form (the transpose of USD's row-vector matrices), so
 //! `world = parent · local`.
 
-use crate::stage::{PrimPath, Stage};
+use crate::stage::{PrimMap, PrimPath, Stage};
 use glam::{DMat3, DMat4, DVec3};
-use std::collections::HashMap;
 
 /// Each prim's world transform, memoised by path.
 #[derive(Default)]
 pub struct WorldTransforms {
-    cache: HashMap<PrimPath, DMat4>,
+    cache: PrimMap<DMat4>,
 }
 
 impl WorldTransforms {

@@ -77,12 +77,41 @@ fn prefixes() {
 
 #[test]
 fn paths_order_by_their_text() {
-    let mut paths = [p("/B"), p("/A/B.x"), p("/A/B"), p("/A{v=s}"), p("/A"), Path::abs_root()];
-    paths.sort();
-    let texts: Vec<String> = paths.iter().map(Path::to_string).collect();
-    let mut sorted = texts.clone();
+    // Siblings, a property beside a child (`.` sorts before `/`), variant selections
+    // (`{` after letters), prims below a selection, an opaque relationship-target path,
+    // and paths of different depths: every pair orders as its texts do.
+    let texts = [
+        "/",
+        "/A",
+        "/A/B",
+        "/A/B2",
+        "/A/Ba",
+        "/A/B.x",
+        "/A/B.x:y",
+        "/A/B/C",
+        "/A/B/C/D.z",
+        "/A{v=s}",
+        "/A{v=s}B",
+        "/A{v=t}",
+        "/A{v=s}B/C",
+        "/Ab",
+        "/B",
+        "/A.rel[/T]",
+        "/A.a",
+        "/A.a.b",
+        "/B/A",
+    ];
+    let paths: Vec<Path> = texts.iter().map(|t| p(t)).collect();
+    for (a, ta) in paths.iter().zip(texts) {
+        for (b, tb) in paths.iter().zip(texts) {
+            assert_eq!(a.cmp(b), ta.cmp(tb), "{ta} against {tb}");
+        }
+    }
+    let mut sorted = paths.clone();
     sorted.sort();
-    assert_eq!(texts, sorted);
+    let mut sorted_texts = texts.to_vec();
+    sorted_texts.sort();
+    assert_eq!(sorted.iter().map(Path::to_string).collect::<Vec<_>>(), sorted_texts);
 }
 
 #[test]

@@ -9,7 +9,7 @@ mod shading;
 mod time;
 mod value;
 
-pub use prim_path::{PrimPath, PrimRef};
+pub use prim_path::{PrimMap, PrimPath, PrimRef};
 pub use shading::{Input, PreviewInputs, TextureRef};
 pub use time::TimeCode;
 pub use value::Value;
@@ -19,7 +19,6 @@ use openusd::ar::{self, Resolver};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::{sdf, usd};
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -39,7 +38,7 @@ pub struct Stage {
     inner: usd::Stage,
     time: TimeCode,
     /// Prims known to apply (or not) MaterialBindingAPI (`shading.rs`).
-    binding_api: RefCell<HashMap<sdf::Path, bool>>,
+    binding_api: RefCell<sdf::PathMap<bool>>,
     /// The composed property names of the prim asked about last (see [`Stage::authors`]).
     properties: RefCell<Option<(PrimPath, Vec<openusd::tf::Token>)>>,
 }

@@ -5,7 +5,11 @@
 //! quadratic in time and memory.
 
 use openusd::sdf;
+use std::collections::HashMap;
 use std::fmt;
+
+/// A map keyed by prims, hashed by the hash their paths carry (no second hash per lookup).
+pub type PrimMap<T> = HashMap<PrimPath, T, sdf::BuildPathHasher>;
 
 /// The path of a prim (or of a relationship's target) on the stage. Written out by
 /// `Display` (`/World/Mesh`).

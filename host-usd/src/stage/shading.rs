@@ -222,7 +222,9 @@ impl Stage {
         if let Some(source) = self.connection(shader, &attr)? {
             let tex = source.prim_path();
             let tex_prim = tex.as_str().to_string();
-            let channel = source.name().unwrap_or_default().trim_start_matches("outputs:").to_string();
+            // The output's name without its namespace: `/Mat/Tex.outputs:r` → `r`.
+            let property = source.as_str().strip_prefix(tex.as_str()).and_then(|p| p.strip_prefix('.'));
+            let channel = property.and_then(|p| p.strip_prefix("outputs:")).unwrap_or_default().to_string();
             let id = self.value(&tex_prim, "info:id")?.and_then(|v| v.token().map(str::to_string));
             if id.as_deref() == Some("UsdUVTexture") {
                 let file_value = self.connected_value(&tex_prim, "inputs:file")?;
@@ -271,5 +273,59 @@ fn map_input<T>(i: Input<Vec<f64>>, f: impl Fn(&[f64]) -> T) -> Input<T> {
         Input::Unset => Input::Unset,
         Input::Value(v) => Input::Value(f(&v)),
         Input::Texture(t) => Input::Texture(t),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A UsdPreviewSurface whose inputs read a texture through `outputs:rgb`, `outputs:r`,
+    /// `outputs:g` and `outputs:a`.
+    const NETWORK: &str = r#"#usda 1.0
+def Material "Mat"
+{
+    token outputs:surface.connect = </Mat/Surface.outputs:surface>
+    def Shader "Surface"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </Mat/Tex.outputs:rgb>
+        float inputs:roughness.connect = </Mat/Tex.outputs:r>
+        float inputs:metallic.connect = </Mat/Tex.outputs:g>
+        float inputs:opacity.connect = </Mat/Tex.outputs:a>
+        token outputs:surface
+    }
+    def Shader "Tex"
+    {
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @tex.png@
+        float3 outputs:rgb
+        float outputs:r
+        float outputs:g
+        float outputs:a
+    }
+}
+"#;
+
+    #[test]
+    fn a_texture_channel_is_named_without_its_outputs_namespace() {
+        let dir = tempfile::Builder::new().prefix("ppis-usd-channel-").tempdir().unwrap();
+        let file = dir.path().join("channels.usda");
+        std::fs::write(&file, NETWORK).unwrap();
+        let stage = Stage::open(&file).unwrap();
+        let (shader, id) = stage.surface_shader("/Mat").unwrap().unwrap();
+        assert_eq!((shader.as_str(), id.as_str()), ("/Mat/Surface", "UsdPreviewSurface"));
+        let inputs = stage.preview_inputs(&shader).unwrap();
+        let channel = |input: &Input<f32>| match input {
+            Input::Texture(t) => t.channel.clone(),
+            other => panic!("not a texture: {other:?}"),
+        };
+        match &inputs.diffuse_color {
+            Input::Texture(t) => assert_eq!(t.channel, "rgb"),
+            other => panic!("not a texture: {other:?}"),
+        }
+        assert_eq!(channel(&inputs.roughness), "r");
+        assert_eq!(channel(&inputs.metallic), "g");
+        assert_eq!(channel(&inputs.opacity), "a");
     }
 }

@@ -104,3 +104,6 @@ pub mod usd;
 pub mod usda;
 pub mod usdc;
 pub mod usdz;
+
+#[cfg(test)]
+mod test_tempdir;

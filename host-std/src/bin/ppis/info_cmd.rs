@@ -48,7 +48,7 @@ pub(crate) fn info_command(args: InfoArgs) -> Result<()> {
     print_scene(&scene);
     println!(
         "a render builds: {} BVH primitives{}; {}",
-        Bvh::build(&scene).primitive_count(),
+        Bvh::count_primitives(&scene),
         if scene.env.is_some() { ", the env hierarchy" } else { "" },
         sampling_summary()
     );

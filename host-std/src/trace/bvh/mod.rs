@@ -95,7 +95,7 @@ impl Bvh {
                 Shape::Mesh { positions, triangles, normals, uvs } => {
                     for (k, t) in triangles.iter().enumerate() {
                         let [a, b, c] = t.map(|i| positions[i as usize]);
-                        if (b - a).cross(c - a).length_squared() > 0.0 {
+                        if has_area(a, b, c) {
                             let n = normals
                                 .get(k)
                                 .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0))
@@ -117,6 +117,23 @@ impl Bvh {
         (prims, binary) = build::build(prims);
         let (nodes, blocks) = wide::collapse(&binary, &prims);
         Bvh { prims, nodes, blocks, corner_attrs }
+    }
+
+    /// The number of primitives `build` makes of `scene`, without building: a sphere is
+    /// one, a rectangle two, a mesh one per triangle with an area.
+    pub fn count_primitives(scene: &Scene) -> usize {
+        let count = |shape: &Shape| match shape {
+            Shape::Sphere { .. } => 1,
+            Shape::Rectangle { .. } => 2,
+            Shape::Mesh { positions, triangles, .. } => triangles
+                .iter()
+                .filter(|t| {
+                    let [a, b, c] = t.map(|i| positions[i as usize]);
+                    has_area(a, b, c)
+                })
+                .count(),
+        };
+        scene.objects.iter().map(|o| count(&o.shape)).sum()
     }
 
     /// Number of primitives.
@@ -207,6 +224,11 @@ impl Bvh {
     }
 }
 
+/// Whether the triangle `a b c` has an area (a degenerate one is never hit, and is left out).
+fn has_area(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    (b - a).cross(c - a).length_squared() > 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -249,6 +271,23 @@ mod tests {
             assert_eq!(*m, bvh.occluded(r.origin, r.dir, r.t_min, r.t_max));
         }
         assert!(many.iter().any(|&m| m) && !many.iter().all(|&m| m));
+    }
+
+    #[test]
+    fn primitives_are_counted_as_built() {
+        let material = Material::new(crate::scene::Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
+        // Two triangles with an area, one with two equal corners, one on a line.
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE, 2.0 * Vec3::ONE];
+        let triangles = vec![[0, 1, 2], [1, 2, 3], [0, 0, 1], [0, 3, 4]];
+        let mesh = Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() };
+        let objects = vec![
+            Object { shape: mesh, material: 0 },
+            Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 },
+            Object { shape: Shape::Rectangle { p0: Vec3::ZERO, e1: Vec3::X, e2: Vec3::Z }, material: 0 },
+        ];
+        let scene = Scene { objects, materials: vec![material], ..crate::scene::builtin::scene() };
+        assert_eq!(Bvh::count_primitives(&scene), 5);
+        assert_eq!(Bvh::build(&scene).primitive_count(), 5);
     }
 
     #[test]

@@ -32,12 +32,12 @@ pub(super) struct Dependencies {
     per_layer: HashMap<LayerId, sdf::PathTable<Vec<Path>>>,
     /// Reverse map for cheap removal: prim_index_path → list of (layer, site)
     /// it registered. Avoids re-walking the index when invalidating.
-    by_prim: HashMap<Path, Vec<(LayerId, Path)>>,
+    by_prim: sdf::PathMap<Vec<(LayerId, Path)>>,
     /// Layer-agnostic set of prim-index paths, each observing exactly its own
     /// path. A prim self-registers here so an empty or cache-miss index stays
     /// findable when a spec is first authored at its path on a layer its graph
     /// does not yet touch; one entry per prim covers that prim on every layer.
-    by_path: HashSet<Path>,
+    by_path: sdf::PathSet,
     /// Reverse `layer → prim-index-paths` map over the layers each index's
     /// composition actually reaches — any dependency node's own layer or a member
     /// of that node's resolved layer stack (including the self-Root edge, which
@@ -47,10 +47,10 @@ pub(super) struct Dependencies {
     /// layers ([`indices_for_layers`](Self::indices_for_layers)). A muted
     /// reference/payload target — reached by nothing — is kept out and tracked by
     /// canonical identifier in [`by_muted_canonical`](Self::by_muted_canonical).
-    by_layer: HashMap<LayerId, HashSet<Path>>,
+    by_layer: HashMap<LayerId, sdf::PathSet>,
     /// The layers `prim_index_path` registered under in `by_layer`, for O(1)
     /// retraction on removal.
-    by_prim_layers: HashMap<Path, HashSet<LayerId>>,
+    by_prim_layers: sdf::PathMap<HashSet<LayerId>>,
     /// Reverse `canonical muted identifier → prim-index-paths` map: which indices
     /// depend on a reference/payload target's *mute state* without reaching it
     /// through a live site. Two cases resolve to one key here — a target muted
@@ -73,12 +73,12 @@ pub(super) struct Dependencies {
     /// stack is never recorded: every prim composes in it, so its entry would
     /// mirror every cached path; [`prims_for_stack`](Self::prims_for_stack)
     /// answers for it with the pseudo-root instead.
-    by_stack: HashMap<LayerStackId, HashSet<Path>>,
+    by_stack: HashMap<LayerStackId, sdf::PathSet>,
     /// The stacks `prim_index_path` registered under — in
     /// [`by_stack`](Self::by_stack), [`by_stack_vars`](Self::by_stack_vars), or
     /// both — for O(1) retraction on removal. Absent for a prim with neither
     /// registration, the common arc-free, expression-free case.
-    by_prim_stacks: HashMap<Path, HashSet<LayerStackId>>,
+    by_prim_stacks: sdf::PathMap<HashSet<LayerStackId>>,
     /// Per-stack expression-variable dependencies: `by_stack_vars[stack][prim]` =
     /// the variable names `prim`'s build read from `stack`'s composed set (C++
     /// `PcpExpressionVariablesDependencyData`). A variable edit that changes

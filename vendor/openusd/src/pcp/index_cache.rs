@@ -100,12 +100,12 @@ pub struct IndexCache {
     // read-mostly; the entries are write-once until invalidation, so a
     // concurrent reader needs only a shared snapshot rather than a lock on the
     // hot path. Keep population off the critical section when that lands.
-    pub(super) redirected_prims: HashMap<Path, Path>,
+    pub(super) redirected_prims: sdf::PathMap<Path>,
     /// The nearest instance at or above each prim path (`None`: not inside an
     /// instance), so finding a prim's enclosing instance costs one step past its
     /// parent's answer instead of a walk to the root (ppis patch, see
     /// PATCHED.md). Invalidated exactly as `redirected_prims` is.
-    pub(super) instance_at_or_above: HashMap<Path, Option<Path>>,
+    pub(super) instance_at_or_above: sdf::PathMap<Option<Path>>,
     /// One-shot errors from layer collection that the [`LayerGraph`](super::layer_graph::LayerGraph)
     /// cannot regenerate (e.g. `UnresolvedSublayer`). Set once at construction;
     /// never cleared, since nothing recomputes them.
@@ -142,7 +142,7 @@ pub struct IndexCache {
     /// of them is cached. Re-entry for an in-progress path
     /// returns early, so the cycle-closing arc simply finds no cached target and
     /// drops out of composition.
-    in_progress: HashSet<Path>,
+    in_progress: sdf::PathSet,
     /// [`Demand`]s a build raised for a target layer that is not yet loaded,
     /// returned up from the indexer (via `BuildOutput`) and accumulated here
     /// across the builds run in a pass. [`Stage::with_cache`](crate::usd::Stage)
@@ -234,11 +234,11 @@ impl IndexCache {
             load_rules,
             clip_cache: ClipCache::default(),
             prototypes: PrototypeRegistry::default(),
-            redirected_prims: HashMap::new(),
-            instance_at_or_above: HashMap::new(),
+            redirected_prims: sdf::PathMap::default(),
+            instance_at_or_above: sdf::PathMap::default(),
             collection_errors,
             query_errors: Vec::new(),
-            in_progress: HashSet::new(),
+            in_progress: sdf::PathSet::default(),
             pending_loads: Vec::new(),
             revision: 0,
         }

@@ -2613,6 +2613,7 @@ impl LayerGraph {
 #[cfg(test)]
 mod tests {
     use std::io;
+    use crate::test_tempdir as tempfile;
     use std::path::Path as FsPath;
 
     use super::*;

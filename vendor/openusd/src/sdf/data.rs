@@ -10,7 +10,7 @@ use std::{
 
 use anyhow::Result;
 
-use crate::sdf::{Path, SpecData, SpecType, Value};
+use crate::sdf::{Path, PathMap, SpecData, SpecType, Value};
 
 /// The scene-description storage interface, mirroring C++ `SdfAbstractData`.
 ///
@@ -131,7 +131,7 @@ pub enum DataError {
 /// In-memory mutable layer data.
 #[derive(Default, Debug, Clone)]
 pub struct Data {
-    specs: HashMap<Path, SpecData>,
+    specs: PathMap<SpecData>,
 }
 
 impl Data {
@@ -142,7 +142,14 @@ impl Data {
 
     /// Build a container from a map of pre-parsed spec records, the form a
     /// reader (e.g. the usda parser) produces.
-    pub fn from_specs(specs: HashMap<Path, SpecData>) -> Self {
+    pub fn from_specs<S>(specs: HashMap<Path, SpecData, S>) -> Self {
+        Self {
+            specs: specs.into_iter().collect(),
+        }
+    }
+
+    /// Build a container from the map a reader produces, keyed as the container keys it.
+    pub fn from_spec_map(specs: PathMap<SpecData>) -> Self {
         Self { specs }
     }
 

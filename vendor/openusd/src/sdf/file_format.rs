@@ -118,6 +118,7 @@ pub trait FileFormat: Sync {
 mod tests {
     use super::*;
     use crate::ar::{DefaultResolver, Resolver};
+    use crate::test_tempdir as tempfile;
     use crate::sdf::{self, SpecType};
     use crate::usda::UsdaFileFormat;
     use crate::usdc::UsdcFileFormat;

@@ -916,6 +916,7 @@ mod tests {
     use super::*;
     use crate::sdf;
     use crate::usda;
+    use crate::test_tempdir as tempfile;
 
     /// Author through the layer's `edit` API and commit, for tests that build a
     /// layer's content or metadata directly.

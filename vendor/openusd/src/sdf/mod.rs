@@ -41,7 +41,7 @@ pub(crate) use layer::{dry_run_layers, edit_layers};
 pub use layer::{AuthoringError, EditError, Layer, LayerEdit, LayerSink, LayerSinkId, PendingLayerChange};
 pub use layer_registry::LayerRegistry;
 pub use ordering::{apply_ordering, element_cmp};
-pub use path::{path, Path, PathArg, PathComponent, PathComponents, PathElement};
+pub use path::{path, BuildPathHasher, Path, PathArg, PathComponent, PathComponents, PathElement, PathHasher, PathMap, PathSet};
 pub use path_table::PathTable;
 pub use schema::{ChildrenKey, FieldKey};
 pub use spec::{

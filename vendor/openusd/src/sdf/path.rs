@@ -1,10 +1,13 @@
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
+mod hasher;
 mod intern;
 mod node;
 mod prefix;
+mod text_cell;
 use node::Kind;
+pub use hasher::{BuildPathHasher, PathHasher, PathMap, PathSet};
 use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};

@@ -3641,6 +3641,7 @@ impl Stage {
 #[cfg(test)]
 mod tests {
     use std::fs;
+    use crate::test_tempdir as tempfile;
     use std::path::Path as FsPath;
 
     use super::*;

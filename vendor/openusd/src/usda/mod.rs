@@ -19,13 +19,13 @@ use crate::{ar, sdf, tf};
 pub fn parse(text: &str) -> Result<sdf::Data> {
     let mut parser = Parser::new(text);
     let specs = parse_on_own_stack(&mut parser)?;
-    Ok(sdf::Data::from_specs(specs))
+    Ok(sdf::Data::from_spec_map(specs))
 }
 
 /// Runs the recursive-descent parser on a thread whose stack holds
 /// [`parser::MAX_NESTING`] levels (ppis patch, see PATCHED.md), so the depth a layer
 /// may nest does not depend on the caller's stack.
-fn parse_on_own_stack(parser: &mut Parser) -> Result<std::collections::HashMap<sdf::Path, sdf::SpecData>> {
+fn parse_on_own_stack(parser: &mut Parser) -> Result<sdf::PathMap<sdf::SpecData>> {
     std::thread::scope(|scope| {
         let worker = std::thread::Builder::new()
             .name("usda-parser".into())
@@ -46,7 +46,7 @@ pub fn read_file(path: impl AsRef<Path>) -> Result<sdf::Data> {
         Some(h) => e.context(format!("{}:{}: {}", path.display(), h.line, h.column)),
         None => e.context(format!("{}: parse error", path.display())),
     })?;
-    Ok(sdf::Data::from_specs(specs))
+    Ok(sdf::Data::from_spec_map(specs))
 }
 
 /// Text format (`.usda`) as an [`sdf::FileFormat`], wrapping [`parse`] and

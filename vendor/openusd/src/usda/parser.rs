@@ -250,8 +250,8 @@ impl<'a> Parser<'a> {
 
     /// Parse tokens to specs.
     /// Walks the entire token stream, seeding the pseudo root and recursing through every prim.
-    pub fn parse(&mut self) -> Result<HashMap<sdf::Path, sdf::SpecData>> {
-        let mut data = HashMap::new();
+    pub fn parse(&mut self) -> Result<sdf::PathMap<sdf::SpecData>> {
+        let mut data = sdf::PathMap::default();
         let current_path = sdf::Path::abs_root();
 
         // Read pseudo root.
@@ -352,7 +352,7 @@ impl<'a> Parser<'a> {
         &mut self,
         current_path: &sdf::Path,
         parent_children: &mut Vec<String>,
-        data: &mut HashMap<sdf::Path, sdf::SpecData>,
+        data: &mut sdf::PathMap<sdf::SpecData>,
     ) -> Result<()> {
         let mut spec = sdf::SpecData::new(sdf::SpecType::Prim);
 
@@ -419,7 +419,7 @@ impl<'a> Parser<'a> {
         &mut self,
         path: &sdf::Path,
         owner_spec: &mut sdf::SpecData,
-        data: &mut HashMap<sdf::Path, sdf::SpecData>,
+        data: &mut sdf::PathMap<sdf::SpecData>,
     ) -> Result<(Vec<String>, Vec<String>, Vec<String>)> {
         ensure!(
             path.prim_element_count() <= MAX_NAMESPACE_DEPTH,
@@ -501,7 +501,7 @@ impl<'a> Parser<'a> {
     fn read_variant_set(
         &mut self,
         prim_path: &sdf::Path,
-        data: &mut HashMap<sdf::Path, sdf::SpecData>,
+        data: &mut sdf::PathMap<sdf::SpecData>,
     ) -> Result<String> {
         self.fetch_next()?; // consume `variantSet`
 
@@ -552,7 +552,7 @@ impl<'a> Parser<'a> {
     }
 
     /// Merge a spec's fields into an existing spec at the given path, or insert it.
-    fn merge_spec(data: &mut HashMap<sdf::Path, sdf::SpecData>, path: sdf::Path, spec: sdf::SpecData) {
+    fn merge_spec(data: &mut sdf::PathMap<sdf::SpecData>, path: sdf::Path, spec: sdf::SpecData) {
         use std::collections::hash_map::Entry;
         match data.entry(path) {
             Entry::Occupied(mut e) => e.get_mut().extend_from(spec),
@@ -581,7 +581,7 @@ impl<'a> Parser<'a> {
         current_path: &sdf::Path,
         properties: &mut Vec<String>,
         suffixed_properties: &mut Vec<String>,
-        data: &mut HashMap<sdf::Path, sdf::SpecData>,
+        data: &mut sdf::PathMap<sdf::SpecData>,
     ) -> Result<()> {
         let mut custom = false;
         let list_op = self.try_list_op();
@@ -884,7 +884,7 @@ impl<'a> Parser<'a> {
         current_path: &sdf::Path,
         custom: bool,
         properties: &mut Vec<String>,
-        data: &mut HashMap<sdf::Path, sdf::SpecData>,
+        data: &mut sdf::PathMap<sdf::SpecData>,
         outer_list_op: Option<Token<'a>>,
     ) -> Result<()> {
         let name = self.expect_name().context("relationship name expected")?;

@@ -1,6 +1,6 @@
 //! Binary file format (`usdc`) implementation.
 
-use std::{borrow::Cow, cell::RefCell, collections::HashMap, fmt::Debug, io, mem, path::Path};
+use std::{borrow::Cow, cell::RefCell, fmt::Debug, io, mem, path::Path};
 
 use anyhow::{Context, Result};
 use layout::ValueRep;
@@ -85,7 +85,7 @@ impl Spec {
 /// High level interface to binary data.
 pub struct CrateData<R> {
     file: RefCell<CrateFile<R>>,
-    data: HashMap<sdf::Path, Spec>,
+    data: sdf::PathMap<Spec>,
 }
 
 impl<R> CrateData<R>
@@ -104,7 +104,7 @@ where
         // its fieldset. The fields themselves stay in the file's compact,
         // deduplicated arrays and are resolved on demand.
         let specs = mem::take(&mut file.specs);
-        let mut data = HashMap::with_capacity(specs.len());
+        let mut data = sdf::PathMap::with_capacity_and_hasher(specs.len(), Default::default());
 
         for spec in &specs {
             let path = file.paths[spec.path_index].clone();

@@ -101,6 +101,7 @@ impl sdf::FileFormat for UsdzFileFormat {
 mod tests {
     use super::*;
     use crate::usd::{Stage, TimeCode};
+    use crate::test_tempdir as tempfile;
 
     /// A `.usdz` whose root layer references another layer *inside the same
     /// archive*. The reference (`@./inner.usda@`) must resolve in-package —

@@ -25,10 +25,11 @@
 //! property name may hold `:` and `.` but not end with `.`.
 
 use super::intern;
+use super::text_cell::TextCell;
 use super::{is_prim_name_char, Path};
 use std::cmp::Ordering;
 use std::hash::{DefaultHasher, Hash, Hasher};
-use std::sync::{Arc, LazyLock, OnceLock};
+use std::sync::{Arc, LazyLock};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -64,8 +65,12 @@ pub(super) struct Node {
     /// interned nodes are different paths.
     pub(super) interned: bool,
     /// The whole text, made on the first `Path::as_str` of a node with a parent.
-    text: OnceLock<Box<str>>,
+    text: TextCell,
 }
+
+// Every path is a node, most of them a property's (one per attribute of every spec in a
+// layer), so a node stays this small: 88 bytes with the `Arc`'s counts.
+const _: () = assert!(std::mem::size_of::<Node>() == 72);
 
 impl Drop for Node {
     /// Unlinks the chain one node at a time: dropping the last path of a deep chain
@@ -98,7 +103,7 @@ fn leaf(kind: Kind, text: &str) -> Path {
             len: text.len(),
             hash,
             interned: false,
-            text: OnceLock::new(),
+            text: TextCell::new(),
         }),
     }
 }
@@ -228,7 +233,7 @@ impl Path {
                 len: up.len + separator + seg_len,
                 hash,
                 interned,
-                text: OnceLock::new(),
+                text: TextCell::new(),
             })
         };
         // Below a node left out of the table nothing is interned: an interned node's
@@ -335,18 +340,36 @@ impl Path {
         self.hash
     }
 
+    /// The order of the texts. Two structured paths agree in their text down to their
+    /// deepest common node, so only the pieces below it are compared: for siblings (the
+    /// children of one prim, kept sorted by `PathTable`) that is their own names.
     pub(super) fn text_cmp(&self, other: &Path) -> Ordering {
         if Arc::ptr_eq(&self.node, &other.node) {
             return Ordering::Equal;
+        }
+        if self.is_structured() && other.is_structured() {
+            if let (Some(p), Some(q)) = (&self.node.parent, &other.node.parent) {
+                if Arc::ptr_eq(&p.node, &q.node) {
+                    return self.own_bytes().cmp(other.own_bytes());
+                }
+            }
+            let (a, b) = (self.chain(), other.chain());
+            let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+            let below_a = a[common..].iter().flat_map(|p| p.own_bytes());
+            return below_a.cmp(b[common..].iter().flat_map(|p| p.own_bytes()));
         }
         let pieces = |p: &Path| {
             let mut v: Vec<u8> = Vec::with_capacity(p.node.len);
             p.for_each_piece(|s| v.extend_from_slice(s.as_bytes()));
             v
         };
-        match (self.node.parent.is_none() || self.node.text.get().is_some(), other.node.parent.is_none()) {
-            (true, true) => self.text().cmp(other.text()),
-            _ => pieces(self).cmp(&pieces(other)),
-        }
+        pieces(self).cmp(&pieces(other))
+    }
+
+    /// The bytes this node adds to its parent's text: its separator, if any, and segment.
+    fn own_bytes(&self) -> impl Iterator<Item = u8> + '_ {
+        let slash = self.node.kind == Kind::Prim && self.node.parent.as_ref().is_some_and(|up| up.node.kind == Kind::Prim);
+        let separator: &[u8] = if slash { b"/" } else { b"" };
+        separator.iter().chain(self.node.seg.as_bytes()).copied()
     }
 }
