@@ -66,7 +66,7 @@ where
     for p in curves.iter().flat_map(|c| &c.points).filter(|p| p.relmse > 0.0) {
         (e0, e1) = (e0.min(p.relmse), e1.max(p.relmse));
     }
-    if !(e0 < e1) {
+    if e0.partial_cmp(&e1) != Some(std::cmp::Ordering::Less) {
         (e0, e1) = (e0.min(1e-6), e1.max(1.0));
     }
     let name = if region == "all" { "whole image" } else { region };
@@ -82,6 +82,7 @@ where
         .x_desc("BRDF samples K")
         .y_desc("relMSE at equal time")
         .x_labels((k1 - k0) as usize + 2)
+        .max_light_lines(2)
         .x_label_formatter(&|x| format!("{:.0}", x.exp2()))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .label_style(("sans-serif", 12))
