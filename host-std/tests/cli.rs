@@ -49,6 +49,18 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["info", "--no-such-flag"], "--no-such-flag");
     fails(dir, &["report", "--methods", "mis,nope"], "nope");
     fails(dir, &["report", "--spp", "0"], "--spp");
+    // A K above the largest arena names both; no silent clamp.
+    fails(
+        dir,
+        &["render", "--brdf-samples", "1025"],
+        "--brdf-samples 1025: 1025 BRDF samples asked of a product arena that holds 1024",
+    );
+    fails(
+        dir,
+        &["report", "--out", "k", "--brdf-samples", "64,4096"],
+        "4096 BRDF samples asked of a product arena that holds 1024",
+    );
+    fails(dir, &["render", "--brdf-samples", "0"], "--brdf-samples");
     fails(dir, &["bogus"], "bogus");
     fails(dir, &[], "render");
     fails(dir, &["render", "--render-settings", "/Render/S"], "USD");
@@ -211,6 +223,31 @@ fn report_writes_csv_plots_and_table() {
     // Bad input fails before the output folder is made.
     fails(dir, &["report", "--out", "rep4", "--reference", "missing.exr"], "missing.exr");
     assert!(!dir.join("rep4").exists(), "a failed report left its folder");
+}
+
+/// `--brdf-samples 16,300`: product-MIS at each K (300 in the large arena), MIS once, and the
+/// K sweep's files beside the report's.
+#[test]
+fn report_sweeps_brdf_samples() {
+    let tmp = scratch("ksweep");
+    let dir = tmp.path();
+    let args = ["--spp", "2,4", "--methods", "product-mis,mis", "--brdf-samples", "300,16", "--base", "product-mis"];
+    tiny_report(dir, &args);
+    for f in ["error_vs_k.csv", "error_vs_k.md", "error_vs_k.svg", "error_vs_k.png"] {
+        assert!(dir.join("rep").join(f).is_file(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(dir.join("rep/error_vs_time.csv")).unwrap();
+    let all: Vec<&str> = csv.lines().filter(|l| l.contains(",all,")).collect();
+    assert_eq!(all.len(), 2 * 2 + 2, "product-MIS at two K, MIS once, two spp each: {csv}");
+    assert!(all.iter().any(|l| l.starts_with("product-mis,4,") && l.ends_with(",300")), "{csv}");
+    assert!(all.iter().any(|l| l.starts_with("mis,4,") && l.ends_with(',')), "{csv}");
+    let k = std::fs::read_to_string(dir.join("rep/error_vs_k.csv")).unwrap();
+    assert!(k.lines().any(|l| l.starts_with("all,product-mis,16,")), "{k}");
+    assert!(!k.contains(",mis,"), "MIS reads no K: {k}");
+    let md = std::fs::read_to_string(dir.join("rep/error_vs_k.md")).unwrap();
+    assert!(md.contains("## Optimum") && md.contains("| 300 |"), "{md}");
+    let report = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
+    assert!(report.contains("| product-mis K=16 | 2 |"), "{report}");
 }
 
 #[test]

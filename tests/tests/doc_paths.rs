@@ -18,7 +18,16 @@ const EXTENSIONS: [&str; 17] = [
 const CRATES: [&str; 5] = ["sampler-core", "sampler-capi", "host-std", "host-usd", "tests"];
 const PLACEHOLDERS: [&str; 10] = ["OUT", "SCENE", "DIR", "FILE", "NAME", "…", "...", "<", "*", "{"];
 /// Files `ppis render` and `ppis report` write, named in the docs as outputs.
-const OUTPUTS: [&str; 5] = ["render.exr", "render.png", "reference.exr", "error_vs_time.csv", "report.md"];
+const OUTPUTS: [&str; 8] = [
+    "render.exr",
+    "render.png",
+    "reference.exr",
+    "error_vs_time.csv",
+    "report.md",
+    "error_vs_k.csv",
+    "error_vs_k.md",
+    "error_vs_k.png",
+];
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

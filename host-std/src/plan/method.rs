@@ -125,6 +125,14 @@ impl Method {
         }
     }
 
+    /// Whether a render with this method builds product samplers from
+    /// [`Settings::brdf_samples`](crate::plan::Settings::brdf_samples) BRDF samples (`auto`
+    /// where it picks product-MIS, and its pilot).
+    #[must_use]
+    pub fn reads_brdf_samples(self) -> bool {
+        matches!(self, Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto)
+    }
+
     /// Whether a render with this method reads the map's peak (`auto`'s rules and
     /// product-MIS's split do).
     #[must_use]

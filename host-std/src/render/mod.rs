@@ -11,6 +11,7 @@
 
 pub mod crop;
 pub mod pixel;
+pub mod product_arena;
 pub mod sampler_cache;
 pub mod shade;
 pub mod strategy;

@@ -11,6 +11,7 @@
 
 use crate::render::Context;
 use crate::render::pixel::Hit;
+use crate::render::product_arena::SizedArena;
 use crate::render::shade::Sampling;
 use crate::render::strategy::{MaterialPlan, Strategy};
 use sampler_core::brdf::Brdf;
@@ -18,7 +19,7 @@ use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
 use sampler_core::glam::Vec3;
 use sampler_core::quadtree::ProductKind;
-use sampler_core::sampler::{ProductArena, ProductParams, ProductSampler};
+use sampler_core::sampler::{ProductParams, ProductSampler};
 use sampler_core::two_level::{TwoLevelArena, TwoLevelSampler};
 use sampler_core::two_stage::TwoStageSampler;
 
@@ -42,13 +43,14 @@ pub fn reuse_cosine(brdf: &dyn Brdf) -> f32 {
     (REUSE_SHARE * brdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
 }
 
-/// `--brdf-samples` is at most the arena's capacity (the command line's range).
-const BRDF_SAMPLES_FIT: &str = "--brdf-samples within the product arena's capacity";
+/// The render's K is at most the largest arena's capacity: the command line checks it
+/// (`product_arena::check_brdf_samples`) before it renders.
+const BRDF_SAMPLES_FIT: &str = "--brdf-samples within the product arenas' capacity";
 
 /// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
 /// direction of the shading point it was built at.
 struct SharedSampler {
-    arena: Box<ProductArena>,
+    arena: SizedArena,
     normal: Vec3,
     mirror: Vec3,
 }
@@ -67,7 +69,7 @@ pub(crate) struct Lead<'a> {
 /// A tile's samplers, reused from pixel to pixel.
 pub(crate) struct SamplerCache {
     /// For the product samplers built per shading point.
-    arena: Option<Box<ProductArena>>,
+    arena: Option<SizedArena>,
     /// For the two-level samplers, built per shading point.
     two_level: Option<Box<TwoLevelArena>>,
     /// Per material, the product-MIS sampler built last and where.
@@ -133,7 +135,10 @@ impl SamplerCache {
         lead: &Lead<'_>,
     ) -> ProductSampler<'s, 'e> {
         let params = ProductParams { brdf_samples: ctx.options.brdf_samples, kind, ..ProductParams::default() };
-        let arena = self.arena.get_or_insert_with(|| Box::new(ProductArena::new()));
+        let arena = match &mut self.arena {
+            Some(arena) => arena,
+            empty => empty.insert(SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT)),
+        };
         let sp = lead.sp;
         arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT)
     }
@@ -153,8 +158,14 @@ impl SamplerCache {
         let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
         let slot = &mut self.shared[hit.material];
         if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
-            let c = slot.get_or_insert_with(|| SharedSampler { arena: Box::new(ProductArena::new()), normal, mirror });
             let params = ProductParams::for_mis(ctx.options.brdf_samples);
+            let c = match &mut *slot {
+                Some(c) => c,
+                empty => {
+                    let arena = SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT);
+                    empty.insert(SharedSampler { arena, normal, mirror })
+                }
+            };
             c.arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT);
             (c.normal, c.mirror) = (normal, mirror);
         }

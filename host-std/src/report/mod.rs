@@ -6,11 +6,17 @@
 //! with ε = 0.01 (the usual guard for dark pixels).
 
 mod errors;
+mod k_plot;
+mod k_sweep;
 mod plot;
+mod series;
 mod tables;
 
 pub use errors::{Regions, errors};
+pub use k_plot::plot_k;
+pub use k_sweep::{KCurve, KPoint, KSweep, reference_k};
 pub use plot::plot;
+pub use series::Series;
 pub use tables::{csv, markdown, relmse_at};
 
 use crate::plan::{self, Method, Settings, ShadingPoints};
@@ -54,6 +60,9 @@ pub struct Timing {
 pub struct Measurement {
     /// The method.
     pub method: Method,
+    /// BRDF samples per product sampler, where the sweep varies them and the method reads
+    /// them (`None`: the sweep's one K, or a method that builds no product sampler).
+    pub brdf_samples: Option<usize>,
     /// Visibility samples per pixel.
     pub spp: usize,
     /// Render time (the fastest of the repeats).
@@ -69,6 +78,12 @@ pub struct Measurement {
 }
 
 impl Measurement {
+    /// The method and K of this render: the line it belongs to in the plots and tables.
+    #[must_use]
+    pub fn series(&self) -> Series {
+        Series { method: self.method, brdf_samples: self.brdf_samples }
+    }
+
     /// relMSE over `region` ("all" for the whole image).
     pub fn relmse_in(&self, region: &str) -> Option<f64> {
         if region == "all" {
@@ -78,15 +93,18 @@ impl Measurement {
     }
 }
 
-/// Renders every (method, spp) pair, with `points` shading points per pixel, and measures it
-/// against `reference`. With `bracket`
-/// (the base method of the equal-time tables), every faster method is then rendered on at
-/// doubling spp — at most [`BRACKET_DOUBLINGS`] times — until its time reaches the base's at
-/// its largest spp, so that the tables interpolate its error there instead of extrapolating.
-/// Renders are timed by `timing.clock`. With `timing.repeat` > 1 every render is timed that many times in all, in rounds over all the
-/// (method, spp) pairs — so that a slow spell of the machine falls on all methods alike — and
-/// keeps its fastest time (the image, and so its error, is the same each time: renders are
-/// deterministic). `progress` is told about each first render.
+/// Renders every (method, K, spp) triple — every K of `brdf_samples` for the methods that read
+/// it, one render per spp for the others — with `points` shading points per pixel, and
+/// measures it against `reference`. With `bracket` (the base series of the equal-time tables),
+/// every other series is then rendered on at doubling spp — at most [`BRACKET_DOUBLINGS`]
+/// times — until its time reaches the base's at its largest spp, and at halving spp while its
+/// fastest render is still slower than that, so that the tables interpolate its error there
+/// instead of extrapolating; in a sweep over K, each K is bracketed so against its method at
+/// the reference K (`reference_k`, the time of the K figure: [`KSweep`]). Renders are timed by `timing.clock`. With `timing.repeat` > 1
+/// every render is timed that many times in all, in rounds over all the renders — so that a
+/// slow spell of the machine falls on all series alike — and keeps its fastest time (the
+/// image, and so its error, is the same each time: renders are deterministic). `progress` is
+/// told about each first render.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep(
     scene: &Scene,
@@ -94,18 +112,24 @@ pub fn sweep(
     env: Option<&EnvHierarchy<'_>>,
     methods: &[Method],
     spps: &[usize],
+    brdf_samples: &[usize],
     base: &Settings,
     points: ShadingPoints,
     reference: &[[f32; 3]],
-    bracket: Option<Method>,
+    bracket: Option<Series>,
     timing: Timing,
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
-    let settings =
-        |method: Method, spp: usize| Settings { method, spp, shading_points: points.resolve(method, spp), ..*base };
-    let mut measure = |method: Method, spp: usize| {
-        let image = plan::render(scene, bvh, env, &settings(method, spp));
+    let settings = |series: Series, spp: usize| Settings {
+        method: series.method,
+        spp,
+        shading_points: points.resolve(series.method, spp),
+        brdf_samples: series.brdf_samples.unwrap_or(base.brdf_samples),
+        ..*base
+    };
+    let mut measure = |series: Series, spp: usize| {
+        let image = plan::render(scene, bvh, env, &settings(series, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
         let plans = image
@@ -119,53 +143,77 @@ pub fn sweep(
                 )
             })
             .collect();
-        let m = Measurement { method, spp, seconds: timing.clock.seconds(&image), rmse, relmse, regions, plans };
+        let (method, k) = (series.method, series.brdf_samples);
+        let seconds = timing.clock.seconds(&image);
+        let m = Measurement { method, brdf_samples: k, spp, seconds, rmse, relmse, regions, plans };
         progress(&m);
         m
     };
-    let mut out = Vec::new();
+    let mut all: Vec<Series> = Vec::new();
     for &method in methods {
+        for &k in brdf_samples {
+            let series = Series::of(method, brdf_samples, k);
+            if !all.contains(&series) {
+                all.push(series);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for &series in &all {
         for &spp in spps {
-            out.push(measure(method, spp));
+            out.push(measure(series, spp));
         }
     }
     if let Some(target) = bracket {
-        bracket_base(&mut out, methods, target, &mut measure);
+        bracket_base(&mut out, &all, target, &mut measure);
+        if brdf_samples.len() > 1 {
+            let k_ref = reference_k(brdf_samples);
+            for &method in methods.iter().filter(|m| m.reads_brdf_samples()) {
+                let own: Vec<Series> = all.iter().copied().filter(|s| s.method == method).collect();
+                bracket_base(&mut out, &own, Series::of(method, brdf_samples, k_ref), &mut measure);
+            }
+        }
     }
-    keep_fastest(&mut out, timing.repeat, |method, spp| {
-        timing.clock.seconds(&plan::render(scene, bvh, env, &Settings { progress: false, ..settings(method, spp) }))
+    keep_fastest(&mut out, timing.repeat, |series, spp| {
+        timing.clock.seconds(&plan::render(scene, bvh, env, &Settings { progress: false, ..settings(series, spp) }))
     });
     out
 }
 
 /// Times every measurement `repeat − 1` more times with `time`, in rounds over all of them
-/// (a slow spell of the machine falls on every method alike), and keeps each one's fastest.
-fn keep_fastest(out: &mut [Measurement], repeat: usize, mut time: impl FnMut(Method, usize) -> f64) {
+/// (a slow spell of the machine falls on every series alike), and keeps each one's fastest.
+fn keep_fastest(out: &mut [Measurement], repeat: usize, mut time: impl FnMut(Series, usize) -> f64) {
     for _ in 1..repeat {
         for m in out.iter_mut() {
-            m.seconds = m.seconds.min(time(m.method, m.spp));
+            m.seconds = m.seconds.min(time(m.series(), m.spp));
         }
     }
 }
 
-/// Renders every method but `target` on at doubling spp until it reaches `target`'s time at its
-/// largest spp (see [`sweep`]).
+/// Renders every series but `target` on at doubling spp until it reaches `target`'s time at
+/// its largest spp, and at halving spp while it is slower than that everywhere (see [`sweep`]).
 fn bracket_base(
     out: &mut Vec<Measurement>,
-    methods: &[Method],
-    target: Method,
-    measure: &mut impl FnMut(Method, usize) -> Measurement,
+    all: &[Series],
+    target: Series,
+    measure: &mut impl FnMut(Series, usize) -> Measurement,
 ) {
-    let slowest = |out: &[Measurement], m: Method| {
-        out.iter().filter(|x| x.method == m).max_by_key(|x| x.spp).map(|x| (x.spp, x.seconds))
+    let of = |out: &[Measurement], s: Series| -> Vec<(usize, f64)> {
+        out.iter().filter(|x| x.series() == s).map(|x| (x.spp, x.seconds)).collect()
     };
-    let Some((_, goal)) = slowest(out, target) else { return };
-    for &method in methods.iter().filter(|&&m| m != target) {
+    let Some((_, goal)) = of(out, target).into_iter().max_by_key(|x| x.0) else { return };
+    for &series in all.iter().filter(|&&s| s != target) {
         for _ in 0..BRACKET_DOUBLINGS {
-            match slowest(out, method) {
+            match of(out, series).into_iter().max_by_key(|x| x.0) {
                 Some((spp, seconds)) if seconds < goal && spp <= MAX_BRACKET_SPP / 2 => {
-                    out.push(measure(method, 2 * spp));
+                    out.push(measure(series, 2 * spp));
                 }
+                _ => break,
+            }
+        }
+        for _ in 0..BRACKET_DOUBLINGS {
+            match of(out, series).into_iter().min_by_key(|x| x.0) {
+                Some((spp, seconds)) if seconds > goal && spp >= 2 => out.push(measure(series, spp / 2)),
                 _ => break,
             }
         }
@@ -184,7 +232,16 @@ mod tests {
 
     fn m(method: Method, spp: usize, seconds: f64, relmse: f64) -> Measurement {
         let regions = vec![("carpaint".into(), 0.0, relmse / 2.0)];
-        Measurement { method, spp, seconds, rmse: relmse.sqrt(), relmse, regions, plans: Vec::new() }
+        Measurement {
+            method,
+            brdf_samples: None,
+            spp,
+            seconds,
+            rmse: relmse.sqrt(),
+            relmse,
+            regions,
+            plans: Vec::new(),
+        }
     }
 
     #[test]
@@ -193,8 +250,8 @@ mod tests {
         // Round 1: a slow spell (both slower than their first run); round 2: both faster.
         let times = [9.0, 9.0, 1.5, 0.5];
         let (mut calls, mut order) = (0, Vec::new());
-        keep_fastest(&mut out, 3, |method, _| {
-            order.push(method);
+        keep_fastest(&mut out, 3, |series, _| {
+            order.push(series.method);
             calls += 1;
             times[calls - 1]
         });
@@ -207,18 +264,18 @@ mod tests {
     #[test]
     fn equal_time_interpolates_log_log() {
         let ms = [m(Method::Env, 4, 1.0, 0.4), m(Method::Env, 16, 4.0, 0.1), m(Method::Product, 4, 2.0, 0.05)];
-        let (e, outside) = relmse_at(&ms, Method::Env, "all", 2.0).unwrap();
+        let (e, outside) = relmse_at(&ms, Method::Env.into(), "all", 2.0).unwrap();
         assert!((e - 0.2).abs() < 1e-9 && !outside); // error ∝ 1/t between the points
-        let (e, outside) = relmse_at(&ms, Method::Env, "all", 8.0).unwrap();
+        let (e, outside) = relmse_at(&ms, Method::Env.into(), "all", 8.0).unwrap();
         assert!((e - 0.05).abs() < 1e-9 && outside);
-        let md = markdown("t", &ms, Method::Product, 2, "test");
+        let md = markdown("t", &ms, Method::Product.into(), 2, "test");
         assert!(md.contains("| 4 | 2.000 | 5.0000e-2 | 2.0000e-1 | 4.00 |"), "{md}");
         assert!(md.contains("### pixels on carpaint"), "{md}");
         assert!(md.contains("| 4 | 2.000 | 2.5000e-2 | 1.0000e-1 | 4.00 |"), "{md}");
         assert!(!md.contains(" spp: "), "no plans without auto");
         let mut auto = m(Method::Auto, 16, 3.0, 0.08);
         auto.plans = vec![("diffuse".into(), "env (pilot)".into()), ("carpaint".into(), "mis".into())];
-        let md = markdown("t", &[auto], Method::Product, 2, "test");
+        let md = markdown("t", &[auto], Method::Product.into(), 2, "test");
         assert!(md.contains("auto at 16 spp: diffuse → env (pilot), carpaint → mis."), "{md}");
     }
 

@@ -1,12 +1,12 @@
 //! The log-log plot of relMSE against render time.
 
-use crate::plan::Method;
-use crate::report::Measurement;
+use crate::report::{Measurement, Series};
 use std::path::Path;
 
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
-/// The log-log plot of relMSE against time, one line per method, as SVG and PNG.
+/// The log-log plot of relMSE against time, one line per series (method, and K where the
+/// report sweeps it), as SVG and PNG.
 pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measurement]) -> Result<(), String> {
     use plotters::prelude::*;
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
@@ -17,16 +17,18 @@ pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measu
     if !(t0 < t1 && e0 < e1) {
         (t0, t1, e0, e1) = (t0.min(1e-3), t1.max(1.0), e0.min(1e-6), e1.max(1.0));
     }
-    let methods: Vec<Method> = {
-        let mut v: Vec<Method> = measurements.iter().map(|m| m.method).collect();
-        v.dedup();
-        v
-    };
+    // In order of first appearance (bracketing renders come last).
+    let mut series: Vec<Series> = Vec::new();
+    for m in measurements {
+        if !series.contains(&m.series()) {
+            series.push(m.series());
+        }
+    }
     fn draw<DB: DrawingBackend>(
         root: DrawingArea<DB, plotters::coord::Shift>,
         title: &str,
         ranges: (f64, f64, f64, f64),
-        methods: &[Method],
+        series: &[Series],
         measurements: &[Measurement],
     ) -> Result<(), String>
     where
@@ -50,18 +52,18 @@ pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measu
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| e.to_string())?;
-        for (k, &method) in methods.iter().enumerate() {
+        for (k, &line) in series.iter().enumerate() {
             let colour = Palette99::pick(k).to_rgba();
             let mut pts: Vec<(f64, f64)> = measurements
                 .iter()
-                .filter(|m| m.method == method && m.seconds > 0.0 && m.relmse > 0.0)
+                .filter(|m| m.series() == line && m.seconds > 0.0 && m.relmse > 0.0)
                 .map(|m| (m.seconds, m.relmse))
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             chart
                 .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
-                .label(method.name())
+                .label(line.to_string())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
             chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled()))).map_err(|e| e.to_string())?;
         }
@@ -75,7 +77,7 @@ pub fn plot(path_svg: &Path, path_png: &Path, title: &str, measurements: &[Measu
         root.present().map_err(|e| e.to_string())
     }
     let ranges = (t0, t1, e0, e1);
-    draw(SVGBackend::new(path_svg, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
-    draw(BitMapBackend::new(path_png, (900, 600)).into_drawing_area(), title, ranges, &methods, measurements)?;
+    draw(SVGBackend::new(path_svg, (900, 600)).into_drawing_area(), title, ranges, &series, measurements)?;
+    draw(BitMapBackend::new(path_png, (900, 600)).into_drawing_area(), title, ranges, &series, measurements)?;
     Ok(())
 }

@@ -1,15 +1,14 @@
 //! The report's text: the CSV of every render and the Markdown equal-time tables.
 
-use crate::plan::Method;
-use crate::report::Measurement;
+use crate::report::{Measurement, Series};
 use std::fmt::Write as _;
 
-/// relMSE over `region` of `method` at time `t`, interpolated log-log between its
+/// relMSE over `region` of `series` at time `t`, interpolated log-log between its
 /// measurements (outside their range: extended along the nearest segment; flagged).
-pub fn relmse_at(measurements: &[Measurement], method: Method, region: &str, t: f64) -> Option<(f64, bool)> {
+pub fn relmse_at(measurements: &[Measurement], series: Series, region: &str, t: f64) -> Option<(f64, bool)> {
     let mut pts: Vec<(f64, f64)> = measurements
         .iter()
-        .filter(|m| m.method == method && m.seconds > 0.0)
+        .filter(|m| m.series() == series && m.seconds > 0.0)
         .filter_map(|m| m.relmse_in(region).filter(|e| *e > 0.0).map(|e| (m.seconds.ln(), e.ln())))
         .collect();
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -29,13 +28,15 @@ pub fn relmse_at(measurements: &[Measurement], method: Method, region: &str, t: 
     Some((y.exp(), outside))
 }
 
-/// `error_vs_time.csv`: one row per render and region ("all" is the whole image).
+/// `error_vs_time.csv`: one row per render and region ("all" is the whole image);
+/// `brdf_samples` is empty where the report has one K or the method reads none.
 pub fn csv(measurements: &[Measurement]) -> String {
-    let mut s = String::from("method,spp,seconds,region,rmse,relmse\n");
+    let mut s = String::from("method,spp,seconds,region,rmse,relmse,brdf_samples\n");
     for m in measurements {
-        let _ = writeln!(s, "{},{},{:.6},all,{:.6e},{:.6e}", m.method, m.spp, m.seconds, m.rmse, m.relmse);
-        for (region, rmse, relmse) in &m.regions {
-            let _ = writeln!(s, "{},{},{:.6},{region},{rmse:.6e},{relmse:.6e}", m.method, m.spp, m.seconds);
+        let k = m.brdf_samples.map_or(String::new(), |k| k.to_string());
+        let rows = std::iter::once(("all", m.rmse, m.relmse)).chain(m.regions.iter().map(|r| (r.0.as_str(), r.1, r.2)));
+        for (region, rmse, relmse) in rows {
+            let _ = writeln!(s, "{},{},{:.6},{region},{rmse:.6e},{relmse:.6e},{k}", m.method, m.spp, m.seconds);
         }
     }
     s
@@ -46,7 +47,7 @@ pub fn csv(measurements: &[Measurement]) -> String {
 pub fn markdown(
     scene: &str,
     measurements: &[Measurement],
-    base: Method,
+    base: Series,
     threads: usize,
     reference_note: &str,
 ) -> String {
@@ -62,7 +63,7 @@ pub fn markdown(
     s.push_str(&"---|".repeat(regions.len()));
     s.push('\n');
     for m in measurements {
-        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.method, m.spp, m.seconds, m.rmse, m.relmse);
+        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.series(), m.spp, m.seconds, m.rmse, m.relmse);
         for r in &m.regions {
             let _ = write!(s, " {:.4e} |", r.2);
         }
@@ -70,15 +71,15 @@ pub fn markdown(
     }
     for m in measurements.iter().filter(|m| !m.plans.is_empty()) {
         let plans: Vec<String> = m.plans.iter().map(|(material, plan)| format!("{material} → {plan}")).collect();
-        let _ = writeln!(s, "\n{} at {} spp: {}.", m.method, m.spp, plans.join(", "));
+        let _ = writeln!(s, "\n{} at {} spp: {}.", m.series(), m.spp, plans.join(", "));
     }
-    let mut others: Vec<Method> = Vec::new();
+    let mut others: Vec<Series> = Vec::new();
     for m in measurements {
-        if m.method != base && !others.contains(&m.method) {
-            others.push(m.method);
+        if m.series() != base && !others.contains(&m.series()) {
+            others.push(m.series());
         }
     }
-    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.method == base).collect();
+    let product: Vec<&Measurement> = measurements.iter().filter(|m| m.series() == base).collect();
     if product.is_empty() || others.is_empty() {
         return s;
     }

@@ -61,9 +61,6 @@ pub(crate) struct SamplingArgs {
     /// `render`: a P given must divide --spp; `report`: reduced to a divisor of each spp.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) shading_points: Option<u32>,
-    /// BRDF samples per product sampler (the paper's K).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub(crate) brdf_samples: u32,
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,
     /// Worker threads, for the BVH and environment builds and the render (default: all cores).
@@ -101,6 +98,13 @@ impl SamplingArgs {
     pub(crate) fn threads(&self) -> usize {
         self.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize)
     }
+}
+
+/// `--brdf-samples` within what the renderer's product arenas hold: the one-line error naming
+/// both otherwise.
+pub(crate) fn check_brdf_samples(brdf_samples: u32) -> anyhow::Result<()> {
+    host_std::render::product_arena::check_brdf_samples(brdf_samples as usize)
+        .map_err(|e| anyhow::anyhow!("--brdf-samples {brdf_samples}: {e}"))
 }
 
 pub(crate) fn parse_method(s: &str) -> Result<Method, String> {

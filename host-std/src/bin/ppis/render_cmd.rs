@@ -1,7 +1,7 @@
 //! `ppis render`: one scene, one method, to a linear EXR, an sRGB PNG and optionally the
 //! stats JSON; with `--crop`, a part of the frame (a tile for `ppis merge`).
 
-use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, check_brdf_samples, parse_method};
 use crate::load::{load_scene, warn_notes};
 use crate::provenance;
 use crate::stats::Stats;
@@ -28,6 +28,9 @@ pub(crate) struct RenderArgs {
     /// Visibility samples (shadow rays) per pixel.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub(crate) spp: u32,
+    /// BRDF samples per product sampler (the paper's K; at most 1024).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
+    pub(crate) brdf_samples: u32,
     #[command(flatten)]
     pub(crate) sampling: SamplingArgs,
     /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
@@ -65,6 +68,7 @@ pub(crate) struct Prepared {
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
+    check_brdf_samples(args.brdf_samples)?;
     let shading_points = match args.sampling.shading_points {
         Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
         Some(p) => p,
@@ -79,7 +83,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         method: args.method,
         spp: args.spp as usize,
         shading_points: shading_points as usize,
-        brdf_samples: args.sampling.brdf_samples as usize,
+        brdf_samples: args.brdf_samples as usize,
         seed: args.sampling.seed,
         progress: true,
         shadows: !args.sampling.unshadowed,

@@ -1,14 +1,14 @@
 //! `ppis report`: every method at every sample count against a reference — error against
 //! render time as CSV, plot and equal-time tables.
 
-use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, parse_method};
+use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, check_brdf_samples, parse_method};
 use crate::load::{load_scene, warn_notes};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{self, Settings, ShadingPoints};
-use host_std::report::{Clock, Timing};
+use host_std::report::{Clock, KSweep, Series, Timing};
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
 use host_std::{output, report};
@@ -25,6 +25,11 @@ pub(crate) struct ReportArgs {
     /// Comma-separated visibility samples per pixel.
     #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     spp: Vec<u32>,
+    /// Comma-separated BRDF samples per product sampler (the paper's K; each at most 1024).
+    /// More than one: the methods that build product samplers are rendered at each, and the
+    /// report adds relMSE at equal time against K (error_vs_k.csv, .md, .svg, .png).
+    #[arg(long, default_value = "256", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..))]
+    brdf_samples: Vec<u32>,
     /// Reference image (linear EXR of the same size); otherwise one is rendered.
     #[arg(long, conflicts_with = "reference_spp")]
     reference: Option<PathBuf>,
@@ -63,6 +68,13 @@ pub(crate) struct ReportArgs {
 }
 
 pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
+    for &k in &args.brdf_samples {
+        check_brdf_samples(k)?;
+    }
+    let mut ks: Vec<usize> = args.brdf_samples.iter().map(|&k| k as usize).collect();
+    ks.sort_unstable();
+    ks.dedup();
+    let reference_k = report::reference_k(&ks);
     let base_method = match args.base {
         Some(b) if !args.methods.contains(&b) => bail!("--base {b} is not among --methods"),
         Some(b) => b,
@@ -100,7 +112,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         method: Method::Product,
         spp: 1,
         shading_points: 1,
-        brdf_samples: args.sampling.brdf_samples as usize,
+        brdf_samples: reference_k,
         seed: args.sampling.seed,
         progress: false,
         shadows: !args.sampling.unshadowed,
@@ -110,7 +122,8 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         None => render_reference(&args, &pool, &scene, &bvh, hierarchy.as_ref(), &base)?,
     };
     let spps: Vec<usize> = args.spp.iter().map(|&s| s as usize).collect();
-    let bracket = args.bracket.then_some(base_method);
+    let base_series = Series::of(base_method, &ks, reference_k);
+    let bracket = args.bracket.then_some(base_series);
     let measurements = pool.install(|| {
         let points = shading_points(&args);
         let methods = &args.methods;
@@ -121,6 +134,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             hierarchy.as_ref(),
             methods,
             &spps,
+            &ks,
             &base,
             points,
             &reference,
@@ -128,8 +142,8 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             timing,
             |m| {
                 eprintln!(
-                    "ppis: {:>12} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
-                    m.method.name(),
+                    "ppis: {:>20} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                    m.series().to_string(),
                     m.spp,
                     m.seconds,
                     m.rmse,
@@ -138,7 +152,10 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             },
         )
     });
-    write_outputs(&args, &scene.name, &measurements, base_method, threads, &note)?;
+    write_outputs(&args, &scene.name, &measurements, base_series, threads, &note)?;
+    if ks.len() > 1 {
+        write_k_sweep(&args, &scene.name, &measurements, reference_k, threads, &note)?;
+    }
     Ok(())
 }
 
@@ -179,14 +196,14 @@ fn write_outputs(
     args: &ReportArgs,
     scene: &str,
     measurements: &[report::Measurement],
-    base_method: Method,
+    base: Series,
     threads: usize,
     note: &str,
 ) -> Result<()> {
     output::write_text(&args.out.join("error_vs_time.csv"), &report::csv(measurements))?;
     output::write_text(
         &args.out.join("report.md"),
-        &report::markdown(scene, measurements, base_method, threads, &timing_note(note, args.repeat, args.clock)),
+        &report::markdown(scene, measurements, base, threads, &timing_note(note, args.repeat, args.clock)),
     )?;
     report::plot(
         &args.out.join("error_vs_time.svg"),
@@ -199,6 +216,31 @@ fn write_outputs(
         "ppis: wrote error_vs_time.csv, error_vs_time.svg, error_vs_time.png and report.md in {}",
         args.out.display()
     );
+    Ok(())
+}
+
+/// Writes the K sweep — relMSE at equal time against K — as error_vs_k.csv, .md, .svg and
+/// .png into `--out`.
+fn write_k_sweep(
+    args: &ReportArgs,
+    scene: &str,
+    measurements: &[report::Measurement],
+    reference_k: usize,
+    threads: usize,
+    note: &str,
+) -> Result<()> {
+    let Some(sweep) = KSweep::new(measurements, reference_k) else { return Ok(()) };
+    output::write_text(&args.out.join("error_vs_k.csv"), &sweep.csv())?;
+    let note = timing_note(note, args.repeat, args.clock);
+    output::write_text(&args.out.join("error_vs_k.md"), &sweep.markdown(scene, threads, &note))?;
+    report::plot_k(
+        &args.out.join("error_vs_k.svg"),
+        &args.out.join("error_vs_k.png"),
+        &format!("{scene}: relMSE at equal time against K (each method's time at K = {reference_k})"),
+        &sweep,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: cannot draw the plot: {e}", args.out.display()))?;
+    eprintln!("ppis: wrote error_vs_k.csv, error_vs_k.md, error_vs_k.svg and error_vs_k.png in {}", args.out.display());
     Ok(())
 }
 

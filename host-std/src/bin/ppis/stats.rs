@@ -104,7 +104,7 @@ impl Stats {
                     scores: (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), r.scores[c])).collect(),
                 })
                 .collect(),
-            brdf_samples: args.sampling.brdf_samples,
+            brdf_samples: args.brdf_samples,
             bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
             bvh_seconds: prepared.bvh_seconds,
             camera_rays: image.camera_rays,
