@@ -139,16 +139,20 @@ fn a_small_render_writes_exr_png_and_stats() {
     assert_eq!(stats["non_finite_pixels"], 0);
 }
 
-/// Without --shading-points a pixel gets spp / 2 primary rays with the default method (a pair
-/// of light samples each), reduced to a divisor of --spp, and spp / 16 with `product` (a P the
+/// Without --shading-points a pixel gets spp / 4 primary rays with the default method (two
+/// pairs of light samples each), reduced to a divisor of --spp, and spp / 16 with `product` (a P the
 /// user gives that does not divide it is an error: `bad_input_fails_cleanly`).
 #[test]
 fn the_default_shading_points_grow_with_spp_and_divide_it() {
     let tmp = scratch("divide");
     let dir = tmp.path();
-    for (method, spp, p) in
-        [("product-mis", "6", 3), ("product-mis", "7", 1), ("mis", "256", 128), ("product", "64", 4)]
-    {
+    for (method, spp, p) in [
+        ("product-mis", "12", 3),
+        ("product-mis", "10", 2),
+        ("product-mis", "7", 1),
+        ("mis", "256", 64),
+        ("product", "64", 4),
+    ] {
         let out = ppis()
             .current_dir(dir)
             .args([

@@ -44,13 +44,14 @@ mod tests {
     #[test]
     fn shading_points_grow_with_spp_and_divide_it() {
         for spp in [16, 64, 256, 1024] {
-            assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, spp), spp / 2, "a pair per point");
+            assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, spp), spp / 4, "two pairs per point");
             assert_eq!(ShadingPoints::Rule.resolve(Method::Env, spp), spp);
             assert_eq!(ShadingPoints::Rule.resolve(Method::Product, spp), (spp / 16).max(1));
         }
         assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 1), 1);
-        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 7), 1, "7 has no divisor up to 3 but 1");
-        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 12), 6);
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 7), 1, "7 has no divisor up to 1 but 1");
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 12), 3);
+        assert_eq!(ShadingPoints::Rule.resolve(Method::Mis, 20), 5);
         assert_eq!(ShadingPoints::Given(4).resolve(Method::Mis, 6), 3);
         assert_eq!(ShadingPoints::Given(4).resolve(Method::Mis, 2), 2);
         assert_eq!(ShadingPoints::PerPoint(16).resolve(Method::Mis, 256), 16);

@@ -72,16 +72,18 @@ impl Method {
     }
 
     /// Light samples per shading point where `--shading-points` is not given (so P = spp /
-    /// this): a pair for the MIS methods and one sample for the single techniques whose
-    /// sampler is built once per render or per pixel, and for the samplers built per
-    /// shading point the power of two nearest √(build cost / sample cost), the split that
-    /// minimises error × time when a point's light and its footprint vary alike
+    /// this): two pairs for the MIS methods, whose shading point (its primary ray, hit and
+    /// wavefront) costs about a pair, so that a second pair halves its share of the time
+    /// where the light's noise dominates the footprint's; one sample for the single
+    /// techniques whose sampler is built once per render or per pixel; and for the samplers
+    /// built per shading point the power of two nearest √(build cost / sample cost), the
+    /// split that minimises error × time when a point's light and its footprint vary alike
     /// (docs/perf.md, "Shading points per pixel").
     #[must_use]
     pub fn samples_per_point(self) -> usize {
         match self {
             Method::Env | Method::Brdf | Method::Ris => 1,
-            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 2,
+            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
             Method::TwoLevel => 2,
             Method::TwoStage => 4,
             Method::Product | Method::Wavelet => 16,
