@@ -312,7 +312,7 @@ def Material "Mat"
         let dir = tempfile::Builder::new().prefix("ppis-usd-channel-").tempdir().unwrap();
         let file = dir.path().join("channels.usda");
         std::fs::write(&file, NETWORK).unwrap();
-        let stage = Stage::open(&file).unwrap();
+        let stage = Stage::open(&file, super::super::TimeCode::Earliest).unwrap();
         let (shader, id) = stage.surface_shader("/Mat").unwrap().unwrap();
         assert_eq!((shader.as_str(), id.as_str()), ("/Mat/Surface", "UsdPreviewSurface"));
         let inputs = stage.preview_inputs(&shader).unwrap();
