@@ -109,12 +109,12 @@ pub struct PilotResult {
 pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
     match PLANS[c].strategy {
         Strategy::Env => {
-            let peak = match bsdf {
-                Bsdf::Diffuse(_) => std::f32::consts::FRAC_1_PI,
-                Bsdf::Conductor(g) => 1.0 / (std::f32::consts::PI * g.ggx.alpha() * g.ggx.alpha()),
-                Bsdf::Phong(p) => (p.exponent + 2.0) / (2.0 * std::f32::consts::PI),
-                Bsdf::CarPaint(_) => f32::INFINITY,
-            };
+            // B·cos's peak scale: 1/π diffuse, 1/(πw²) for a lobe of width w — GGX's D at its
+            // centre for α = w, Phong's (n+2)/2π for w = √(2/(n+2)).
+            let brdf = bsdf.as_brdf();
+            let w = brdf.lobe_width();
+            let peak =
+                if brdf.is_diffuse() { std::f32::consts::FRAC_1_PI } else { 1.0 / (std::f32::consts::PI * w * w) };
             peak <= ENV_ONLY_LOBE_PEAK
         }
         Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,

@@ -4,13 +4,14 @@
 //! pilot. The thresholds and splits come from equal-time sweeps per material region
 //! (`ppis report`; docs/perf.md, "Headline: error at equal time" and "Budget splits").
 //!
-//! * GGX conductors of moderate gloss, α in [`PRODUCT_ALPHA`]: product-MIS — the lobe is wide
-//!   enough to span bright detail of the map and narrow enough that one B̃ per pixel fits its
-//!   shading points.
+//! * Glossy BRDFs whose sharpest lobe is of moderate width (`Brdf::lobe_width`, GGX α, in
+//!   [`PRODUCT_ALPHA`]): product-MIS — the lobe is wide enough to span bright detail of the map
+//!   and narrow enough that one B̃ per pixel fits its shading points.
 //! * Under extended bright regions rather than a sun (`env_peak` below [`SUN_PEAK`]), wider
-//!   conductors too, α in [`PRODUCT_ALPHA_EXTENDED`]: B varies across the bright region, which
-//!   the product follows, while a sun is found exactly by env sampling alone.
-//! * Everything else: MIS of env and BRDF sampling — sharper lobes, car paint, diffuse.
+//!   lobes too, in [`PRODUCT_ALPHA_EXTENDED`]: B varies across the bright region, which the
+//!   product follows, while a sun is found exactly by env sampling alone.
+//! * Everything else: MIS of env and BRDF sampling — sharper lobes (a car paint's coat among
+//!   them), diffuse.
 //!   Env-only sampling can win on diffuse surfaces under extended light but falls far behind
 //!   under a sun, so the rules do not pick it (the pilot may); instead MIS on diffuse surfaces
 //!   under extended light leans on env samples ([`auto_env_share`]).
@@ -21,7 +22,8 @@
 use crate::render::strategy::Strategy;
 use crate::scene::Bsdf;
 
-/// GGX roughness range where `auto` samples the product (with BRDF sampling, MIS).
+/// Lobe widths (GGX α; `Brdf::lobe_width`) where `auto` samples the product (with BRDF
+/// sampling, MIS).
 pub const PRODUCT_ALPHA: std::ops::RangeInclusive<f32> = 0.03..=0.1;
 
 /// The range under extended bright regions (`env_peak` below [`SUN_PEAK`]).
@@ -40,7 +42,7 @@ pub const SMOOTH_LIGHTING_PEAK: f32 = 4.0;
 /// with more.
 pub const WIDE_LOBE_PRODUCT_SHARE: f64 = 0.75;
 
-/// GGX α from which product-MIS leans on product samples (see [`WIDE_LOBE_PRODUCT_SHARE`]).
+/// Lobe width (GGX α) from which product-MIS leans on product samples (see [`WIDE_LOBE_PRODUCT_SHARE`]).
 pub const WIDE_LOBE: f32 = 0.1;
 
 /// Share of an MIS budget that `auto` spends on env samples on diffuse surfaces under extended
@@ -57,11 +59,11 @@ pub fn auto_strategy(bsdf: &Bsdf, env_peak: f32) -> Strategy {
         return Strategy::Brdf;
     }
     let range = if env_peak < SUN_PEAK { PRODUCT_ALPHA_EXTENDED } else { PRODUCT_ALPHA };
-    match bsdf {
-        Bsdf::Conductor(c) if range.contains(&c.ggx.alpha()) => {
-            Strategy::ProductMis { product_share: product_share(bsdf, env_peak) }
-        }
-        _ => Strategy::Mis { env_share: auto_env_share(bsdf, env_peak) },
+    let brdf = bsdf.as_brdf();
+    if !brdf.is_diffuse() && range.contains(&brdf.lobe_width()) {
+        Strategy::ProductMis { product_share: product_share(bsdf, env_peak) }
+    } else {
+        Strategy::Mis { env_share: auto_env_share(bsdf, env_peak) }
     }
 }
 
@@ -69,9 +71,11 @@ pub fn auto_strategy(bsdf: &Bsdf, env_peak: f32) -> Strategy {
 /// samples; see [`WIDE_LOBE_PRODUCT_SHARE`]).
 #[must_use]
 pub fn product_share(bsdf: &Bsdf, env_peak: f32) -> f64 {
-    match bsdf {
-        Bsdf::Conductor(c) if env_peak < SUN_PEAK && c.ggx.alpha() >= WIDE_LOBE => WIDE_LOBE_PRODUCT_SHARE,
-        _ => 0.5,
+    let brdf = bsdf.as_brdf();
+    if !brdf.is_diffuse() && env_peak < SUN_PEAK && brdf.lobe_width() >= WIDE_LOBE {
+        WIDE_LOBE_PRODUCT_SHARE
+    } else {
+        0.5
     }
 }
 
@@ -95,6 +99,23 @@ mod tests {
     /// The method `auto` resolves to, its split aside.
     fn auto(bsdf: &Bsdf, env_peak: f32) -> Method {
         Method::of(Method::Auto.strategy(bsdf, env_peak))
+    }
+
+    #[test]
+    fn the_rules_read_the_brdf_s_sharpest_lobe_whatever_its_kind() {
+        use sampler_core::brdf::{CarPaint, Phong};
+        // Phong n = 998: a lobe width of √(2/1000) ≈ 0.045, inside the range.
+        let phong = Bsdf::Phong(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 998.0));
+        assert_eq!(auto(&phong, 713.0), Method::ProductMis);
+        assert_eq!(auto(&Bsdf::Phong(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e5)), 713.0), Method::Mis);
+        // A car paint by its coat: the default's α = 0.005 is sharper than the range; a rougher
+        // coat is inside it.
+        assert_eq!(auto(&Bsdf::CarPaint(CarPaint::default()), 67.0), Method::Mis);
+        let rough_coat = CarPaint::new(Vec3::splat(0.02), Vec3::splat(0.2), 0.25, 1.0, 0.05);
+        assert_eq!(auto(&Bsdf::CarPaint(rough_coat), 67.0), Method::ProductMis);
+        // A Phong without a specular part is diffuse.
+        let matte = Bsdf::Phong(Phong::new(Vec3::splat(0.5), Vec3::ZERO, 998.0));
+        assert_eq!(auto(&matte, 713.0), Method::Mis);
     }
 
     #[test]

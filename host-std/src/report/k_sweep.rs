@@ -89,7 +89,7 @@ impl KCurve {
         self.points.iter().find(|p| p.brdf_samples == k)
     }
 
-    /// The smallest and the largest K within [`PLATEAU`] of the optimum.
+    /// The smallest and the largest K within `PLATEAU` times the optimum's relMSE.
     #[must_use]
     pub fn plateau(&self) -> Option<(usize, usize)> {
         let best = self.optimum()?.relmse;
