@@ -2,7 +2,8 @@
 //! which keeps strata compact) and converted to solid angle, d²/(|cos| A).
 
 use super::{
-    Emission, Light, LightError, LightHit, LightSample, area_to_solid_angle, checked_rgb, emitted, finite, unit,
+    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
+    unit,
 };
 use crate::frame::Frame;
 use crate::sampling::square_to_uniform_disk_concentric;
@@ -71,12 +72,8 @@ impl Light for DiskLight {
             return None;
         }
         let d = square_to_uniform_disk_concentric(u) * self.radius;
-        let v = self.center + self.frame.s * d.x + self.frame.t * d.y - p;
-        let distance = v.length();
-        let dir = v / distance;
-        let pdf = area_to_solid_angle(distance, dir.dot(self.frame.n), self.area());
-        let radiance = self.emission.radiance;
-        (pdf > 0.0 && pdf.is_finite()).then_some(LightSample { dir, distance, radiance, pdf, delta: false })
+        let q = self.center + self.frame.s * d.x + self.frame.t * d.y;
+        area_sample(p, q, self.frame.n, self.area(), self.emission.radiance)
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -96,8 +93,7 @@ impl Light for DiskLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        self.emission.radiance * (sides * PI * self.area())
+        self.emission.power(self.area())
     }
 }
 

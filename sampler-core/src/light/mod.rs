@@ -102,6 +102,16 @@ pub struct Emission {
     pub two_sided: bool,
 }
 
+impl Emission {
+    /// The power leaving a surface of area `area` that emits this radiance uniformly: π·L·A per
+    /// emitting side.
+    #[must_use]
+    pub fn power(&self, area: f32) -> Vec3 {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        self.radiance * (sides * core::f32::consts::PI * area)
+    }
+}
+
 /// Why a light cannot be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightError {
@@ -156,6 +166,17 @@ fn unit(v: Vec3) -> Result<Vec3, LightError> {
 #[inline]
 fn emitted(emission: &Emission, cos_front: f32) -> Option<Vec3> {
     (cos_front > 0.0 || (emission.two_sided && cos_front < 0.0)).then_some(emission.radiance)
+}
+
+/// The sample of a point `q` drawn uniformly on an area `area` of normal `normal`, seen from
+/// `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
+#[inline]
+fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, radiance: Vec3) -> Option<LightSample> {
+    let v = q - p;
+    let distance = v.length();
+    let dir = v / distance;
+    let pdf = area_to_solid_angle(distance, dir.dot(normal), area);
+    (pdf > 0.0 && pdf.is_finite()).then_some(LightSample { dir, distance, radiance, pdf, delta: false })
 }
 
 /// The density with respect to solid angle of a point drawn uniformly on an area `area`, seen

@@ -4,7 +4,9 @@
 //! point of it lies in almost the same direction and area sampling is uniform in solid angle too.
 
 use super::spherical_rect::SphericalRect;
-use super::{Emission, Light, LightError, LightHit, LightSample, area_to_solid_angle, checked_rgb, emitted, finite};
+use super::{
+    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
+};
 use glam::{DVec3, Vec2, Vec3};
 
 /// A rectangle `p0 + s·e1 + t·e2`, s, t ∈ [0, 1], emitting on its front side (normal e1 × e2).
@@ -98,11 +100,7 @@ impl Light for RectLight {
             let pdf = (1.0 / rect.solid_angle()) as f32;
             return Some(LightSample { dir, distance: distance as f32, radiance, pdf, delta: false });
         }
-        let v = self.p0 + u.x * self.e1 + u.y * self.e2 - p;
-        let distance = v.length();
-        let dir = v / distance;
-        let pdf = area_to_solid_angle(distance, dir.dot(self.normal), self.area);
-        (pdf > 0.0 && pdf.is_finite()).then_some(LightSample { dir, distance, radiance, pdf, delta: false })
+        area_sample(p, self.p0 + u.x * self.e1 + u.y * self.e2, self.normal, self.area, radiance)
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -126,8 +124,7 @@ impl Light for RectLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        self.emission.radiance * (sides * core::f32::consts::PI * self.area)
+        self.emission.power(self.area)
     }
 }
 

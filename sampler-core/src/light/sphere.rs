@@ -154,8 +154,7 @@ impl Light for SphereLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        self.emission.radiance * (sides * PI * self.area())
+        self.emission.power(self.area())
     }
 }
 

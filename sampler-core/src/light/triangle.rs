@@ -3,7 +3,9 @@
 //! converted to solid angle. [`TriangleSampling::default`] is the measured choice.
 
 use super::spherical_triangle::SphericalTriangle;
-use super::{Emission, Light, LightError, LightHit, LightSample, area_to_solid_angle, checked_rgb, emitted, finite};
+use super::{
+    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
+};
 use glam::{Vec2, Vec3};
 
 /// How a [`TriangleLight`] draws directions.
@@ -124,11 +126,7 @@ impl Light for TriangleLight {
         // Uniform barycentrics by the square-root warp.
         let su = libm::sqrtf(u.x);
         let q = self.v[0] + (u.y * su) * (self.v[1] - self.v[0]) + (su * (1.0 - u.y)) * (self.v[2] - self.v[0]);
-        let v = q - p;
-        let distance = v.length();
-        let dir = v / distance;
-        let pdf = area_to_solid_angle(distance, dir.dot(self.normal), self.area);
-        (pdf > 0.0 && pdf.is_finite()).then_some(LightSample { dir, distance, radiance, pdf, delta: false })
+        area_sample(p, q, self.normal, self.area, radiance)
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -152,8 +150,7 @@ impl Light for TriangleLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        self.emission.radiance * (sides * core::f32::consts::PI * self.area)
+        self.emission.power(self.area)
     }
 }
 
