@@ -319,3 +319,23 @@ fn report_brackets_the_base_time() {
     let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
     assert!(md.contains("For the time product-mis takes") && md.contains("| product-mis spp |"), "{md}");
 }
+
+/// `ppis info | head`: a reader gone before the output is written ends the process as the
+/// default SIGPIPE ends C tools, without a panic's message. The pipe's read end is closed
+/// before the process starts, so its first write meets it closed.
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_the_process_without_a_panic() {
+    use std::os::fd::{FromRawFd, OwnedFd};
+    use std::os::unix::process::ExitStatusExt;
+    let mut fds = [0; 2];
+    // SAFETY: `fds` has room for the two descriptors `pipe` writes.
+    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+    // SAFETY: both descriptors were just opened and are owned here alone.
+    let (read, write) = unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+    drop(read);
+    let out = ppis().args(["info"]).stdout(write).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{:?}: {stderr}", out.status);
+}

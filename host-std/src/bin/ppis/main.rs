@@ -84,6 +84,7 @@ fn parse_command_line() -> Cli {
 }
 
 fn main() {
+    end_quietly_on_a_closed_pipe();
     let cli = parse_command_line();
     let result = match cli.command {
         Command::Render(args) => render_command(args),
@@ -96,5 +97,16 @@ fn main() {
     if let Err(e) = result {
         eprintln!("ppis: error: {e:#}");
         std::process::exit(2);
+    }
+}
+
+/// A reader that stops early (`ppis info | head`) ends the process as it ends C tools, by the
+/// default SIGPIPE, instead of making the next print panic (Rust ignores SIGPIPE and turns the
+/// write's error into a panic in `println!`).
+fn end_quietly_on_a_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restoring a signal's default disposition, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
