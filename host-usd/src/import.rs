@@ -6,7 +6,7 @@ use crate::inherit::Hidden;
 use crate::scene::{Counts, Skip, UpAxis, UsdScene};
 use crate::stage::{PrimPath, Stage, TimeCode, Value};
 use crate::xform::{WorldTransforms, up_axis_conversion};
-use crate::{camera, dome, instancer, render_settings};
+use crate::{camera, dome, render_settings};
 use glam::DMat4;
 use std::collections::HashMap;
 use std::path::Path;
@@ -14,6 +14,11 @@ use std::time::Instant;
 
 mod gprim;
 mod material_binding;
+mod prototypes;
+mod walk;
+
+use prototypes::{Prototypes, prototype_roots};
+use walk::Stop;
 
 /// Import options.
 #[derive(Clone, Debug)]
@@ -63,6 +68,13 @@ struct Importer<'a> {
     hidden: Hidden,
     scene: UsdScene,
     materials: HashMap<String, usize>,
+    /// PointInstancer prototypes, the gprims under them and the instancers waiting for them.
+    prototypes: Prototypes,
+    /// The Camera prims in walk order: the one rendered is chosen after the walk, once the
+    /// render settings (which may name it) are read.
+    cameras: Vec<PrimPath>,
+    /// The RenderSettings prims in walk order.
+    settings: Vec<PrimPath>,
 }
 
 /// Imports a USD file with default options.
@@ -109,6 +121,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         }
     };
     let meters_per_unit = stage.metadata("metersPerUnit").map_err(at("/"))?.and_then(|v| v.scalar()).unwrap_or(0.01);
+    let opened_skips = skipped.len();
     let scene = UsdScene {
         file: file.to_owned(),
         up_axis,
@@ -127,25 +140,30 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         counts: Counts::default(),
         import_seconds: 0.0,
     };
-    let mut imp = Importer {
-        stage: &stage,
-        conversion: up_axis_conversion(up_axis == UpAxis::Z),
-        worlds: WorldTransforms::default(),
-        hidden: Hidden::default(),
-        scene,
-        materials: HashMap::new(),
-    };
-    let prims = stage.prims().map_err(at("/"))?;
-    let fail = |(prim, message)| UsdError::Prim { file: file.to_owned(), prim, message };
-    let (settings, notes) = render_settings::read(&stage, &prims, options.render_settings.as_deref()).map_err(fail)?;
+    let fail = |(prim, message): Failure| UsdError::Prim { file: file.to_owned(), prim, message };
+    let mut imp = Importer::new(&stage, scene.clone(), Prototypes::default());
+    let walked = imp.walk();
+    if let Err(Stop::Restart) = walked {
+        // A PointInstancer names a prototype the walk has already imported in place: walk
+        // again knowing every instancer's prototypes from the start.
+        let known = prototype_roots(&stage).map_err(fail)?;
+        imp = Importer::new(&stage, scene, Prototypes::known(known));
+        imp.walk().map_err(Stop::failure).map_err(fail)?;
+    } else {
+        walked.map_err(Stop::failure).map_err(fail)?;
+    }
+    let (settings, notes) =
+        render_settings::read(&stage, &imp.settings, options.render_settings.as_deref()).map_err(fail)?;
     let where_ = settings.as_ref().map_or("/", |s| s.path.as_str()).to_string();
-    notes.into_iter().for_each(|n| imp.skip(&where_, n));
+    let at_notes = imp.scene.skipped.len().min(opened_skips);
+    let notes = notes.into_iter().map(|n| Skip { path: where_.clone(), what: n });
+    imp.scene.skipped.splice(at_notes..at_notes, notes);
     let mut options = options.clone();
     if let Some(s) = settings {
         options.camera = options.camera.or_else(|| s.camera.clone());
         imp.scene.render_settings = Some(s);
     }
-    imp.walk(&prims, &options).map_err(fail)?;
+    imp.camera(options.camera.as_deref()).map_err(fail)?;
     let mut scene = imp.scene;
     scene.layers = stage.layers();
     if let Some(name) = &options.camera
@@ -175,105 +193,41 @@ fn fail(prim: &PrimPath) -> impl FnOnce(String) -> Failure + '_ {
     move |m| (prim.to_string(), m)
 }
 
-impl Importer<'_> {
-    fn skip(&mut self, path: &(impl std::fmt::Display + ?Sized), what: impl Into<String>) {
-        self.scene.skipped.push(Skip { path: path.to_string(), what: what.into() });
+impl<'a> Importer<'a> {
+    fn new(stage: &'a Stage, scene: UsdScene, prototypes: Prototypes) -> Self {
+        Importer {
+            stage,
+            conversion: up_axis_conversion(scene.up_axis == UpAxis::Z),
+            worlds: WorldTransforms::default(),
+            hidden: Hidden::default(),
+            scene,
+            materials: HashMap::new(),
+            prototypes,
+            cameras: Vec::new(),
+            settings: Vec::new(),
+        }
     }
 
-    fn walk(&mut self, prims: &[PrimPath], options: &Options) -> Result<(), Failure> {
+    /// The camera rendered: the first Camera prim the walk met, or the one `wanted` names.
+    fn camera(&mut self, wanted: Option<&str>) -> Result<(), Failure> {
         let stage = self.stage;
-        // Each prim's type, read once for both passes.
-        let types = prims.iter().map(|p| stage.type_name(p).map_err(fail(p))).collect::<Result<Vec<_>, _>>()?;
-        // Prototypes render only through their instancers.
-        let mut prototypes: Vec<PrimPath> = Vec::new();
-        for (prim, t) in prims.iter().zip(&types) {
-            if t == "PointInstancer" {
-                prototypes.extend(stage.targets(prim, "prototypes").map_err(fail(prim))?);
-            }
-        }
-        let in_prototype = |p: &PrimPath| prototypes.iter().any(|r| p.is_at_or_below(r));
-        for (prim, type_name) in prims.iter().zip(&types) {
-            self.scene.counts.prims += 1;
-            if in_prototype(prim) {
-                continue;
-            }
-            let t = type_name.as_str();
-            if GPRIMS.contains(&t) || t == "PointInstancer" {
-                if self.hidden(prim).map_err(fail(prim))? {
-                    self.scene.counts.hidden += 1;
-                    continue;
-                }
-                let world = self.worlds.world(stage, prim).map_err(fail(prim))?;
-                if t == "PointInstancer" {
-                    self.instancer(prim, prims, &world)?;
-                } else {
-                    let proxy = stage.is_instance_proxy(prim).map_err(fail(prim))?;
-                    self.scene.counts.instances += usize::from(proxy);
-                    self.gprim(prim, t, &prim.to_string(), &(self.conversion * world)).map_err(fail(prim))?;
-                }
-            } else if t == "Camera" {
-                let wanted = options.camera.as_deref().is_none_or(|c| *c == prim.to_string());
-                if self.scene.camera.is_none() && wanted {
-                    let world = self.conversion * self.worlds.world(stage, prim).map_err(fail(prim))?;
-                    let (c, notes) = camera::read(stage, prim, &world).map_err(fail(prim))?;
-                    notes.into_iter().for_each(|n| self.skip(prim, n));
-                    self.scene.camera = Some(c);
-                }
-            } else if t == "DomeLight" || t == "DomeLight_1" {
-                if self.scene.dome.is_some() {
-                    self.skip(prim, "a second DomeLight; only the first lights the scene");
-                    continue;
-                }
-                if self.hidden(prim).map_err(fail(prim))? {
-                    self.skip(prim, "invisible DomeLight");
-                    continue;
-                }
-                let world = self.worlds.world(stage, prim).map_err(fail(prim))?;
-                let z_up = self.scene.up_axis == UpAxis::Z;
-                let (d, notes) = dome::read(stage, prim, t, z_up, &world, &self.conversion).map_err(fail(prim))?;
-                notes.into_iter().for_each(|n| self.skip(prim, n));
-                self.scene.dome = Some(d);
-            } else if OTHER_LIGHTS.contains(&t) {
-                self.skip(prim, format!("{t} not rendered (only a DomeLight lights the scene)"));
-            } else if SKELETAL.contains(&t) {
-                self.skip(prim, format!("{t}: skinning not applied (meshes render in their rest pose)"));
-            } else if !STRUCTURE.contains(&t) {
-                self.skip(prim, format!("prim type {t} not rendered"));
-            }
-        }
+        let cameras = std::mem::take(&mut self.cameras);
+        let Some(prim) = cameras.iter().find(|c| wanted.is_none_or(|w| *w == c.to_string())) else {
+            return Ok(());
+        };
+        let world = self.conversion * self.worlds.world(stage, prim).map_err(fail(prim))?;
+        let (c, notes) = camera::read(stage, prim, &world).map_err(fail(prim))?;
+        notes.into_iter().for_each(|n| self.skip(prim, n));
+        self.scene.camera = Some(c);
         Ok(())
+    }
+
+    fn skip(&mut self, path: &(impl std::fmt::Display + ?Sized), what: impl Into<String>) {
+        self.scene.skipped.push(Skip { path: path.to_string(), what: what.into() });
     }
 
     /// Invisible, or a proxy/guide purpose.
     fn hidden(&mut self, prim: &PrimPath) -> Result<bool, String> {
         self.hidden.hidden(self.stage, prim)
-    }
-
-    fn instancer(&mut self, prim: &PrimPath, prims: &[PrimPath], world: &DMat4) -> Result<(), Failure> {
-        let stage = self.stage;
-        let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
-        // Each prototype's renderable prims, with their transform relative to the
-        // prototype root's parent.
-        let mut parts: Vec<Vec<(PrimPath, String, DMat4)>> = Vec::new();
-        for root in &protos {
-            let mut list = Vec::new();
-            for p in prims.iter().filter(|p| p.is_at_or_below(root)) {
-                let t = stage.type_name(p).map_err(fail(p))?;
-                if GPRIMS.contains(&t.as_str()) && !self.hidden(p).map_err(fail(p))? {
-                    let rel = self.worlds.relative_to(stage, p, root).map_err(fail(p))?;
-                    list.push((p.clone(), t, rel));
-                }
-            }
-            parts.push(list);
-        }
-        for inst in &instances {
-            for (p, t, rel) in &parts[inst.prototype] {
-                let m = self.conversion * *world * inst.transform * *rel;
-                let label = format!("{p}[{prim}:{}]", inst.index);
-                self.gprim(p, t, &label, &m).map_err(fail(p))?;
-            }
-        }
-        self.scene.counts.instances += instances.len();
-        Ok(())
     }
 }

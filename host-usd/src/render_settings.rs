@@ -78,11 +78,10 @@ const MAX_SIDE: f64 = 16384.0;
 /// explicitly must exist; the stage's metadata naming none is a note.
 fn settings_prim(
     stage: &Stage,
-    prims: &[PrimPath],
+    all: &[PrimPath],
     wanted: Option<&str>,
 ) -> Result<(Option<PrimPath>, Option<String>), String> {
-    let typed = |p: &PrimPath| stage.type_name(p).is_ok_and(|t| t == "RenderSettings");
-    let settings = |p: &str| PrimPath::new(p).ok().filter(|p| prims.contains(p) && typed(p));
+    let settings = |p: &str| PrimPath::new(p).ok().filter(|p| all.contains(p));
     if let Some(w) = wanted {
         return match settings(w) {
             Some(w) => Ok((Some(w), None)),
@@ -97,16 +96,15 @@ fn settings_prim(
             None => (None, Some(format!("renderSettingsPrimPath {p} names no RenderSettings prim; none applied"))),
         });
     }
-    let all: Vec<&PrimPath> = prims.iter().filter(|p| typed(p)).collect();
-    Ok(match all.as_slice() {
+    Ok(match all {
         [] => (None, None),
-        [one] => (Some((*one).clone()), None),
+        [one] => (Some(one.clone()), None),
         [first, ..] => {
             let note = format!(
                 "{} RenderSettings prims and no renderSettingsPrimPath: {first} applied (--render-settings chooses)",
                 all.len()
             );
-            (Some((*first).clone()), Some(note))
+            (Some(first.clone()), Some(note))
         }
     })
 }
@@ -148,14 +146,15 @@ fn authored(stage: &Stage, prim: &PrimPath) -> Result<Authored, String> {
     Ok(Authored { resolution, pixel_aspect, conform, camera })
 }
 
-/// Reads the settings that apply to the stage whose prims are `prims`, with the notes on
-/// what of them is not honoured. `wanted` names a settings prim explicitly.
+/// Reads the settings that apply to the stage whose RenderSettings prims are `all` (the
+/// traversed ones, in traversal order), with the notes on what of them is not honoured.
+/// `wanted` names a settings prim explicitly.
 pub fn read(
     stage: &Stage,
-    prims: &[PrimPath],
+    all: &[PrimPath],
     wanted: Option<&str>,
 ) -> Result<(Option<RenderSettings>, Vec<String>), (String, String)> {
-    let (path, note) = settings_prim(stage, prims, wanted).map_err(|e| ("/".to_string(), e))?;
+    let (path, note) = settings_prim(stage, all, wanted).map_err(|e| ("/".to_string(), e))?;
     let mut notes: Vec<String> = note.into_iter().collect();
     let Some(path) = path else {
         return Ok((None, notes));

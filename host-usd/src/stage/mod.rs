@@ -19,6 +19,7 @@ use openusd::ar::{self, Resolver};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::{sdf, usd};
 use std::cell::RefCell;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 /// Any prim seen as Xformable/Imageable (openusd's typed views only wrap matching types).
@@ -104,9 +105,40 @@ impl Stage {
     /// A namespace deeper than [`MAX_DEPTH`] is an error naming the first such prim.
     pub fn prims(&self) -> Result<Vec<PrimPath>> {
         let mut out = Vec::new();
-        self.inner.traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| out.push(PrimPath(p.clone()))).map_err(err)?;
-        check_depth(&out)?;
+        self.walk(|step| -> Result<()> {
+            if let Step::Enter(p) = step {
+                out.push(p);
+            }
+            Ok(())
+        })?;
         Ok(out)
+    }
+
+    /// Visits the prims of [`prims`](Self::prims) in the same order, entering each before
+    /// its subtree and leaving it after, and composes each prim once: the stage frees a
+    /// prim's composition when the walk leaves it, so a one-pass reader holds the
+    /// compositions of the prims from the root to the one it reads, not the whole stage's
+    /// (docs/usd.md, "Import speed"). Any prim may still be read at any time; one left
+    /// behind composes again. The first error, the visitor's or a namespace deeper than
+    /// [`MAX_DEPTH`], ends the walk.
+    pub fn walk<E: From<String>>(
+        &self,
+        mut visit: impl FnMut(Step) -> std::result::Result<(), E>,
+    ) -> std::result::Result<(), E> {
+        let mut failure = None;
+        let walked = self.inner.traverse_once(usd::PrimPredicate::DEFAULT_PROXIES, |step| {
+            let step = match step {
+                usd::Visit::Enter(p) => Step::Enter(PrimPath(p.clone())),
+                usd::Visit::Leave(p) => Step::Leave(PrimPath(p.clone())),
+            };
+            let outcome = match &step {
+                Step::Enter(p) if p.depth() > MAX_DEPTH => Err(E::from(too_deep(p))),
+                _ => visit(step),
+            };
+            outcome.map_err(|e| failure = Some(e)).map_or(ControlFlow::Break(()), ControlFlow::Continue)
+        });
+        walked.map_err(|e| E::from(err(e)))?;
+        failure.map_or(Ok(()), Err)
     }
 
     /// Every composed prim, defined or not (`over`s, classes, inactive), without
@@ -259,9 +291,14 @@ impl Stage {
 /// (each path is as long as its depth).
 pub const MAX_DEPTH: usize = openusd::usda::parser::MAX_NAMESPACE_DEPTH;
 
-fn check_depth(prims: &[PrimPath]) -> Result<()> {
-    match prims.iter().find(|p| p.depth() > MAX_DEPTH) {
-        Some(p) => Err(format!("{}/…: namespace deeper than {MAX_DEPTH} levels", p.ancestor_at(3))),
-        None => Ok(()),
-    }
+fn too_deep(prim: &PrimPath) -> String {
+    format!("{}/…: namespace deeper than {MAX_DEPTH} levels", prim.ancestor_at(3))
+}
+
+/// Where [`Stage::walk`] is.
+pub enum Step {
+    /// At this prim; its subtree follows.
+    Enter(PrimPath),
+    /// Done with this prim and its subtree.
+    Leave(PrimPath),
 }

@@ -761,6 +761,25 @@ impl IndexCache {
         self.query_errors.clear();
     }
 
+    /// Frees the composed index at `path` once its reader is done with it (ppis
+    /// patch, see PATCHED.md, "Composing once"): a one-pass consumer such as
+    /// [`Stage::traverse_once`](crate::usd::Stage::traverse_once) reads a prim and
+    /// then its subtree, and needs neither again, so the stage need not hold every
+    /// prim's index at once. A later query at `path` composes it again, with the
+    /// same result. Kept, because something else reads them from the cache, are
+    /// an index that recorded build errors (they are the stage's
+    /// `composition_errors`), an instance's (its prototype was seeded from it),
+    /// and every index of a stage with relocates (their evaluation scans the
+    /// cached indices).
+    pub(crate) fn release_index(&mut self, graph: &LayerGraph, path: &Path) {
+        if graph.has_relocates() || self.store.has_errors_at(path) || self.prototypes.has_instance(path) {
+            return;
+        }
+        self.store.remove(path);
+        self.redirected_prims.remove(path);
+        self.instance_at_or_above.remove(path);
+    }
+
     /// Drops every cached index that recorded a
     /// [`MalformedLayer`](Error::MalformedLayer) error so it recomposes and
     /// re-demands the target. The arc to an unreadable target was dropped, so

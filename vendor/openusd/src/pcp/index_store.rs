@@ -119,6 +119,12 @@ impl IndexStore {
         );
     }
 
+    /// Whether the entry at `path` recorded build errors (which
+    /// [`errors`](Self::errors) reports for as long as the entry is cached).
+    pub(super) fn has_errors_at(&self, path: &Path) -> bool {
+        self.entries.get(path).is_some_and(|entry| !entry.errors.is_empty())
+    }
+
     /// Drops the entry at `path` and retracts its dependency registrations.
     pub(super) fn remove(&mut self, path: &Path) {
         self.entries.remove(path);

@@ -196,6 +196,11 @@ impl PrototypeRegistry {
         roots.into_iter().map(|(root, _)| root.clone()).collect()
     }
 
+    /// Whether `path` is a registered instance of some prototype.
+    pub(super) fn has_instance(&self, path: &Path) -> bool {
+        self.by_instance.contains_key(path)
+    }
+
     /// Whether `path` is a registered `/__Prototype_N` root.
     fn is_root(&self, path: &Path) -> bool {
         self.by_root.contains_key(path)

@@ -19,6 +19,7 @@ mod sink;
 mod stage;
 mod status;
 mod timecode;
+mod traverse_once;
 
 pub use attribute::{Attribute, AttributeQuery};
 pub use capture::{ReplayStage, UndoStage};
@@ -40,6 +41,7 @@ pub use stage::{
     StageAuthoringError, StageBuilder, StagePopulationMask, WeakStage,
 };
 pub use timecode::TimeCode;
+pub use traverse_once::Visit;
 
 use crate::sdf;
 

@@ -82,7 +82,7 @@ pub struct PrimPredicate {
     /// prim's subtree — its contents are reached through the prototype
     /// (`Prim::prototype`). When `true`, instance subtrees are traversed
     /// directly (the "instance proxy" view, spec 11.3.3).
-    traverse_instance_proxies: bool,
+    pub(crate) traverse_instance_proxies: bool,
 }
 
 impl PrimPredicate {
@@ -141,7 +141,7 @@ impl PrimPredicate {
     }
 
     /// Returns the set of status bits this predicate actually consults.
-    fn consulted_bits(self) -> PrimStatus {
+    pub(crate) fn consulted_bits(self) -> PrimStatus {
         let mut bits = self.required.union(self.rejected);
         // Stopping at instances requires knowing which prims are instances.
         if !self.traverse_instance_proxies {
@@ -151,7 +151,7 @@ impl PrimPredicate {
     }
 
     /// Returns `true` if no descendant can satisfy this predicate.
-    fn prunes_descendants(self, status: PrimStatus) -> bool {
+    pub(crate) fn prunes_descendants(self, status: PrimStatus) -> bool {
         let required = self.required.intersection(Self::INHERITED_REQUIRED);
         if !status.contains(required) {
             return true;

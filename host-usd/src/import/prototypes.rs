@@ -1,0 +1,162 @@
+//! PointInstancers in a one-pass walk. A prototype renders only through its instancers, so
+//! the prims under a prototype root are not imported in place but kept (their renderable
+//! gprims, each with its transform relative to the root's parent) until the instancer that
+//! names the root is expanded: when the walk leaves the instancer if every prototype lies
+//! below it (the usual layout), otherwise after the walk. A prototype root that the walk
+//! passed before reaching its instancer cannot be taken back: the import then walks again
+//! knowing every instancer's prototypes from a first walk ([`prototype_roots`]).
+
+use super::{Failure, Importer, Stop, fail};
+use crate::instancer;
+use crate::stage::{PrimPath, Stage, Step};
+use glam::DMat4;
+
+/// A renderable gprim under a prototype root: its path, type and transform relative to
+/// the root's parent.
+type Part = (PrimPath, String, DMat4);
+
+/// The prototype roots known so far, what lies under each, and the instancers not yet
+/// expanded.
+#[derive(Default)]
+pub(super) struct Prototypes {
+    roots: Vec<PrimPath>,
+    parts: Vec<Vec<Part>>,
+    /// Visible instancers met by the walk, with their world transforms.
+    waiting: Vec<(PrimPath, DMat4)>,
+}
+
+impl Prototypes {
+    /// Knowing `roots` from the start.
+    pub(super) fn known(roots: Vec<PrimPath>) -> Self {
+        let parts = vec![Vec::new(); roots.len()];
+        Self { roots, parts, waiting: Vec::new() }
+    }
+
+    /// Whether `prim` is at or below a prototype root.
+    pub(super) fn contains(&self, prim: &PrimPath) -> bool {
+        self.roots.iter().any(|r| prim.is_at_or_below(r))
+    }
+
+    /// Expands `instancer` (at `world`) once its prototypes are walked.
+    pub(super) fn wait(&mut self, instancer: &PrimPath, world: DMat4) {
+        self.waiting.push((instancer.clone(), world));
+    }
+}
+
+/// Every PointInstancer's prototype roots, by a walk of the stage that reads nothing else.
+pub(super) fn prototype_roots(stage: &Stage) -> Result<Vec<PrimPath>, Failure> {
+    let mut roots: Vec<PrimPath> = Vec::new();
+    let walked = stage.walk(|step| -> Result<(), Stop> {
+        let Step::Enter(prim) = step else { return Ok(()) };
+        if stage.type_name(&prim).map_err(fail(&prim))? == "PointInstancer" {
+            for target in stage.targets(&prim, "prototypes").map_err(fail(&prim))? {
+                if !roots.contains(&target) {
+                    roots.push(target);
+                }
+            }
+        }
+        Ok(())
+    });
+    walked.map_err(Stop::failure)?;
+    Ok(roots)
+}
+
+/// Whether the walk, now at `current`, has already passed `root`: an ancestor of
+/// `current`, or a subtree of an earlier sibling of one of `current`'s ancestors.
+fn walked_before(stage: &Stage, root: &PrimPath, current: &PrimPath) -> Result<bool, String> {
+    if current.is_at_or_below(root) {
+        return Ok(true);
+    }
+    if root.is_at_or_below(current) {
+        return Ok(false);
+    }
+    let mut common = root.parent().unwrap_or_else(PrimPath::root);
+    while !current.is_at_or_below(&common) {
+        common = common.parent().unwrap_or_else(PrimPath::root);
+    }
+    let depth = common.depth() + 1;
+    let (r, c) = (root.ancestor_at(depth), current.ancestor_at(depth));
+    let children = stage.children(&common)?;
+    let at = |p: &PrimPath| children.iter().position(|x| x == p);
+    Ok(matches!((at(&r), at(&c)), (Some(r), Some(c)) if r < c))
+}
+
+impl Importer<'_> {
+    /// Learns the prototype roots `instancer` names; a root already walked past restarts
+    /// the import.
+    pub(super) fn register_instancer(&mut self, instancer: &PrimPath) -> Result<(), Stop> {
+        let stage = self.stage;
+        for root in stage.targets(instancer, "prototypes").map_err(fail(instancer))? {
+            if self.prototypes.roots.contains(&root) {
+                continue;
+            }
+            if walked_before(stage, &root, instancer).map_err(fail(instancer))? {
+                return Err(Stop::Restart);
+            }
+            self.prototypes.roots.push(root);
+            self.prototypes.parts.push(Vec::new());
+        }
+        Ok(())
+    }
+
+    /// Keeps a visible gprim under prototype roots for their instancers.
+    pub(super) fn prototype_gprim(&mut self, prim: &PrimPath, type_name: &str) -> Result<(), String> {
+        let stage = self.stage;
+        for i in 0..self.prototypes.roots.len() {
+            let root = &self.prototypes.roots[i];
+            if prim.is_at_or_below(root) {
+                let rel = self.worlds.relative_to(stage, prim, root)?;
+                self.prototypes.parts[i].push((prim.clone(), type_name.to_string(), rel));
+            }
+        }
+        Ok(())
+    }
+
+    /// Expands the waiting instancers that can be: those at `left` whose prototypes all
+    /// lie below it (the walk has just left it), or, after the walk (`None`), all of them.
+    pub(super) fn instancers_after(&mut self, left: Option<&PrimPath>) -> Result<(), Failure> {
+        let waiting = &self.prototypes.waiting;
+        if waiting.is_empty() || left.is_some_and(|l| waiting.iter().all(|(p, _)| p != l)) {
+            return Ok(());
+        }
+        let stage = self.stage;
+        for (prim, world) in std::mem::take(&mut self.prototypes.waiting) {
+            let due = match left {
+                None => true,
+                Some(l) => {
+                    prim == *l && {
+                        let targets = stage.targets(&prim, "prototypes").map_err(fail(&prim))?;
+                        targets.iter().all(|t| t.is_at_or_below(&prim))
+                    }
+                }
+            };
+            if due {
+                self.instancer(&prim, &world)?;
+            } else {
+                self.prototypes.waiting.push((prim, world));
+            }
+        }
+        Ok(())
+    }
+
+    fn instancer(&mut self, prim: &PrimPath, world: &DMat4) -> Result<(), Failure> {
+        let stage = self.stage;
+        let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
+        let roots = &self.prototypes.roots;
+        let index: Vec<Option<usize>> = protos.iter().map(|p| roots.iter().position(|r| r == p)).collect();
+        // Out of `self` while `gprim` adds to the scene.
+        let parts = std::mem::take(&mut self.prototypes.parts);
+        let expanded = instances.iter().try_for_each(|inst| {
+            let Some(list) = index.get(inst.prototype).copied().flatten().map(|i| &parts[i]) else { return Ok(()) };
+            list.iter().try_for_each(|(p, t, rel)| {
+                let m = self.conversion * *world * inst.transform * *rel;
+                let label = format!("{p}[{prim}:{}]", inst.index);
+                self.gprim(p, t, &label, &m).map_err(fail(p))
+            })
+        });
+        self.prototypes.parts = parts;
+        expanded?;
+        self.scene.counts.instances += instances.len();
+        Ok(())
+    }
+}
