@@ -82,10 +82,30 @@ impl Spec {
     }
 }
 
+/// The specs at one path of the layer's namespace (ppis patch, see PATCHED.md): its own,
+/// if any, and those of the properties it owns, by name. A stage of simple prims has
+/// several property specs per prim; keyed by owner and name they need no path node each
+/// (and no table slot), which were most of a usdc layer's memory.
+#[derive(Debug, Default)]
+struct Entry {
+    spec: Option<Spec>,
+    /// `(name token, spec)`, sorted by name (the token's text), names unique.
+    properties: Vec<(u32, Spec)>,
+}
+
+impl Entry {
+    /// The slot of `name` among the properties, or where it would go.
+    fn find(&self, tokens: &[String], name: &str) -> Result<usize, usize> {
+        self.properties.binary_search_by(|(t, _)| tokens[*t as usize].as_str().cmp(name))
+    }
+}
+
 /// High level interface to binary data.
 pub struct CrateData<R> {
     file: RefCell<CrateFile<R>>,
-    data: sdf::PathMap<Spec>,
+    /// Keyed by prim (and other non-property) paths; a property spec lives in its
+    /// owner's entry (see [`Entry`]).
+    data: sdf::PathMap<Entry>,
 }
 
 impl<R> CrateData<R>
@@ -102,24 +122,31 @@ where
 
         // Index each spec by its path, recording only its type and the start of
         // its fieldset. The fields themselves stay in the file's compact,
-        // deduplicated arrays and are resolved on demand.
+        // deduplicated arrays and are resolved on demand. A property spec goes to
+        // its owner's entry.
         let specs = mem::take(&mut file.specs);
-        let mut data = sdf::PathMap::with_capacity_and_hasher(specs.len(), Default::default());
+        let is_property = |index: usize| file.property_names[index] != reader::NO_PROPERTY;
+        let owners = specs.iter().filter(|spec| !is_property(spec.path_index)).count();
+        let mut data: sdf::PathMap<Entry> = sdf::PathMap::with_capacity_and_hasher(owners, Default::default());
 
         for spec in &specs {
-            let path = file.paths[spec.path_index].clone();
             let fieldset = u32::try_from(spec.fieldset_index)
                 .ok()
                 .filter(|&i| i != NO_FIELDSET)
                 .context("corrupt file: fieldset index out of range")?;
-            data.insert(
-                path,
-                Spec {
-                    ty: spec.spec_type,
-                    fieldset,
-                    authored: None,
-                },
-            );
+            let entry = data.entry(file.paths[spec.path_index].clone()).or_default();
+            let new = Spec {
+                ty: spec.spec_type,
+                fieldset,
+                authored: None,
+            };
+            match file.property_names[spec.path_index] {
+                reader::NO_PROPERTY => entry.spec = Some(new),
+                name => entry.properties.push((name, new)),
+            }
+        }
+        for entry in data.values_mut() {
+            sort_properties(&mut entry.properties, &file.tokens);
         }
 
         Ok(Self {
@@ -129,17 +156,54 @@ where
     }
 }
 
+/// Sorts a prim's properties by name, keeping the last of equal names (the file's
+/// last spec for a path wins, as a map insert would).
+fn sort_properties(properties: &mut Vec<(u32, Spec)>, tokens: &[String]) {
+    if properties.len() > 1 {
+        properties.reverse();
+        properties.sort_by(|(a, _), (b, _)| tokens[*a as usize].cmp(&tokens[*b as usize]));
+        properties.dedup_by(|(a, _), (b, _)| tokens[*a as usize] == tokens[*b as usize]);
+    }
+    properties.shrink_to_fit();
+}
+
+impl<R> CrateData<R> {
+    /// The spec at `path`.
+    fn spec(&self, path: &sdf::Path) -> Option<&Spec> {
+        match path.as_property() {
+            Some((owner, name)) => {
+                let entry = self.data.get(owner)?;
+                let at = entry.find(&self.file.borrow().tokens, name).ok()?;
+                Some(&entry.properties[at].1)
+            }
+            None => self.data.get(path)?.spec.as_ref(),
+        }
+    }
+
+    /// The spec at `path`, to author its fields.
+    fn spec_mut(&mut self, path: &sdf::Path) -> Option<&mut Spec> {
+        match path.as_property() {
+            Some((owner, name)) => {
+                let entry = self.data.get_mut(owner)?;
+                let at = entry.find(&self.file.get_mut().tokens, name).ok()?;
+                Some(&mut entry.properties[at].1)
+            }
+            None => self.data.get_mut(path)?.spec.as_mut(),
+        }
+    }
+}
+
 impl<R> sdf::AbstractData for CrateData<R>
 where
     R: io::Read + io::Seek,
 {
     #[inline]
     fn has_spec(&self, path: &sdf::Path) -> bool {
-        self.data.contains_key(path)
+        self.spec(path).is_some()
     }
 
     fn has_field(&self, path: &sdf::Path, field: &str) -> bool {
-        let Some(spec) = self.data.get(path) else {
+        let Some(spec) = self.spec(path) else {
             return false;
         };
         if let Some(authored) = spec.authored(field) {
@@ -153,11 +217,11 @@ where
 
     #[inline]
     fn spec_type(&self, path: &sdf::Path) -> Option<sdf::SpecType> {
-        self.data.get(path).map(|spec| spec.ty)
+        self.spec(path).map(|spec| spec.ty)
     }
 
     fn try_field(&self, path: &sdf::Path, field: &str) -> Result<Option<Cow<'_, sdf::Value>>, sdf::DataError> {
-        let Some(spec) = self.data.get(path) else {
+        let Some(spec) = self.spec(path) else {
             return Ok(None);
         };
         if let Some(authored) = spec.authored(field) {
@@ -183,7 +247,7 @@ where
     }
 
     fn list_fields(&self, path: &sdf::Path) -> Option<Vec<String>> {
-        let spec = self.data.get(path)?;
+        let spec = self.spec(path)?;
         let mut names = Vec::new();
         if let Some(start) = spec.fieldset() {
             for (name, _) in crate_fields(&self.file.borrow(), start) {
@@ -203,43 +267,81 @@ where
     }
 
     fn spec_paths(&self) -> Vec<sdf::Path> {
-        let mut paths: Vec<sdf::Path> = self.data.keys().cloned().collect();
+        let file = self.file.borrow();
+        let mut paths: Vec<sdf::Path> = Vec::with_capacity(self.data.len());
+        for (path, entry) in &self.data {
+            if entry.spec.is_some() {
+                paths.push(path.clone());
+            }
+            let named = entry.properties.iter().map(|(name, _)| path.append_property(&file.tokens[*name as usize]));
+            paths.extend(named.filter_map(Result::ok));
+        }
         paths.sort_by(|a, b| a.as_str().cmp(b.as_str()));
         paths
     }
 
     fn create_spec(&mut self, path: sdf::Path, ty: sdf::SpecType) {
-        self.data.insert(
-            path,
-            Spec {
-                ty,
-                fieldset: NO_FIELDSET,
-                authored: None,
-            },
-        );
+        let new = Spec {
+            ty,
+            fieldset: NO_FIELDSET,
+            authored: None,
+        };
+        let Some((owner, name)) = path.as_property() else {
+            self.data.entry(path).or_default().spec = Some(new);
+            return;
+        };
+        let tokens = &mut self.file.get_mut().tokens;
+        let entry = self.data.entry(owner.clone()).or_default();
+        match entry.find(tokens, name) {
+            Ok(at) => entry.properties[at].1 = new,
+            Err(at) => {
+                let token = u32::try_from(tokens.len()).expect("fewer than 2^32 tokens");
+                tokens.push(name.to_owned());
+                entry.properties.insert(at, (token, new));
+            }
+        }
     }
 
     fn erase_spec(&mut self, path: &sdf::Path) {
-        self.data.remove(path);
+        let (key, name) = match path.as_property() {
+            Some((owner, name)) => (owner, Some(name)),
+            None => (path, None),
+        };
+        let Some(entry) = self.data.get_mut(key) else {
+            return;
+        };
+        match name {
+            Some(name) => {
+                if let Ok(at) = entry.find(&self.file.get_mut().tokens, name) {
+                    entry.properties.remove(at);
+                }
+            }
+            None => entry.spec = None,
+        }
+        if entry.spec.is_none() && entry.properties.is_empty() {
+            self.data.remove(key);
+        }
     }
 
     fn set_field(&mut self, path: &sdf::Path, field: &str, value: sdf::Value) {
-        match self.data.get_mut(path) {
+        match self.spec_mut(path) {
             Some(spec) => spec.set_authored(field, Some(value)),
             None => debug_assert!(false, "set_field on absent spec at {path}"),
         }
     }
 
     fn erase_field(&mut self, path: &sdf::Path, field: &str) {
-        let Some(spec) = self.data.get_mut(path) else {
+        let Some(fieldset) = self.spec(path).map(Spec::fieldset) else {
             return;
         };
         // A tombstone is only needed to mask a field the crate holds; for an
         // authored-only or absent field, dropping the overlay entry keeps erase
         // idempotent and lets a later set re-append in authored order.
-        let masks_crate = spec
-            .fieldset()
-            .is_some_and(|start| crate_fields(&self.file.borrow(), start).any(|(name, _)| name == field));
+        let masks_crate =
+            fieldset.is_some_and(|start| crate_fields(&self.file.borrow(), start).any(|(name, _)| name == field));
+        let Some(spec) = self.spec_mut(path) else {
+            return;
+        };
         if masks_crate {
             spec.set_authored(field, None);
         } else {
@@ -323,7 +425,52 @@ mod tests {
     use super::*;
     use crate::gf;
     use crate::gf::f16;
+    use sdf::AbstractData;
     use std::path::Path;
+
+    /// A layer of a prim with three attributes and a child, written by the crate writer and
+    /// read back: property specs keyed by owner and name answer as path-keyed ones did.
+    #[test]
+    fn property_specs_are_found_by_owner_and_name() -> Result<()> {
+        let p = |text: &str| sdf::path(text).unwrap();
+        let mut layer = sdf::Data::default();
+        layer.create_spec(p("/"), sdf::SpecType::PseudoRoot);
+        layer.create_spec(p("/A"), sdf::SpecType::Prim);
+        layer.create_spec(p("/A/B"), sdf::SpecType::Prim);
+        for (name, value) in [("z", 3.0), ("x", 1.0), ("primvars:y", 2.0)] {
+            layer.create_spec(p(&format!("/A.{name}")), sdf::SpecType::Attribute).add("default", value);
+        }
+        layer.create_spec(p("/A/B"), sdf::SpecType::Prim).add("testTargets", sdf::Value::PathVec(vec![p("/A.x")]));
+        let mut bytes = io::Cursor::new(Vec::new());
+        CrateWriter::write(&layer, &mut bytes)?;
+        bytes.set_position(0);
+        let mut data = CrateData::open(bytes, true)?;
+
+        for (name, value) in [("x", 1.0), ("primvars:y", 2.0), ("z", 3.0)] {
+            let path = p(&format!("/A.{name}"));
+            assert!(data.has_spec(&path), "{path}");
+            assert_eq!(data.spec_type(&path), Some(sdf::SpecType::Attribute));
+            assert_eq!(data.get_field(&path, "default").ok().map(|v| v.into_owned()), Some(sdf::Value::Double(value)));
+        }
+        assert!(!data.has_spec(&p("/A.w")) && !data.has_spec(&p("/A/B.x")));
+        assert_eq!(data.spec_type(&p("/A")), Some(sdf::SpecType::Prim));
+        // A path value naming a property is made whole again.
+        let targets = data.get_field(&p("/A/B"), "testTargets").ok().map(|v| v.into_owned());
+        assert_eq!(targets, Some(sdf::Value::PathVec(vec![p("/A.x")])));
+        let all = |data: &CrateData<_>| data.spec_paths().iter().map(|p| p.to_string()).collect::<Vec<_>>();
+        assert_eq!(all(&data), ["/", "/A", "/A.primvars:y", "/A.x", "/A.z", "/A/B"]);
+
+        // Authoring after load: a new property, a field on it, and erasing specs.
+        data.create_spec(p("/A.w"), sdf::SpecType::Attribute);
+        data.set_field(&p("/A.w"), "default", sdf::Value::Double(4.0));
+        assert_eq!(data.get_field(&p("/A.w"), "default").ok().map(|v| v.into_owned()), Some(sdf::Value::Double(4.0)));
+        data.erase_spec(&p("/A.x"));
+        assert!(!data.has_spec(&p("/A.x")) && data.has_spec(&p("/A.z")) && data.has_spec(&p("/A")));
+        data.erase_spec(&p("/A"));
+        assert!(!data.has_spec(&p("/A")) && data.has_spec(&p("/A.w")));
+        assert_eq!(all(&data), ["/", "/A.primvars:y", "/A.w", "/A.z", "/A/B"]);
+        Ok(())
+    }
 
     #[test]
     fn test_crate_hierarchy() -> Result<()> {

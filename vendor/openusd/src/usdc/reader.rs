@@ -45,8 +45,15 @@ pub struct CrateFile<R> {
     pub fields: Vec<Field>,
     /// A vector of groups of fields, invalid-index terminated.
     pub fieldsets: Vec<Option<usize>>,
-    // All unique paths.
+    /// All unique paths, but a prim's property: its owner's path, the property's name
+    /// being in [`property_names`](Self::property_names). Use [`path`](Self::path).
     pub paths: Vec<sdf::Path>,
+    /// ppis patch: for each of [`paths`](Self::paths), the token of the property name
+    /// appended to it, or [`NO_PROPERTY`]. A property's path node is made only when a value
+    /// names it ([`path`](Self::path)): the layer keys property specs by owner and name
+    /// (`CrateData`), and on a stage of simple prims the properties' nodes were a third of
+    /// the layer's memory.
+    pub property_names: Vec<u32>,
     // All specs.
     pub specs: Vec<Spec>,
     /// ppis patch: how many values enclose the one being read (see [`MAX_VALUE_DEPTH`]).
@@ -57,6 +64,9 @@ pub struct CrateFile<R> {
 /// recursion on the caller's stack, one frame per level of file-controlled data; deeper
 /// nesting than this is refused as corrupt instead of overflowing the stack.
 pub const MAX_VALUE_DEPTH: usize = 128;
+
+/// [`CrateFile::property_names`] of a path that is not a prim's property.
+pub const NO_PROPERTY: u32 = u32::MAX;
 
 impl<R> CrateFile<R> {
     /// Returns file's version extracted from bootstrap header.
@@ -83,6 +93,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             fields: Vec::new(),
             fieldsets: Vec::new(),
             paths: Vec::new(),
+            property_names: Vec::new(),
             specs: Vec::new(),
             value_depth: 0,
         };
@@ -377,6 +388,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             bail!("corrupt file: path element token {i} of {} tokens", self.tokens.len());
         }
         self.paths = vec![sdf::Path::default(); path_count];
+        self.property_names = vec![NO_PROPERTY; path_count];
 
         self.build_compressed_paths(&path_indexes, &element_token_indexes, &jumps)?;
 
@@ -431,7 +443,12 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     let token_index = token_index.unsigned_abs() as usize;
                     let element_token = self.tokens[token_index].as_str();
 
-                    self.paths[path_indexes[index] as usize] = if is_prim_property_path {
+                    let slot = path_indexes[index] as usize;
+                    self.property_names[slot] = NO_PROPERTY;
+                    self.paths[slot] = if is_prim_property_path && parent_path.owns_property(element_token) {
+                        self.property_names[slot] = token_index as u32;
+                        parent_path.clone()
+                    } else if is_prim_property_path {
                         parent_path.append_property(element_token)?
                     } else if element_token.starts_with('{') {
                         // Variant segments are appended directly without a separator
@@ -454,7 +471,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
                     // Descend into the child (the next sequential entry) under
                     // this node's path.
-                    parent_path = self.paths[path_indexes[index] as usize].clone();
+                    parent_path = self.path(path_indexes[index] as usize)?;
                 }
 
                 if !has_child && !has_sibling {
@@ -747,7 +764,17 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     }
 
     fn read_path_vec(&mut self) -> Result<Vec<sdf::Path>> {
-        self.read_indexed_vec(|file, index| file.paths[index].clone())
+        self.read_indexed_vec(|file, index| file.path(index))?.into_iter().collect()
+    }
+
+    /// The path at `index` of the PATHS section (ppis patch: a property's node is made
+    /// here, from its owner and name; see [`property_names`](Self::property_names)).
+    pub fn path(&self, index: usize) -> Result<sdf::Path> {
+        let owner = self.paths.get(index).with_context(|| format!("corrupt file: path index {index} out of range"))?;
+        match self.property_names.get(index).copied().unwrap_or(NO_PROPERTY) {
+            NO_PROPERTY => Ok(owner.clone()),
+            name => owner.append_property(&self.tokens[name as usize]),
+        }
     }
 
     /// Reads a count-prefixed vector of POD values.
@@ -765,9 +792,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
     fn read_path(&mut self) -> Result<sdf::Path> {
         let index = self.reader.read_pod::<u32>()?;
-        let path = self.paths[index as usize].clone();
-
-        Ok(path)
+        self.path(index as usize)
     }
 
     fn read_reference(&mut self) -> Result<sdf::Reference> {
@@ -1429,8 +1454,8 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 for _ in 0..count {
                     let src_idx: u32 = self.reader.read_pod()?;
                     let tgt_idx: u32 = self.reader.read_pod()?;
-                    let src = self.paths[src_idx as usize].clone();
-                    let tgt = self.paths[tgt_idx as usize].clone();
+                    let src = self.path(src_idx as usize)?;
+                    let tgt = self.path(tgt_idx as usize)?;
                     pairs.push((src, tgt));
                 }
                 sdf::Value::Relocates(pairs)

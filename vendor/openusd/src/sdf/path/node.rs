@@ -272,6 +272,22 @@ impl Path {
         (fits && is_property_name(name)).then(|| self.child(Kind::Property, &[".", name]))
     }
 
+    /// Whether [`append_property`](Path::append_property)`(name)` makes a property node
+    /// of this path, which [`as_property`](Self::as_property) takes apart again: a table
+    /// may then key the property by this path and `name` instead of holding its node.
+    pub(crate) fn owns_property(&self, name: &str) -> bool {
+        matches!(self.node.kind, Kind::Prim | Kind::Variant) && is_property_name(name)
+    }
+
+    /// The owner and the name of a property node (`/A/B.points` → `/A/B`, `points`);
+    /// `None` for any other path, an opaque text included.
+    pub(crate) fn as_property(&self) -> Option<(&Path, &str)> {
+        match (self.node.kind, &self.node.parent) {
+            (Kind::Property, Some(owner)) => Some((owner, &self.node.seg[1..])),
+            _ => None,
+        }
+    }
+
     /// The nodes from the root (or opaque text) down to this one.
     pub(super) fn chain(&self) -> Vec<&Path> {
         let mut chain = Vec::with_capacity(self.node.elems as usize + 2);
