@@ -27,9 +27,9 @@ pub struct Options {
     pub camera: Option<String>,
     /// The RenderSettings prim to use (default: the layer's `renderSettingsPrimPath`).
     pub render_settings: Option<String>,
-    /// Leave the composed stage allocated when the import returns instead of freeing it.
-    /// Freeing a large stage is a tenth to a fifth of its import; a process about to exit
-    /// (`ppis info`) need not pay it. The stage's memory is never returned.
+    /// Leave the stage (its layers) allocated when the import returns instead of freeing
+    /// it: work that a process about to exit (`ppis info`) need not do. The stage's memory
+    /// is never returned.
     pub leak_stage: bool,
     /// The time code the stage is read at (default: [`TimeCode::Earliest`], as `usdrecord`
     /// renders without a frame).
@@ -141,17 +141,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         import_seconds: 0.0,
     };
     let fail = |(prim, message): Failure| UsdError::Prim { file: file.to_owned(), prim, message };
-    let mut imp = Importer::new(&stage, scene.clone(), Prototypes::default());
-    let walked = imp.walk();
-    if let Err(Stop::Restart) = walked {
-        // A PointInstancer names a prototype the walk has already imported in place: walk
-        // again knowing every instancer's prototypes from the start.
-        let known = prototype_roots(&stage).map_err(fail)?;
-        imp = Importer::new(&stage, scene, Prototypes::known(known));
-        imp.walk().map_err(Stop::failure).map_err(fail)?;
-    } else {
-        walked.map_err(Stop::failure).map_err(fail)?;
-    }
+    let mut imp = walk(&stage, scene).map_err(fail)?;
     let (settings, notes) =
         render_settings::read(&stage, &imp.settings, options.render_settings.as_deref()).map_err(fail)?;
     let where_ = settings.as_ref().map_or("/", |s| s.path.as_str()).to_string();
@@ -186,6 +176,21 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
 }
 
 type Failure = (String, String);
+
+/// The stage's prims imported into `scene` by one walk, or two when a PointInstancer names a
+/// prototype that the first walk has already imported in place.
+fn walk<'a>(stage: &'a Stage, scene: UsdScene) -> Result<Importer<'a>, Failure> {
+    let mut imp = Importer::new(stage, scene.clone(), Prototypes::default());
+    match imp.walk() {
+        Ok(()) => Ok(imp),
+        Err(Stop::Restart) => {
+            let mut imp = Importer::new(stage, scene, Prototypes::known(prototype_roots(stage)?));
+            imp.walk().map_err(Stop::failure)?;
+            Ok(imp)
+        }
+        Err(stop) => Err(stop.failure()),
+    }
+}
 
 /// The failure of `prim` with message `m`, for `map_err`: the path is written out only
 /// on failure (it is as long as the prim is deep).
