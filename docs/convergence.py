@@ -2,7 +2,7 @@
 """Does every method converge? relMSE against a converged reference at 4× steps of spp, each
 the mean over several seeds (one seed's relMSE is dominated by its rarest large samples; the
 mean over seeds estimates the expected error, which falls 4× per 4× spp when the pixel
-footprint is integrated too — docs/perf.md, "Shading points per pixel").
+footprint is integrated too — docs/tuning.md, "Shading points per pixel").
 
   python3 docs/convergence.py --out DIR [--methods mis,product-mis] [--spp 16,64,256,1024]
                               [--seeds 4] [--ref-spp 16384] [--width 160 --height 90] [SCENE]

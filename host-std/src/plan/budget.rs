@@ -3,7 +3,7 @@
 //! pixel footprint — edges, textures, a sun seen in a glossy reflection — is integrated only by
 //! the primary rays: with P fixed, every method stops converging at the footprint's error.
 //! So P grows with spp, and each method keeps the few light samples per shading point that
-//! pay for what a shading point costs it (docs/perf.md, "Shading points per pixel").
+//! pay for what a shading point costs it (docs/tuning.md, "Shading points per pixel").
 
 use crate::plan::Method;
 

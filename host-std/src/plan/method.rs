@@ -78,7 +78,7 @@ impl Method {
     /// techniques whose sampler is built once per render or per pixel; and for the samplers
     /// built per shading point the power of two nearest √(build cost / sample cost), the
     /// split that minimises error × time when a point's light and its footprint vary alike
-    /// (docs/perf.md, "Shading points per pixel").
+    /// (docs/tuning.md, "Shading points per pixel").
     #[must_use]
     pub fn samples_per_point(self) -> usize {
         match self {

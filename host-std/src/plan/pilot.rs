@@ -59,8 +59,8 @@ pub const OVERRIDE_MARGIN: f64 = 1.25;
 
 /// How much better than the rule's plan a costlier plan must score to replace it. The rules
 /// give the costly product-MIS to the materials where it won the equal-time sweeps; elsewhere
-/// it lost on every scene measured, and a pilot whose few brightest pixels happened to favour
-/// it would spend the render's time where it does not pay.
+/// it loses on every scene measured (docs/perf.md, "`auto` and its pilot"), and a pilot whose
+/// few brightest pixels happened to favour it would spend the render's time where it does not pay.
 pub const COSTLIER_OVERRIDE_MARGIN: f64 = 2.0;
 
 /// Share of the render's work (in MIS pixels, the candidates weighted by their cost) the pilot
@@ -202,7 +202,7 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
 }
 
 /// Renders every task's pixels twice, in parallel, and returns per task its pixel pairs, in a
-/// fixed order whatever the thread count (truncating kept every measured material at ≥
+/// fixed order whatever the thread count (truncating keeps every measured material at ≥
 /// [`MIN_PIXELS`]). One job per (task, pixel), so that the threads share the work evenly.
 fn measure(
     ctx: &Context<'_, '_>,

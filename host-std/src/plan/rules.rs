@@ -2,7 +2,7 @@
 //! the material's lobe and how peaked the lighting is — its plan before the pilot
 //! (`plan::pilot`) checks it on the scene, and its plan where the image is too small for a
 //! pilot. The thresholds and splits come from equal-time sweeps per material region
-//! (`ppis report`; docs/perf.md, "Headline: error at equal time" and "Budget splits").
+//! (`ppis report`; docs/perf.md, "Headline: error at equal time"; docs/tuning.md, "Budget splits").
 //!
 //! * Glossy BRDFs whose sharpest lobe is of moderate width (`Brdf::lobe_width`, GGX α, in
 //!   [`PRODUCT_ALPHA`]): product-MIS — the lobe is wide enough to span bright detail of the map

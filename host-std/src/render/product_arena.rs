@@ -1,7 +1,7 @@
 //! The product arena a render builds its samplers in, sized for the render's K (BRDF samples
 //! per sampler): the core's arena has its capacity as a const generic, so the renderer keeps
 //! two sizes and takes the smaller that holds K. K ≤ 256 — the paper's default and every
-//! render's unless asked — runs in the default arena, exactly as before; larger K, up to
+//! render's unless asked — runs in the default arena; larger K, up to
 //! [`MAX_BRDF_SAMPLES`], in an arena four times as large (~180 KB).
 
 use sampler_core::brdf::Brdf;

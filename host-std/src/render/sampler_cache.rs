@@ -6,7 +6,7 @@
 //! point: MIS with BRDF sampling covers where another point's lobe leaves the shared B̃. Plain
 //! product, wavelet and two-stage build per shading point: shared, they grow fireflies near
 //! silhouettes and on sharp lobes, where only the defensive mixture covers the mismatch. How
-//! much sharing saves is measured in docs/perf.md ("Sampler reuse across pixels", "Tried and
+//! much sharing saves is measured in docs/tuning.md Sampler reuse across pixels", "Tried and
 //! not kept").
 
 use crate::render::Context;
@@ -26,7 +26,7 @@ use sampler_core::two_stage::TwoStageSampler;
 /// Share of a material's lobe width within which the tile's next pixels reuse a product-MIS
 /// sampler (normals and mirror directions both that close to the one it was built at). A
 /// smaller share rebuilds more often for no less error; a larger one raises the error on
-/// glossy surfaces (docs/perf.md, "Sampler reuse across pixels").
+/// glossy surfaces (docs/tuning.md, "Sampler reuse across pixels").
 pub const REUSE_SHARE: f32 = 0.5;
 
 /// Widest lobe (radians) the reuse angle follows; diffuse surfaces reuse within

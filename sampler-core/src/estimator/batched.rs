@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples per batch: four lanes of four, and no more (a shading point with 16 visibility
 /// samples spends 8 pairs; a larger batch only zeroes more scratch per call, which a shading
-/// point with few samples pays in full: docs/perf.md#batched-and-branch-free-sampling).
+/// point with few samples pays in full: docs/tuning.md#batched-and-branch-free-sampling).
 pub const BATCH: usize = 16;
 
 /// A drawn direction, or none.
@@ -178,7 +178,7 @@ fn brdf_draws<B: Brdf + ?Sized>(
 /// their count. Unbiased for any split: each technique's density covers what it samples, and
 /// together they cover every direction where L·B > 0 (the product through its defensive part).
 /// Where a wide lobe meets extended light, product samples are worth more than BRDF samples,
-/// and a split towards them lowers the error (docs/perf.md#budget-splits); with shares (½, ½) and as many
+/// and a split towards them lowers the error (docs/tuning.md#budget-splits); with shares (½, ½) and as many
 /// points of each it is [`sampled_mis_many`]'s estimate. The sum runs over all of the first
 /// technique's samples, then the BRDF's, one by one (the same order and rounding however the
 /// points are batched).

@@ -8,7 +8,7 @@ pub enum Leaves {
     #[default]
     Sampled,
     /// The samples' mean or B at the leaf's centre, the larger. Hosts use it for product-MIS,
-    /// where it lowers the error on glossy surfaces (docs/perf.md#product-mis-preset); plain
+    /// where it lowers the error on glossy surfaces (docs/tuning.md#product-mis-preset); plain
     /// product sampling without BRDF-sampling MIS keeps a heavy tail on car paint at grazing
     /// views either way.
     Probed,
@@ -19,7 +19,7 @@ pub enum Leaves {
     /// inside. Per sample it is far better (`examples/product_variance`), but every sample and
     /// every density walks the environment's levels weighing cells by B̃, which costs more than
     /// it saves where rays are cheap and one build serves a pixel
-    /// (docs/perf.md#product-mis-preset): worth it where rays cost more than those lookups.
+    /// (docs/tuning.md#product-mis-preset): worth it where rays cost more than those lookups.
     /// Needs an arena with `CORNERS ≥ NODES`; an arena without builds [`Leaves::Sampled`]
     /// leaves, and the sampler says so (`ProductSampler::kind`).
     Bilinear,
@@ -94,7 +94,7 @@ pub struct ProductParams {
     /// Depth cap of the quadtree (≤ 24): coincident samples cannot split forever. Default 14
     /// (cells of 6e-5 of the square, ~2e-4 rad): deeper leaves shrink towards the f32 direction's
     /// resolution, and then the density a BRDF sample's `pdf(ω)` lookup finds is not always the
-    /// product's density at ω — MIS weights stop summing to one (docs/perf.md#depth-cap).
+    /// product's density at ω — MIS weights stop summing to one (docs/tuning.md#depth-cap).
     pub max_depth: u32,
     /// Defensive environment-sampling fraction ε ∈ (0, 1].
     pub defensive: f32,
@@ -111,7 +111,7 @@ impl Default for ProductParams {
 
 impl ProductParams {
     /// Settings for a product sampler used in MIS with BRDF sampling (`estimator::sampled_mis`;
-    /// docs/perf.md#product-mis-preset): leaves probed at their centres, leaves heavier than
+    /// docs/tuning.md#product-mis-preset): leaves probed at their centres, leaves heavier than
     /// one BRDF sample's share (1/K of the mass) refined, and a defensive fraction of 0.25 —
     /// the BRDF half already covers the lobe, so environment samples are what the pair lacks
     /// where the light peaks in the lobe's tail (a sun beside a sharp lobe).

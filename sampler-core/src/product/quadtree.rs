@@ -250,7 +250,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         // With `probe_leaves`, B at the leaf's centre too, the larger kept (NaN reads as
         // unknown): a sample can sit on the dim side of its leaf, and a B̃ that understates
         // the leaf makes B/B̃ large wherever the light sends the product's samples in it,
-        // while one that overstates it only spends a few samples (docs/perf.md#product-mis-preset).
+        // while one that overstates it only spends a few samples (docs/tuning.md#product-mis-preset).
         if self.probe_leaves {
             let probe = self.probe(cell);
             if probe.is_finite() {

@@ -15,7 +15,7 @@
 //!
 //! Cost: the second moment of f/p grows by at most 1/(1 − ε), so the variance by at most
 //! Var/(1 − ε) + μ²·ε/(1 − ε) — the relative cost is largest where product sampling is already
-//! excellent (small Var against μ²); docs/perf.md#defensive-mixture has the measured cost.
+//! excellent (small Var against μ²); docs/perf.md#per-sample-variance has the measured cost.
 //! The default is ε = 0.02.
 
 use super::bilinear::Corners;

@@ -56,7 +56,7 @@ pub(crate) fn grandchild_probability(mass: &[f32; 16], k: usize) -> f64 {
 /// [`choose_grandchild`] without data-dependent branches (the same choice and rescaling for
 /// every input with some mass), for interleaving several descents: alone, its chain of
 /// dependent arithmetic is slower than a predicted branch; four chains side by side are not
-/// (docs/perf.md#batched-and-branch-free-sampling).
+/// (docs/tuning.md#batched-and-branch-free-sampling).
 #[inline(always)]
 pub fn choose_grandchild_branchless(mass: &[f32; 16], xi: &mut DVec2) -> Option<(usize, u32, u32)> {
     grandchild_by(mass, xi, pick_branchless::<4>)
@@ -99,7 +99,7 @@ fn grandchild_by(mass: &[f32; 16], xi: &mut DVec2, pick: Pick<4>) -> Option<(usi
 /// its weight, or `None` if Σw is not positive. A side of zero weight is never chosen, even
 /// when rounding pushes t past the end. (Branching, for one descent: with a branch-free count
 /// of prefix sums the address of the next level's load waits for the arithmetic, where a
-/// predicted branch lets the load start early; docs/perf.md#batched-and-branch-free-sampling.)
+/// predicted branch lets the load start early; docs/tuning.md#batched-and-branch-free-sampling.)
 #[inline(always)]
 fn pick<const N: usize>(w: [f64; N], x: f64) -> Option<(usize, f64, f64)> {
     let total = w.iter().sum::<f64>();
