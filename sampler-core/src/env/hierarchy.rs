@@ -2,7 +2,8 @@
 //! relative to the mean, radiance lookups and the env-only density.
 
 use super::pyramid::{EnvError, check_lengths, level_offset, pyramid_index};
-use crate::cell::Cell;
+use super::texel_cdf::TexelCdf;
+use crate::cell::{Cell, morton2};
 use crate::mapping::{
     SPHERE_AREA, sphere_to_square, sphere_to_square_batch, square_to_sphere, square_to_sphere_batch, texel_of,
 };
@@ -20,6 +21,8 @@ pub struct EnvHierarchy<'a> {
     tint: Vec3,
     world_to_map: Mat3,
     map_to_world: Mat3,
+    /// The texel table env-only sampling uses instead of the descent, when attached.
+    pub(crate) cdf: Option<TexelCdf<'a>>,
 }
 
 impl<'a> EnvHierarchy<'a> {
@@ -40,7 +43,32 @@ impl<'a> EnvHierarchy<'a> {
             tint: Vec3::ONE,
             world_to_map: Mat3::IDENTITY,
             map_to_world: Mat3::IDENTITY,
+            cdf: None,
         })
+    }
+
+    /// Samples env-only through `cdf` (built by [`build_texel_cdf`](super::build_texel_cdf)
+    /// from this pyramid) instead of descending the pyramid: [`sample`](Self::sample),
+    /// [`sample_many`](Self::sample_many), [`pdf_square`](Self::pdf_square) and
+    /// [`pdf`](Self::pdf) then follow the table's quantized density. The product samplers keep
+    /// descending the pyramid below their leaves.
+    pub fn with_texel_cdf(mut self, cdf: TexelCdf<'a>) -> Result<Self, EnvError> {
+        if cdf.finest_level() != self.finest {
+            return Err(EnvError::WrongLength {
+                buffer: "texel table",
+                expected: super::texel_cdf_len(self.finest),
+                found: super::texel_cdf_len(cdf.finest_level()),
+            });
+        }
+        self.cdf = Some(cdf);
+        Ok(self)
+    }
+
+    /// The texel table env-only sampling uses, if one is attached.
+    #[inline]
+    #[must_use]
+    pub fn texel_cdf(&self) -> Option<&TexelCdf<'a>> {
+        self.cdf.as_ref()
     }
 
     /// Orients the map: `map_to_world` takes directions of the map's own frame (the frame
@@ -236,14 +264,32 @@ impl<'a> EnvHierarchy<'a> {
         let (x, y) = self.texel_at(uv);
         let i = y as usize * self.resolution() as usize + x as usize;
         prefetch(&self.radiance[i..=i]);
-        let node = pyramid_index(Cell::new(self.finest, x, y));
-        prefetch(&self.pyramid[node..=node]);
+        match &self.cdf {
+            Some(cdf) => cdf.prefetch(morton2(x, y)),
+            None => {
+                let node = pyramid_index(Cell::new(self.finest, x, y));
+                prefetch(&self.pyramid[node..=node]);
+            }
+        }
     }
 
-    /// Env-only density per unit area of the square at `uv` (mean 1 over the square).
+    /// Env-only density per unit area of the square at `uv` (mean 1 over the square): the
+    /// texel table's where one is attached, else the texel's importance relative to the mean.
     #[inline]
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
+        let (x, y) = self.texel_at(uv);
+        match &self.cdf {
+            Some(cdf) => cdf.relative(morton2(x, y)),
+            None => self.node_relative(Cell::new(self.finest, x, y)),
+        }
+    }
+
+    /// The importance of the finest-level texel at `uv` relative to the map's mean: the
+    /// pyramid's env-only density, which the product samplers continue below their leaves.
+    #[inline]
+    #[must_use]
+    pub fn texel_relative(&self, uv: Vec2) -> f32 {
         let (x, y) = self.texel_at(uv);
         self.node_relative(Cell::new(self.finest, x, y))
     }

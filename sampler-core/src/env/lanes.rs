@@ -6,8 +6,10 @@
 
 use super::EnvHierarchy;
 use super::pyramid::level_offset;
+use super::texel_cdf::TexelCdf;
 use crate::cell::Cell;
 use crate::direction::DirectionSample;
+use crate::mapping::SPHERE_AREA;
 use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
@@ -48,6 +50,9 @@ impl EnvHierarchy<'_> {
     /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
     pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
+        if let Some(cdf) = &self.cdf {
+            return self.sample_many_by_table(cdf, u, out);
+        }
         for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
             let n = us.len().min(os.len());
             let mut lanes = [WarpLane::default(); LANES];
@@ -65,6 +70,29 @@ impl EnvHierarchy<'_> {
             for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
                 let (uv, pdf) = points[k];
                 *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv, pdf });
+            }
+        }
+    }
+
+    /// [`sample_many`](Self::sample_many) through the texel table: every point's texel first,
+    /// so that the table's loads of all of them are in flight together, then the directions.
+    fn sample_many_by_table(&self, cdf: &TexelCdf<'_>, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
+        if self.is_black() {
+            out.iter_mut().for_each(|o| *o = None);
+            return;
+        }
+        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let n = us.len().min(os.len());
+            let mut points = [(Vec2::ZERO, 0.0f32); LANES];
+            for (p, u) in points.iter_mut().zip(&us[..n]) {
+                let (_, morton, uv) = cdf.pick(u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON)));
+                *p = (uv, cdf.relative(morton) / SPHERE_AREA);
+            }
+            let mut dirs = [Vec3::ZERO; LANES];
+            self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
+            for (k, o) in os[..n].iter_mut().enumerate() {
+                let (uv, pdf) = points[k];
+                *o = Some(DirectionSample { dir: dirs[k], uv, pdf });
             }
         }
     }
@@ -125,7 +153,6 @@ impl EnvHierarchy<'_> {
 mod tests {
     use super::*;
     use crate::env::{build_pyramid, pyramid_len};
-    use crate::mapping::SPHERE_AREA;
 
     #[test]
     fn sample_many_draws_what_sample_draws() {

@@ -13,12 +13,14 @@
 //! radiance cancels exactly in the product estimator.
 //!
 //! The pyramid's layout and builders are in `pyramid.rs`, the view over it in `hierarchy.rs`,
-//! env-only sampling in `sample.rs` and the same four descents at a time in `lanes.rs`.
+//! env-only sampling in `sample.rs` and the same four descents at a time in `lanes.rs`; with a
+//! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent.
 
 mod hierarchy;
 mod lanes;
 mod pyramid;
 mod sample;
+mod texel_cdf;
 
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::{LANES, WarpLane};
@@ -26,3 +28,4 @@ pub use pyramid::{
     EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, pyramid_index,
     pyramid_len, sanitize_rgb,
 };
+pub use texel_cdf::{CDF_MAX_LEVEL, TexelCdf, build_texel_cdf, texel_cdf_len, texel_guide_len};

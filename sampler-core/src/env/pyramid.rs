@@ -55,6 +55,11 @@ pub enum EnvError {
     },
     /// The pyramid's root is NaN, infinite or negative: the map was not sanitized.
     NotSanitized,
+    /// A texel table was asked for a finest level above [`CDF_MAX_LEVEL`](super::CDF_MAX_LEVEL).
+    TableTooLarge {
+        /// The finest level asked for.
+        finest: u32,
+    },
 }
 
 impl core::fmt::Display for EnvError {
@@ -67,6 +72,9 @@ impl core::fmt::Display for EnvError {
                 write!(f, "{buffer} buffer holds {found} values, expected {expected}")
             }
             Self::NotSanitized => write!(f, "environment holds NaN, infinite or negative values"),
+            Self::TableTooLarge { finest } => {
+                write!(f, "texel table of level {finest} exceeds the maximum {}", super::CDF_MAX_LEVEL)
+            }
         }
     }
 }

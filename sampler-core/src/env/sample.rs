@@ -31,13 +31,18 @@ impl EnvHierarchy<'_> {
         Some(cell)
     }
 
-    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy).
+    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy, or
+    /// through the texel table where one is attached).
     #[inline]
     pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
         if self.is_black() {
             return None;
         }
         let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
+        if let Some(cdf) = &self.cdf {
+            let (_, morton, uv) = cdf.pick(xi);
+            return Some(DirectionSample { dir: self.dir_of(uv), uv, pdf: cdf.relative(morton) / SPHERE_AREA });
+        }
         let texel = self.warp_down(Cell::ROOT, &mut xi)?;
         Some(self.sample_in_texel(texel, xi))
     }

@@ -184,7 +184,7 @@ impl ProductSampler<'_, '_> {
                 }
             }
             for ((o, l), uv) in os.iter_mut().zip(&lanes[..n]).zip(us) {
-                let texel = self.env.pdf_square(*uv);
+                let texel = self.env.texel_relative(*uv);
                 *o = self.mixture(self.leaf_density(self.paths[l.index], l.cell, texel), texel);
             }
         }

@@ -139,7 +139,7 @@ impl<'e> ProductSampler<'_, 'e> {
             (texel.point(xi), self.env.node_relative(texel))
         } else {
             let uv = leaf.point(xi);
-            (uv, self.env.pdf_square(uv))
+            (uv, self.env.texel_relative(uv))
         };
         (uv, self.leaf_density(path, leaf, importance), importance)
     }
@@ -218,7 +218,7 @@ impl<'e> ProductSampler<'_, 'e> {
     /// Density per unit area of the square at `uv` (the mixture; integrates to 1 over the unit square).
     #[must_use]
     pub fn pdf_square(&self, uv: Vec2) -> f32 {
-        let env_relative = self.env.pdf_square(uv);
+        let env_relative = self.env.texel_relative(uv);
         if self.defensive >= 1.0 {
             return env_relative;
         }

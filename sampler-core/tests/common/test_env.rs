@@ -1,7 +1,9 @@
 //! Environments owned by a test: RGB texels and their importance pyramid.
 
 use glam::{Vec2, Vec3};
-use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+use sampler_core::env::{
+    CDF_MAX_LEVEL, EnvHierarchy, TexelCdf, build_pyramid, build_texel_cdf, pyramid_len, texel_cdf_len, texel_guide_len,
+};
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::rng::Pcg32;
 
@@ -10,17 +12,33 @@ pub struct TestEnv {
     pub level: u32,
     pub rgb: Vec<[f32; 3]>,
     pub pyramid: Vec<f32>,
+    /// The texel table and its guide (env-only sampling without the descent).
+    pub ends: Vec<u32>,
+    pub guide: Vec<u32>,
 }
 
 impl TestEnv {
     pub fn new(level: u32, rgb: Vec<[f32; 3]>) -> Self {
         let mut pyramid = vec![0.0; pyramid_len(level)];
         build_pyramid(level, &rgb, &mut pyramid).unwrap();
-        Self { level, rgb, pyramid }
+        let (mut ends, mut guide) = (Vec::new(), Vec::new());
+        if level <= CDF_MAX_LEVEL {
+            ends = vec![0; texel_cdf_len(level)];
+            guide = vec![0; texel_guide_len(level)];
+            build_texel_cdf(level, &pyramid, &mut ends, &mut guide).unwrap();
+        }
+        Self { level, rgb, pyramid, ends, guide }
     }
 
     pub fn view(&self) -> EnvHierarchy<'_> {
         EnvHierarchy::new(self.level, &self.pyramid, &self.rgb).unwrap()
+    }
+
+    /// [`view`](Self::view) sampling env-only through the texel table.
+    #[allow(dead_code)]
+    pub fn table_view(&self) -> EnvHierarchy<'_> {
+        let cdf = TexelCdf::new(self.level, &self.ends, &self.guide).unwrap();
+        self.view().with_texel_cdf(cdf).unwrap()
     }
 
     /// Smooth random sky: a few random lobes over a dim floor, coloured.
