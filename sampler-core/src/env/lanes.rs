@@ -9,7 +9,6 @@ use super::pyramid::level_offset;
 use super::texel_cdf::TexelCdf;
 use crate::cell::Cell;
 use crate::direction::DirectionSample;
-use crate::mapping::SPHERE_AREA;
 use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
@@ -85,8 +84,7 @@ impl EnvHierarchy<'_> {
             let n = us.len().min(os.len());
             let mut points = [(Vec2::ZERO, 0.0f32); LANES];
             for (p, u) in points.iter_mut().zip(&us[..n]) {
-                let (_, morton, uv) = cdf.pick(u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON)));
-                *p = (uv, cdf.relative(morton) / SPHERE_AREA);
+                *p = cdf.sample_point(u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON)));
             }
             let mut dirs = [Vec3::ZERO; LANES];
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
@@ -153,6 +151,7 @@ impl EnvHierarchy<'_> {
 mod tests {
     use super::*;
     use crate::env::{build_pyramid, pyramid_len};
+    use crate::mapping::SPHERE_AREA;
 
     #[test]
     fn sample_many_draws_what_sample_draws() {

@@ -40,8 +40,8 @@ impl EnvHierarchy<'_> {
         }
         let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
         if let Some(cdf) = &self.cdf {
-            let (_, morton, uv) = cdf.pick(xi);
-            return Some(DirectionSample { dir: self.dir_of(uv), uv, pdf: cdf.relative(morton) / SPHERE_AREA });
+            let (uv, pdf) = cdf.sample_point(xi);
+            return Some(DirectionSample { dir: self.dir_of(uv), uv, pdf });
         }
         let texel = self.warp_down(Cell::ROOT, &mut xi)?;
         Some(self.sample_in_texel(texel, xi))

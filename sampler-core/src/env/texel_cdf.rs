@@ -18,6 +18,8 @@
 
 use super::pyramid::{EnvError, level_offset, pyramid_len};
 use crate::cell::Cell;
+use crate::cone::morton_cell;
+use crate::mapping::SPHERE_AREA;
 use glam::{DVec2, Vec2};
 
 /// Finest level a texel table supports: 4096² texels, at least 128 steps per texel on average.
@@ -169,6 +171,15 @@ impl<'a> TexelCdf<'a> {
         crate::prefetch::prefetch(&self.ends[morton.saturating_sub(1)..=morton]);
     }
 
+    /// The point of the square `u` picks and the env-only density there with respect to
+    /// solid angle.
+    #[inline]
+    #[must_use]
+    pub fn sample_point(&self, u: DVec2) -> (Vec2, f32) {
+        let (_, morton, uv) = self.pick(u);
+        (uv, self.relative(morton) / SPHERE_AREA)
+    }
+
     /// The texel a point `u` of [0, 1)² picks and the point inside it (`u.x` picks, the bits
     /// of `u.y` split between the axes place).
     #[inline]
@@ -177,23 +188,12 @@ impl<'a> TexelCdf<'a> {
         let step = ((u.x * STEPS as f64) as u64).min(STEPS - 1) as u32;
         let morton = self.texel_of_step(step);
         let bits = ((u.y * 4_294_967_296.0) as u64).min(u32::MAX as u64) as u32;
-        let inside = DVec2::new(
-            (f64::from(even_bits(bits)) + 0.5) / 65_536.0,
-            (f64::from(even_bits(bits >> 1)) + 0.5) / 65_536.0,
-        );
-        let cell = Cell::new(self.finest, even_bits(morton as u32), even_bits((morton >> 1) as u32));
+        let (ix, iy) = morton_cell(bits as usize);
+        let inside = DVec2::new((f64::from(ix) + 0.5) / 65_536.0, (f64::from(iy) + 0.5) / 65_536.0);
+        let (x, y) = morton_cell(morton);
+        let cell = Cell::new(self.finest, x, y);
         (cell, morton, cell.point(inside))
     }
-}
-
-/// The even bits of `v`, packed: the x of a Morton index (and, of `v >> 1`, its y).
-#[inline]
-fn even_bits(v: u32) -> u32 {
-    let mut v = v & 0x5555_5555;
-    v = (v | (v >> 1)) & 0x3333_3333;
-    v = (v | (v >> 2)) & 0x0F0F_0F0F;
-    v = (v | (v >> 4)) & 0x00FF_00FF;
-    (v | (v >> 8)) & 0x0000_FFFF
 }
 
 #[cfg(test)]
@@ -203,7 +203,6 @@ mod tests {
     use crate::env::build_pyramid_from_importance;
 
     fn tables(finest: u32, importance: &[f32]) -> (std::vec::Vec<u32>, std::vec::Vec<u32>) {
-        extern crate std;
         let mut p = std::vec![0.0f32; pyramid_len(finest)];
         build_pyramid_from_importance(finest, importance, &mut p).unwrap();
         let mut ends = std::vec![0u32; texel_cdf_len(finest)];
@@ -214,7 +213,6 @@ mod tests {
 
     #[test]
     fn steps_follow_importance_and_every_lit_texel_has_one() {
-        extern crate std;
         let finest = 5;
         let n = 1usize << finest;
         let mut w = std::vec![0.0f32; n * n];
