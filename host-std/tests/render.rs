@@ -66,6 +66,7 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
         materials: vec![Material::new(Bsdf::Diffuse(Lambert::new(Vec3::splat(0.5))), false)],
         env: None,
+        lights: Vec::new(),
         hide_emitters: true,
     };
     for method in Method::ALL {

@@ -151,6 +151,7 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
                 }],
                 materials: vec![Material::new(bsdf.clone(), false)],
                 env: None,
+                lights: Vec::new(),
                 hide_emitters: true,
             };
             for method in Method::ALL {
@@ -196,6 +197,7 @@ fn views_down_to_n_dot_v_1e_6_shade_finite_values() {
                 }],
                 materials: vec![Material::new(bsdf.clone(), false)],
                 env: None,
+                lights: Vec::new(),
                 hide_emitters: true,
             };
             for method in Method::ALL {

@@ -1,8 +1,10 @@
 //! Light sources. The environment: image files read into RGB texels, lat-long maps resampled to
 //! the equal-area square, the built-in sky, and the built map with its importance pyramid that
-//! `sampler-core` samples. The bottom layer: it depends on nothing else in the crate.
+//! `sampler-core` samples; and the other lights of a scene, as a table the renderer samples
+//! (`lights.rs`). The bottom layer: it depends on nothing else in the crate.
 
 pub mod environment;
 pub mod image_file;
+pub mod lights;
 pub mod resample;
 pub mod sky;

@@ -12,6 +12,7 @@ pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::cpu_time::process_cpu_time;
+use crate::light::lights::LightTable;
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
@@ -116,10 +117,13 @@ pub fn render_crop(
     let cones = env.and_then(|e| two_level_cones(e, &plans));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
+    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius());
+    let lights = light_table.as_ref().map(LightTable::set);
     let ctx = Context {
         scene,
         bvh,
         env,
+        lights: lights.as_ref(),
         sat: sat.as_deref(),
         cones: cones.as_deref(),
         camera: &camera,

@@ -177,8 +177,9 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
         let i = permutation_element(k as u32, n as u32, order_seed) as usize;
         let (x, y) = (i % w, i / w);
         let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
-        if let Some(hit) = ctx.bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY) {
-            found[hit.material as usize].push((x, y));
+        let hit = ctx.bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY);
+        if let Some(material) = hit.and_then(|hit| hit.surface.material()) {
+            found[material].push((x, y));
         }
     }
     // Every (material, candidate) to measure, and the cost of one pilot pixel of all of them,

@@ -1,7 +1,8 @@
 //! Rendering an image whose materials are already planned: rayon over 16×16 tiles
 //! ([`tiles`]), each pixel through the pipeline of [`pixel`] (camera ray, intersection,
 //! shading point, light samples, the pixel's mean), samplers built and kept by
-//! [`sampler_cache`], light sampled by [`shade`] as each material's [`strategy`] says.
+//! [`sampler_cache`], the environment's light sampled by [`shade`] as each material's
+//! [`strategy`] says, the other lights' by `shade_lights`.
 //! Depends on `light`, `scene` and `trace`; `plan` decides the strategies and calls in here.
 //!
 //! Every pixel is seeded from (seed, pixel index), so the image depends only on the scene, the
@@ -14,6 +15,7 @@ pub mod pixel;
 pub mod product_arena;
 pub mod sampler_cache;
 pub mod shade;
+mod shade_lights;
 pub mod strategy;
 pub mod tiles;
 pub(crate) mod wavefront;
@@ -22,6 +24,7 @@ use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
 use sampler_core::env::EnvHierarchy;
+use sampler_core::estimator::lights::LightSet;
 use std::ops::AddAssign;
 use strategy::MaterialPlan;
 
@@ -52,6 +55,8 @@ pub struct Context<'a, 'e> {
     pub bvh: &'a Bvh,
     /// The environment light, if the scene has one.
     pub env: Option<&'a EnvHierarchy<'e>>,
+    /// The scene's other lights, if any emits.
+    pub lights: Option<&'a LightSet<'a>>,
     /// The summed-area table of `env`, built when a material is sampled two-stage.
     pub sat: Option<&'a [f64]>,
     /// The cell cones of the two-level product's coarse level, built when a material is

@@ -1,21 +1,24 @@
 //! One pixel, in named steps: for each of its shading points a camera ray
 //! (`camera_ray`), its intersection with the scene, the shading point there
-//! (`surface`); then the light sampled at every shading point (`sample_light`), and the
-//! pixel's mean (`accumulate`).
+//! (`surface`) or the light it sees (`background`, `emitted`); then the light sampled at every
+//! shading point (`sample_light` for the environment, `shade_lights` for the other lights), and
+//! the pixel's mean (`accumulate`).
 
 use crate::render::sampler_cache::{Lead, SamplerCache};
 use crate::render::shade::{self, CountingVisibility, Run, Sampling};
+use crate::render::shade_lights::{budgets, shade_lights};
 use crate::render::strategy::Strategy;
 use crate::render::wavefront::{self, WaveBuffers};
 use crate::render::{Context, Counters};
 use crate::scene::{Bsdf, Scene};
-use crate::trace::bvh::{self, ShadowRay};
+use crate::trace::bvh::{self, ShadowRay, Surface};
 use crate::trace::camera::Camera;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
 use sampler_core::frame::Frame;
 use sampler_core::glam::{DVec2, DVec3, Vec3};
+use sampler_core::light::Light;
 use sampler_core::points::{permutation_element, sobol02};
 use sampler_core::rng::hash_combine;
 
@@ -96,12 +99,24 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
                 }
                 continue;
             };
-            if let Some(h) = surface(ctx, dir, &hit, done + k) {
-                scratch.hits.push(h);
+            match hit.surface {
+                Surface::Material(material) => {
+                    if let Some(h) = surface(ctx, dir, &hit, material, done + k) {
+                        scratch.hits.push(h);
+                    }
+                }
+                Surface::Emitter(light) => sum += emitted(ctx, light, dir),
             }
         }
+        let (env_budget, light_budget) = budgets(ctx);
         if let Some(env) = ctx.env {
-            sample_light(ctx, env, seeds, scratch, &mut sum);
+            sample_light(ctx, env, seeds, env_budget, scratch, &mut sum);
+        } else {
+            scratch.counters.shading_points += scratch.hits.len() as u64;
+        }
+        if let Some(lights) = ctx.lights {
+            let run_of = |h: &Hit| run(seeds, h, p);
+            sum += shade_lights(ctx, lights, &scratch.hits, run_of, light_budget, &mut scratch.counters);
         }
         done += m;
     }
@@ -122,15 +137,32 @@ fn background(ctx: &Context<'_, '_>, dir: Vec3) -> Option<DVec3> {
     }
 }
 
-/// The shading point of a primary hit, `None` where nothing is reflected to the viewer (the
-/// back of a one-sided surface, or no light to reflect).
-fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, index: usize) -> Option<Hit> {
-    let material = &ctx.scene.materials[hit.material as usize];
+/// What a primary ray sees of the surface of light `light`: its radiance from the front, none
+/// from the back or where the scene hides emitters.
+fn emitted(ctx: &Context<'_, '_>, light: usize, dir: Vec3) -> DVec3 {
+    if ctx.scene.hide_emitters {
+        return DVec3::ZERO;
+    }
+    let seen = ctx.scene.lights[light].eval(ctx.camera.origin, dir);
+    seen.map_or(DVec3::ZERO, |h| h.radiance.as_dvec3())
+}
+
+/// The run of the pixel's light sequences the shading point `h` takes (see [`shade::Run`]),
+/// of a pixel of `p` shading points.
+fn run(seeds: Seeds, h: &Hit, p: usize) -> Run {
+    Run { seed: seeds.light, block: permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize }
+}
+
+/// The shading point of a primary hit on a surface of material `material`, `None` where
+/// nothing is reflected to the viewer (the back of a one-sided surface, or no light to
+/// reflect).
+fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material: usize, index: usize) -> Option<Hit> {
+    let m = &ctx.scene.materials[material];
     let wo = -dir;
     let (mut n, mut ns) = (hit.normal, hit.shading_normal);
     if n.dot(wo) < 0.0 {
         // Seen from the back, a one-sided surface reflects nothing.
-        if !material.twosided {
+        if !m.twosided {
             return None;
         }
         (n, ns) = (-n, -ns);
@@ -140,37 +172,42 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, index: usize) -> Op
     if ns.dot(n) <= 0.0 {
         ns = n;
     }
-    ctx.env?;
+    if ctx.env.is_none() && ctx.lights.is_none() {
+        return None;
+    }
     let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
     Some(Hit {
         frame: Frame::from_normal(ns),
         wo,
-        bsdf: match (&material.texture, hit.uv) {
+        bsdf: match (&m.texture, hit.uv) {
             (Some(t), Some(uv)) => Some(t.0.bsdf_at(uv)),
             _ => None,
         },
         origin: hit.point + n * eps,
-        material: hit.material as usize,
+        material,
         index,
     })
 }
 
-/// Samples the light at every shading point of the group in `scratch`, adding to `sum`: one
-/// sampler per shading point, or for product-MIS one per material, built at its first point.
-/// Where a material's sampler is the same at all its points (the environment, or the shared
+/// Samples the environment's light with `budget` samples at every shading point of the group in
+/// `scratch`, adding to `sum`: one sampler per shading point, or for product-MIS one per
+/// material, built at its first point. Where a material's sampler is the same at all its points (the environment, or the shared
 /// product-MIS sampler) and each point takes few samples, its points are shaded as one
 /// wavefront. The points' estimates are added in the order of the per-point path: hit order,
 /// and a product-MIS material's points together at its first.
-fn sample_light(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, seeds: Seeds, scratch: &mut Scratch, sum: &mut DVec3) {
+fn sample_light(
+    ctx: &Context<'_, '_>,
+    env: &EnvHierarchy<'_>,
+    seeds: Seeds,
+    budget: usize,
+    scratch: &mut Scratch,
+    sum: &mut DVec3,
+) {
     let Scratch { cache, hits, waves, counters } = scratch;
     let n = hits.len();
     let p = ctx.options.shading_points.max(1);
-    let budget = (ctx.options.spp / p).max(1);
     let shadows = ctx.options.shadows;
-    let run_of = |h: &Hit| Run {
-        seed: seeds.light,
-        block: permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize,
-    };
+    let run_of = |h: &Hit| run(seeds, h, p);
     let mut values = [DVec3::ZERO; GROUP];
     let mut done = [false; GROUP];
     for first in 0..n {
@@ -291,7 +328,7 @@ fn accumulate(sum: DVec3, shading_points: usize, counters: &mut Counters) -> [f3
 }
 
 /// The hit's shading point: its own BRDF if its material is textured, the material's otherwise.
-fn shading_point<'a>(scene: &'a Scene, h: &'a Hit) -> ShadingPoint<'a, dyn Brdf + 'a> {
+pub(crate) fn shading_point<'a>(scene: &'a Scene, h: &'a Hit) -> ShadingPoint<'a, dyn Brdf + 'a> {
     let brdf = match &h.bsdf {
         Some(b) => b.as_brdf(),
         None => scene.materials[h.material].bsdf.as_brdf(),

@@ -24,8 +24,9 @@ impl Regions {
         for y in 0..h {
             for x in 0..w {
                 let d = camera.direction(x as f32 + 0.5, y as f32 + 0.5);
-                of_pixel.push(bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY).map(|hit| {
-                    let label = scene.materials[hit.material as usize].bsdf.label();
+                let hit = bvh.intersect(camera.origin, d, camera.near_clip, f32::INFINITY);
+                of_pixel.push(hit.and_then(|hit| hit.surface.material()).map(|material| {
+                    let label = scene.materials[material].bsdf.label();
                     names.iter().position(|n| *n == label).unwrap_or_else(|| {
                         names.push(label);
                         names.len() - 1

@@ -51,6 +51,7 @@ pub fn scene() -> Scene {
         objects,
         materials,
         env: Some((EnvSource::Sky { level: SKY_LEVEL }, Placement::default())),
+        lights: Vec::new(),
         hide_emitters: false,
     }
 }

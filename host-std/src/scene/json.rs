@@ -1,9 +1,10 @@
 //! The JSON scene format of docs/scene-format.md:
-//! camera, environment, spheres, rectangles and meshes with diffuse, rough-conductor, Phong and
-//! car-paint materials. Unknown fields are errors: a misspelt key must not silently render
+//! camera, environment, lights (`json_lights.rs`), spheres, rectangles and meshes with diffuse,
+//! rough-conductor, Phong and car-paint materials. Unknown fields are errors: a misspelt key must not silently render
 //! something else.
 
 use crate::light::environment::{EnvSource, Placement};
+use crate::scene::json_lights::{self, JsonLight};
 use crate::scene::mesh;
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
@@ -51,6 +52,8 @@ struct JsonScene {
     #[serde(default)]
     envmap: Option<JsonEnv>,
     camera: JsonCamera,
+    #[serde(default)]
+    lights: Vec<JsonLight>,
     shapes: Vec<JsonShape>,
     #[serde(default)]
     hide_emitters: bool,
@@ -171,7 +174,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, path)
 }
 
-/// The files a scene file reads besides itself — its meshes and environment map — as
+/// The files a scene file reads besides itself — its meshes, mesh lights and environment map — as
 /// [`load`] resolves them.
 pub fn files_read(path: &Path) -> Result<Vec<PathBuf>, SceneError> {
     let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_owned(), error })?;
@@ -182,7 +185,8 @@ pub fn files_read(path: &Path) -> Result<Vec<PathBuf>, SceneError> {
         JsonShape::Mesh { file, .. } => Some(dir.join(file)),
         _ => None,
     });
-    Ok(meshes.chain(json.envmap.map(|e| dir.join(e.file))).collect())
+    let mesh_lights: Vec<PathBuf> = json.lights.iter().filter_map(|l| l.file().map(|f| dir.join(f))).collect();
+    Ok(meshes.chain(mesh_lights).chain(json.envmap.map(|e| dir.join(e.file))).collect())
 }
 
 /// Parses scene JSON; `path` names the file in errors and anchors relative paths.
@@ -250,6 +254,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         materials.push(material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?);
         objects.push(Object { shape, material: materials.len() - 1 });
     }
+    let mut lights = Vec::new();
+    for (k, light) in json.lights.into_iter().enumerate() {
+        lights.extend(json_lights::lights_of(light, dir).map_err(|m| invalid(format!("lights[{k}]: {m}")))?);
+    }
     let env = json.envmap.map(|e| {
         (
             EnvSource::File(dir.join(e.file)),
@@ -258,7 +266,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     });
     let name =
         json.name.unwrap_or_else(|| path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()));
-    Ok(Scene { name, camera, objects, materials, env, hide_emitters: json.hide_emitters })
+    Ok(Scene { name, camera, objects, materials, env, lights, hide_emitters: json.hide_emitters })
 }
 
 fn material_of(m: JsonMaterial) -> Result<Material, String> {

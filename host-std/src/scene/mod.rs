@@ -4,6 +4,7 @@
 
 pub mod builtin;
 pub mod json;
+mod json_lights;
 pub mod mesh;
 mod model;
 pub mod ply;

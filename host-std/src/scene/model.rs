@@ -1,9 +1,11 @@
-//! The scene model: camera, shapes with materials, and an optional environment light, as every
-//! loader fills it (the built-in scene, the JSON reader, the USD importer).
+//! The scene model: camera, shapes with materials, an optional environment light and any
+//! number of other lights, as every loader fills it (the built-in scene, the JSON reader, the
+//! USD importer).
 
 use crate::light::environment::{EnvSource, Placement};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Vec2, Vec3};
+use sampler_core::light::{LightSurface, SceneLight};
 
 /// A pinhole camera, the scene format's exact convention (see `camera.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,20 +164,40 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The environment light, if any.
     pub env: Option<(EnvSource, Placement)>,
-    /// Camera rays that miss return 0 instead of the environment.
+    /// The other lights (a mesh light is one triangle light per face); area lights are
+    /// surfaces too, seen by camera rays and occluding like any shape.
+    pub lights: Vec<SceneLight>,
+    /// Camera rays that miss return 0 instead of the environment, and area lights seen
+    /// directly are black.
     pub hide_emitters: bool,
 }
 
 impl Scene {
-    /// Triangles a render will intersect (rectangles count 2, spheres 0).
+    /// Triangles a render will intersect (rectangles count 2, spheres 0), emitters' included.
     pub fn triangle_count(&self) -> usize {
-        self.objects
+        let emitters: usize = self
+            .lights
+            .iter()
+            .map(|l| match l.surface() {
+                Some(LightSurface::Rect { .. }) => 2,
+                Some(LightSurface::Triangle(_)) => 1,
+                _ => 0,
+            })
+            .sum();
+        let shapes: usize = self
+            .objects
             .iter()
             .map(|o| match &o.shape {
                 Shape::Mesh { triangles, .. } => triangles.len(),
                 Shape::Rectangle { .. } => 2,
                 Shape::Sphere { .. } => 0,
             })
-            .sum()
+            .sum();
+        shapes + emitters
+    }
+
+    /// There is light to shade with: an environment or another light.
+    pub fn is_lit(&self) -> bool {
+        self.env.is_some() || !self.lights.is_empty()
     }
 }

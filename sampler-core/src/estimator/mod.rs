@@ -11,6 +11,7 @@ use crate::mapping::SPHERE_AREA;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 mod batched;
+pub mod lights;
 pub mod wavefront;
 pub use batched::{BATCH, brdf_many, sampled_many, sampled_mis_many, sampled_mis_split};
 

@@ -43,6 +43,12 @@ impl DiskLight {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
     }
 
+    /// The disk's surface.
+    #[must_use]
+    pub fn surface(&self) -> super::LightSurface {
+        super::LightSurface::Disk { center: self.center, normal: self.frame.n, radius: self.radius }
+    }
+
     /// Area πr².
     #[must_use]
     pub fn area(&self) -> f32 {

@@ -33,7 +33,7 @@ pub use disk::DiskLight;
 pub use distant::{DistantLight, MIN_DISTANT_ANGLE};
 pub use point::PointLight;
 pub use rect::RectLight;
-pub use scene_light::SceneLight;
+pub use scene_light::{LightSurface, SceneLight};
 pub use select::{PowerSelector, SelectedLight};
 pub use sphere::SphereLight;
 pub use triangle::{TriangleLight, TriangleSampling};

@@ -46,6 +46,12 @@ impl RectLight {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
     }
 
+    /// The rectangle's surface.
+    #[must_use]
+    pub fn surface(&self) -> super::LightSurface {
+        super::LightSurface::Rect { p0: self.p0, e1: self.e1, e2: self.e2 }
+    }
+
     /// The unit front normal.
     #[must_use]
     pub fn normal(&self) -> Vec3 {

@@ -3,6 +3,39 @@
 use super::{DiskLight, DistantLight, Light, LightHit, LightSample, PointLight, RectLight, SphereLight, TriangleLight};
 use glam::{Vec2, Vec3};
 
+/// The surface of an area light, for a host that makes it visible to camera rays and lets it
+/// occlude: the shape [`Light::eval`] intersects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightSurface {
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// The rectangle `p0 + s·e1 + t·e2`, s, t ∈ [0, 1].
+    Rect {
+        /// A corner.
+        p0: Vec3,
+        /// The first edge from `p0`.
+        e1: Vec3,
+        /// The second edge from `p0`.
+        e2: Vec3,
+    },
+    /// A disk.
+    Disk {
+        /// Centre.
+        center: Vec3,
+        /// Unit normal of its plane.
+        normal: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A triangle.
+    Triangle([Vec3; 3]),
+}
+
 /// One light of any kind.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SceneLight {
@@ -31,6 +64,27 @@ macro_rules! dispatch {
             SceneLight::Distant($l) => $e,
         }
     };
+}
+
+impl SceneLight {
+    /// The light's surface; `None` for a point or distant light, which nothing can hit.
+    #[must_use]
+    pub fn surface(&self) -> Option<LightSurface> {
+        match self {
+            SceneLight::Point(_) | SceneLight::Distant(_) => None,
+            SceneLight::Sphere(l) => Some(l.surface()),
+            SceneLight::Rect(l) => Some(l.surface()),
+            SceneLight::Disk(l) => Some(l.surface()),
+            SceneLight::Triangle(l) => Some(l.surface()),
+        }
+    }
+
+    /// A light at infinity that BRDF-sampled directions can find (a distant light with an
+    /// angular size): a ray that escapes the scene receives its radiance.
+    #[must_use]
+    pub fn is_infinite_area(&self) -> bool {
+        matches!(self, SceneLight::Distant(l) if !l.is_delta())
+    }
 }
 
 impl Light for SceneLight {

@@ -46,6 +46,16 @@ impl<'a> PowerSelector<'a> {
         Some(Self { cdf })
     }
 
+    /// The selector over a distribution [`PowerSelector::build`] made before (kept by the
+    /// caller, e.g. for a whole render): `None` unless `cdf` starts at 0, never decreases and
+    /// ends at 1.
+    #[must_use]
+    pub fn from_cdf(cdf: &'a [f64]) -> Option<Self> {
+        let valid =
+            cdf.len() >= 2 && cdf[0] == 0.0 && cdf[cdf.len() - 1] == 1.0 && cdf.windows(2).all(|w| w[0] <= w[1]);
+        valid.then_some(Self { cdf })
+    }
+
     /// Number of lights.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -105,5 +115,9 @@ mod tests {
         assert!(PowerSelector::build(&[0.0, 0.0], &mut [0.0; 3]).is_none());
         assert!(PowerSelector::build(&[1.0, f32::NAN], &mut [0.0; 3]).is_none());
         assert!(PowerSelector::build(&[1.0], &mut [0.0; 3]).is_none());
+        let again = PowerSelector::from_cdf(&cdf).unwrap();
+        assert_eq!(again.pick(0.3), PowerSelector::from_cdf(&cdf).unwrap().pick(0.3));
+        assert!(PowerSelector::from_cdf(&[0.0, 0.6, 0.5, 1.0]).is_none());
+        assert!(PowerSelector::from_cdf(&[0.0, 0.5]).is_none() && PowerSelector::from_cdf(&[1.0]).is_none());
     }
 }

@@ -40,6 +40,12 @@ impl SphereLight {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
     }
 
+    /// The sphere's surface.
+    #[must_use]
+    pub fn surface(&self) -> super::LightSurface {
+        super::LightSurface::Sphere { center: self.center, radius: self.radius }
+    }
+
     /// Surface area 4πr².
     #[must_use]
     pub fn area(&self) -> f32 {

@@ -71,6 +71,12 @@ impl TriangleLight {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
     }
 
+    /// The triangle's surface.
+    #[must_use]
+    pub fn surface(&self) -> super::LightSurface {
+        super::LightSurface::Triangle(self.v)
+    }
+
     /// Area in square units.
     #[must_use]
     pub fn area(&self) -> f32 {

@@ -52,6 +52,7 @@ pub fn sphere_scene(bsdf: Bsdf, dir: Vec3) -> Scene {
         objects: vec![Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 }],
         materials: vec![Material::new(bsdf, false)],
         env: None,
+        lights: Vec::new(),
         hide_emitters: true,
     }
 }

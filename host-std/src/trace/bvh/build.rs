@@ -220,7 +220,7 @@ mod tests {
                 let v0 = if k % 10 == 0 { Vec3::ONE } else { Vec3::new(next(), next(), next()) * 100.0 };
                 let e1 = Vec3::new(next(), next(), next());
                 let e2 = Vec3::new(next(), next(), next());
-                Primitive::Triangle { v0, e1, e2, material: k as u32, attrs: u32::MAX }
+                Primitive::Triangle { v0, e1, e2, surface: k as u32, attrs: u32::MAX }
             })
             .collect()
     }
@@ -235,9 +235,9 @@ mod tests {
         ([b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z], n.offset, n.count)
     }
 
-    fn material(p: &Primitive) -> u32 {
+    fn surface(p: &Primitive) -> u32 {
         match *p {
-            Primitive::Triangle { material, .. } | Primitive::Sphere { material, .. } => material,
+            Primitive::Triangle { surface, .. } | Primitive::Sphere { surface, .. } => surface,
         }
     }
 
@@ -247,7 +247,7 @@ mod tests {
         let (p1, n1) = build_on(1, &prims);
         let (p3, n3) = build_on(3, &prims);
         assert_eq!(n1.iter().map(key).collect::<Vec<_>>(), n3.iter().map(key).collect::<Vec<_>>());
-        assert_eq!(p1.iter().map(material).collect::<Vec<_>>(), p3.iter().map(material).collect::<Vec<_>>());
+        assert_eq!(p1.iter().map(surface).collect::<Vec<_>>(), p3.iter().map(surface).collect::<Vec<_>>());
     }
 
     #[test]
@@ -265,7 +265,7 @@ mod tests {
                 assert!(n.count as usize <= LEAF_MAX, "leaf {i} holds {}", n.count);
                 for p in &ordered[n.offset as usize..(n.offset + n.count) as usize] {
                     assert!(inside(p.aabb(), n.bounds));
-                    seen[material(p) as usize] += 1;
+                    seen[surface(p) as usize] += 1;
                 }
             } else {
                 stack.push((i + 1, n.bounds));

@@ -152,8 +152,8 @@ mod tests {
         let mut v = || Vec3::new(next(), next(), next());
         let prims: Vec<Primitive> = (0..4000)
             .map(|k| match k % 5 {
-                0 => Primitive::Sphere { center: v(), radius: 0.3, material: 0 },
-                _ => Primitive::Triangle { v0: v(), e1: v(), e2: v() * 1e-3f32.powi(k % 3), material: 0, attrs: 0 },
+                0 => Primitive::Sphere { center: v(), radius: 0.3, surface: 0 },
+                _ => Primitive::Triangle { v0: v(), e1: v(), e2: v() * 1e-3f32.powi(k % 3), surface: 0, attrs: 0 },
             })
             .collect();
         let mut blocks = Vec::new();
@@ -180,7 +180,7 @@ mod tests {
             }
         }
         // From inside a sphere only the far root is in the interval.
-        let inside = Primitive::Sphere { center: Vec3::new(0.5, -0.25, 2.0), radius: 0.75, material: 0 };
+        let inside = Primitive::Sphere { center: Vec3::new(0.5, -0.25, 2.0), radius: 0.75, surface: 0 };
         let mut one = Vec::new();
         Block::pack(&[inside], 0, 1, &mut one);
         for d in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize()] {

@@ -2,19 +2,24 @@
 //! the binned surface-area heuristic (`build.rs`) and collapsed to four children per node
 //! (`wide.rs`) whose boxes a ray tests at once in SIMD lanes (`lanes.rs`, `traverse.rs`).
 //! Primitive tests (`primitive.rs`) decide every hit, so the closest hit is the one a test of
-//! every primitive finds.
+//! every primitive finds. Area lights' surfaces are primitives too (`gather.rs`), each hit saying
+//! what it is the surface of (`surface.rs`); disks are tested beside the tree (`disk.rs`).
 
 mod build;
+mod disk;
+mod gather;
 mod lanes;
 mod leaf;
 mod primitive;
+mod surface;
 mod traverse;
 mod wide;
 
 use primitive::Aabb;
 pub use primitive::Primitive;
+pub use surface::Surface;
 
-use crate::scene::{Scene, Shape};
+use crate::scene::Scene;
 use sampler_core::glam::{Vec2, Vec3};
 
 const NO_ATTRS: u32 = u32::MAX;
@@ -49,8 +54,8 @@ pub struct Hit {
     pub shading_normal: Vec3,
     /// Interpolated texture coordinates, where the mesh has them.
     pub uv: Option<Vec2>,
-    /// Index into the scene's materials.
-    pub material: u32,
+    /// What was hit: a shape's material or a light's surface.
+    pub surface: Surface,
 }
 
 /// A shadow ray for [`Bvh::occluded_many`]: is anything on origin + t·dir, t ∈ (t_min, t_max)?
@@ -74,66 +79,36 @@ pub struct Bvh {
     blocks: Vec<leaf::Block>,
     /// Per-corner shading normals and texture coordinates of triangles that have them.
     corner_attrs: Vec<CornerAttrs>,
+    /// Disk lights' surfaces.
+    disks: Vec<disk::Disk>,
 }
 
 impl Bvh {
-    /// Builds the hierarchy over every shape of the scene (rectangles become two triangles).
+    /// Builds the hierarchy over every shape of the scene and every area light's surface
+    /// (rectangles become two triangles).
     pub fn build(scene: &Scene) -> Self {
-        let mut prims = Vec::new();
-        let mut corner_attrs = Vec::new();
-        for o in &scene.objects {
-            let material = o.material as u32;
-            match &o.shape {
-                Shape::Sphere { center, radius } => {
-                    prims.push(Primitive::Sphere { center: *center, radius: *radius, material })
-                }
-                Shape::Rectangle { p0, e1, e2 } => {
-                    let attrs = NO_ATTRS;
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1, e2: *e1 + *e2, material, attrs });
-                    prims.push(Primitive::Triangle { v0: *p0, e1: *e1 + *e2, e2: *e2, material, attrs });
-                }
-                Shape::Mesh { positions, triangles, normals, uvs } => {
-                    for (k, t) in triangles.iter().enumerate() {
-                        let [a, b, c] = t.map(|i| positions[i as usize]);
-                        if has_area(a, b, c) {
-                            let n = normals
-                                .get(k)
-                                .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0))
-                                .copied();
-                            let uv = uvs.get(k).filter(|uv| uv.iter().all(|t| t.is_finite())).copied();
-                            let attrs = if n.is_some() || uv.is_some() {
-                                corner_attrs.push(CornerAttrs { normals: n, uvs: uv });
-                                (corner_attrs.len() - 1) as u32
-                            } else {
-                                NO_ATTRS
-                            };
-                            prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, material, attrs });
-                        }
-                    }
-                }
-            }
-        }
-        let binary;
-        (prims, binary) = build::build(prims);
+        let gather::Gathered { prims, corner_attrs, disks } = gather::gather(scene);
+        let (prims, binary) = build::build(prims);
         let (nodes, blocks) = wide::collapse(&binary, &prims);
-        Bvh { prims, nodes, blocks, corner_attrs }
+        Bvh { prims, nodes, blocks, corner_attrs, disks }
     }
 
     /// The number of primitives `build` makes of `scene`, without building: a sphere is
-    /// one, a rectangle two, a mesh one per triangle with an area.
+    /// one, a rectangle two, a mesh one per triangle with an area (disk lights aside).
     pub fn count_primitives(scene: &Scene) -> usize {
-        let count = |shape: &Shape| match shape {
-            Shape::Sphere { .. } => 1,
-            Shape::Rectangle { .. } => 2,
-            Shape::Mesh { positions, triangles, .. } => triangles
-                .iter()
-                .filter(|t| {
-                    let [a, b, c] = t.map(|i| positions[i as usize]);
-                    has_area(a, b, c)
-                })
-                .count(),
-        };
-        scene.objects.iter().map(|o| count(&o.shape)).sum()
+        gather::count(scene)
+    }
+
+    /// The radius of a sphere around every primitive (0 for an empty scene): the scale at
+    /// which distant lights' power is compared with the others'.
+    #[must_use]
+    pub fn bounding_radius(&self) -> f32 {
+        let boxes = self.prims.iter().map(Primitive::aabb).chain(self.disks.iter().map(|d| {
+            let r = Vec3::splat(d.radius_squared.sqrt());
+            Aabb { min: d.center - r, max: d.center + r }
+        }));
+        let (lo, hi) = boxes.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.min), hi.max(b.max)));
+        if lo.cmple(hi).all() { 0.5 * (hi - lo).length() } else { 0.0 }
     }
 
     /// Number of primitives.
@@ -171,15 +146,21 @@ impl Bvh {
                 }
             }
         });
+        if let Some((k, t)) = disk::closest(&self.disks, o, d, t_min, t_max) {
+            let disk = &self.disks[k];
+            let (point, normal) = (o + t * d, disk.normal);
+            let surface = Surface::from_id(disk.surface);
+            return Some(Hit { t, point, normal, shading_normal: normal, uv: None, surface });
+        }
         let prim = best?;
         let point = o + t_max * d;
         let mut uv = None;
-        let (normal, shading, material) = match self.prims[prim] {
-            Primitive::Sphere { center, radius, material } => {
+        let (normal, shading, surface) = match self.prims[prim] {
+            Primitive::Sphere { center, radius, surface } => {
                 let n = ((point - center) / radius).normalize();
-                (n, n, material)
+                (n, n, surface)
             }
-            Primitive::Triangle { v0, e1, e2, material, attrs } => {
+            Primitive::Triangle { v0, e1, e2, surface, attrs } => {
                 let n = e1.cross(e2).normalize();
                 match self.corner_attrs.get(attrs as usize) {
                     Some(c) => {
@@ -196,17 +177,20 @@ impl Bvh {
                             if s == Vec3::ZERO { n } else { s }
                         });
                         uv = c.uvs.map(|c| c[0] * u + c[1] * v + c[2] * w);
-                        (n, shading, material)
+                        (n, shading, surface)
                     }
-                    None => (n, n, material),
+                    None => (n, n, surface),
                 }
             }
         };
-        Some(Hit { t: t_max, point, normal, shading_normal: shading, uv, material })
+        Some(Hit { t: t_max, point, normal, shading_normal: shading, uv, surface: Surface::from_id(surface) })
     }
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        if self.disks.iter().any(|k| k.intersect(o, d, t_min, t_max).is_some()) {
+            return true;
+        }
         traverse::any(&self.nodes, o, d, t_max, |first, count| {
             self.blocks[first as usize..(first + count) as usize]
                 .iter()
@@ -224,15 +208,10 @@ impl Bvh {
     }
 }
 
-/// Whether the triangle `a b c` has an area (a degenerate one is never hit, and is left out).
-fn has_area(a: Vec3, b: Vec3, c: Vec3) -> bool {
-    (b - a).cross(c - a).length_squared() > 0.0
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Material, Object};
+    use crate::scene::{Material, Object, Shape};
     use sampler_core::brdf::Lambert;
 
     #[test]

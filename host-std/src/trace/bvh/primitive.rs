@@ -12,8 +12,8 @@ pub enum Primitive {
         center: Vec3,
         /// Radius.
         radius: f32,
-        /// Index into the scene's materials.
-        material: u32,
+        /// What it is the surface of ([`super::Surface::id`]).
+        surface: u32,
     },
     /// v0 and two edges; the front face is normalize(e1 × e2).
     Triangle {
@@ -23,8 +23,8 @@ pub enum Primitive {
         e1: Vec3,
         /// The edge from `v0` to the third vertex.
         e2: Vec3,
-        /// Index into the scene's materials.
-        material: u32,
+        /// What it is the surface of ([`super::Surface::id`]).
+        surface: u32,
         /// Index into the corner attributes, or `NO_ATTRS` (face normal, no texture
         /// coordinates).
         attrs: u32,
