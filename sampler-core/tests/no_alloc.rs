@@ -4,6 +4,7 @@
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+use sampler_core::estimator::lights::{FirstHit, LightRays, LightSet, light_pair};
 use sampler_core::estimator::{self, ShadingPoint};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::square_to_sphere;
@@ -118,8 +119,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
     assert_eq!(count, 0, "the core allocated {count} times");
 }
 
-/// Every light's sampling, density and ray query, and picking a light by power, at 10 000
-/// shading points.
+/// Every light's sampling, density and ray query, picking a light by power, and the lights'
+/// estimator (a light sample and a BRDF sample under the balance heuristic), at 10 000 shading
+/// points.
 #[test]
 fn light_sampling_allocates_nothing() {
     use sampler_core::light::*;
@@ -143,6 +145,19 @@ fn light_sampling_allocates_nothing() {
     let mut sink = 0.0f64;
     ARMED.with(|a| a.set(true));
     let selector = PowerSelector::build(&weights, &mut cdf).unwrap();
+    let infinite = [6u32];
+    let set = LightSet::new(&lights, selector, &infinite).unwrap();
+    let brdf = RoughConductor::new(0.2, Vec3::ONE);
+    let sp = ShadingPoint { frame: Frame::from_normal(Vec3::Z), wo: Vec3::Z, brdf: &brdf };
+    struct Open;
+    impl LightRays for Open {
+        fn unoccluded(&mut self, _: Vec3, _: f32) -> bool {
+            true
+        }
+        fn first_hit(&mut self, _: Vec3) -> FirstHit {
+            FirstHit::Escapes
+        }
+    }
     for _ in 0..10_000 {
         let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - Vec3::splat(2.0);
         let picked = selector.pick(rng.next_f64());
@@ -154,6 +169,8 @@ fn light_sampling_allocates_nothing() {
                 sink += light.eval(p, s.dir).map_or(0.0, |h| h.distance.min(1e9) as f64);
             }
         }
+        let (u, v) = (DVec2::new(rng.next_f64(), rng.next_f64()), glam::Vec2::new(rng.next_f32(), rng.next_f32()));
+        sink += light_pair(&set, p, &sp, u, v, &mut Open).x;
     }
     ARMED.with(|a| a.set(false));
     let count = COUNT.with(|c| c.get());

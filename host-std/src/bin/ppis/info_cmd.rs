@@ -17,6 +17,7 @@ use host_std::plan::rules::{
 };
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
+use sampler_core::light::{Light, SceneLight};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -71,8 +72,10 @@ fn print_scene(scene: &Scene) {
     for (i, m) in scene.materials.iter().enumerate() {
         println!("  material {i}: {}{}", m.bsdf.kind(), if m.twosided { ", two-sided" } else { "" });
     }
+    print_lights(scene);
     match &scene.env {
-        None => println!("environment: none — a render builds no env hierarchy and is black except for hits"),
+        None if !scene.lights.is_empty() => println!("environment: none"),
+        None => println!("environment: none, no lights — a render builds no env hierarchy and is black"),
         Some((EnvSource::Sky { level }, _)) => {
             println!("environment: built-in sky, equal-area {}² (pyramid {} MB)", 1u32 << level, pyramid_mb(*level))
         }
@@ -89,6 +92,35 @@ fn print_scene(scene: &Scene) {
             p.rotate_y_deg
         ),
     }
+}
+
+/// The scene's lights besides the environment, counted by kind (a mesh light's triangles each).
+fn print_lights(scene: &Scene) {
+    if scene.lights.is_empty() {
+        return;
+    }
+    let mut kinds: Vec<(&str, usize)> = Vec::new();
+    for l in &scene.lights {
+        let kind = match l {
+            SceneLight::Point(_) => "point",
+            SceneLight::Sphere(_) => "sphere",
+            SceneLight::Rect(_) => "rectangle",
+            SceneLight::Disk(_) => "disk",
+            SceneLight::Triangle(_) => "mesh triangle",
+            SceneLight::Distant(d) if d.is_delta() => "distant (delta)",
+            SceneLight::Distant(_) => "distant (with an angle)",
+        };
+        match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, n)) => *n += 1,
+            None => kinds.push((kind, 1)),
+        }
+    }
+    let list: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} {k}")).collect();
+    println!(
+        "lights: {} ({}), picked by power, each sampled by solid angle with MIS",
+        scene.lights.len(),
+        list.join(", ")
+    );
 }
 
 /// What the methods build and how `auto` decides, from the constants that decide it.

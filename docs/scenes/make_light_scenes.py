@@ -1,0 +1,79 @@
+"""Writes the light test scenes (docs/scene-format.md, "lights"): one scene per kind of light
+alone, and one with every kind together under an environment map, over the same floor and three
+spheres (a rough conductor, a diffuse sphere, a near-mirror). The mesh light is a small torus
+written here as OBJ. Run from the repository root:
+
+  python3 docs/scenes/make_light_scenes.py
+
+Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3".
+"""
+import json
+import math
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+CAMERA = {"origin": [0, 2.5, 6], "target": [0, 0.6, 0], "up": [0, 1, 0], "fov_y_deg": 40,
+          "width": 256, "height": 256}
+SHAPES = [
+    {"type": "rectangle", "p0": [-4, 0, -4], "e1": [0, 0, 8], "e2": [8, 0, 0],
+     "material": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}},
+    {"type": "sphere", "center": [-0.9, 0.6, 0], "radius": 0.6,
+     "material": {"type": "roughconductor", "alpha": 0.15, "specular": [0.9, 0.8, 0.6]}},
+    {"type": "sphere", "center": [0.6, 0.5, 0.6], "radius": 0.5,
+     "material": {"type": "diffuse", "albedo": [0.7, 0.3, 0.2]}},
+    {"type": "sphere", "center": [1.2, 0.4, -0.8], "radius": 0.4,
+     "material": {"type": "roughconductor", "alpha": 0.02, "specular": [0.95, 0.95, 0.95]}},
+]
+LIGHTS = {
+    "point": {"type": "point", "position": [0, 3, 2.5], "intensity": [12, 12, 12]},
+    "sphere": {"type": "sphere", "center": [-1.8, 2.2, 0.5], "radius": 0.3, "radiance": [30, 25, 20]},
+    "rectangle": {"type": "rectangle", "p0": [0.5, 3.0, -1.0], "e1": [1.0, 0, 0], "e2": [0, 0, 0.8],
+                  "radiance": [8, 8, 10]},
+    "disk": {"type": "disk", "center": [2.0, 1.5, 1.0], "normal": [-1, -0.3, -0.2], "radius": 0.35,
+             "radiance": [15, 10, 6]},
+    "mesh": {"type": "mesh", "file": "meshes/torus_lamp.obj", "radiance": [6, 8, 10]},
+    "distant": {"type": "distant", "direction": [0.3, 1, 0.4], "irradiance": [1.5, 1.4, 1.2], "angle_deg": 2},
+}
+
+
+def torus(path, major=0.45, minor=0.08, center=(0.0, 2.4, 1.2), n_major=24, n_minor=8):
+    """A torus around the vertical axis, faces wound outwards (front = emitting side)."""
+    verts, faces = [], []
+    for i in range(n_major):
+        a = 2 * math.pi * i / n_major
+        for j in range(n_minor):
+            b = 2 * math.pi * j / n_minor
+            r = major + minor * math.cos(b)
+            verts.append((center[0] + r * math.cos(a), center[1] + minor * math.sin(b), center[2] + r * math.sin(a)))
+    for i in range(n_major):
+        for j in range(n_minor):
+            a, b = i * n_minor + j, ((i + 1) % n_major) * n_minor + j
+            c, d = ((i + 1) % n_major) * n_minor + (j + 1) % n_minor, i * n_minor + (j + 1) % n_minor
+            faces += [(a, d, c), (a, c, b)]
+    with open(path, "w") as f:
+        f.write("# torus lamp: docs/scenes/make_light_scenes.py\n")
+        for v in verts:
+            f.write("v %.6f %.6f %.6f\n" % v)
+        for t in faces:
+            f.write("f %d %d %d\n" % tuple(k + 1 for k in t))
+
+
+def write(name, scene):
+    with open(os.path.join(HERE, name + ".json"), "w") as f:
+        json.dump(scene, f, indent=1)
+        f.write("\n")
+
+
+def main():
+    os.makedirs(os.path.join(HERE, "meshes"), exist_ok=True)
+    torus(os.path.join(HERE, "meshes", "torus_lamp.obj"))
+    for kind, light in LIGHTS.items():
+        write("light_" + kind, {"name": "light_" + kind, "camera": CAMERA, "lights": [light], "shapes": SHAPES})
+    write("lights_env", {"name": "lights_env", "camera": CAMERA,
+                         "envmap": {"file": "../envmaps/courtyard.exr", "scale": 0.5},
+                         "lights": list(LIGHTS.values()), "shapes": SHAPES})
+
+
+if __name__ == "__main__":
+    main()
