@@ -14,7 +14,16 @@ use sampler_core::brdf::RoughConductor;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
-    Settings { method, spp, shading_points, brdf_samples: 32, seed: 5, progress: false, shadows: true }
+    Settings {
+        method,
+        spp,
+        shading_points,
+        brdf_samples: 32,
+        seed: 5,
+        progress: false,
+        shadows: true,
+        light_selection: Default::default(),
+    }
 }
 
 fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {

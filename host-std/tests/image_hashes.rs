@@ -83,7 +83,16 @@ fn hash(image: &Rendered) -> u64 {
 }
 
 fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
-    Settings { method, spp, shading_points, brdf_samples: 32, seed: 11, progress: false, shadows: true }
+    Settings {
+        method,
+        spp,
+        shading_points,
+        brdf_samples: 32,
+        seed: 11,
+        progress: false,
+        shadows: true,
+        light_selection: Default::default(),
+    }
 }
 
 fn rendered(scene: &Scene, env: &Environment, s: &Settings) -> Rendered {

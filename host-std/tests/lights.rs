@@ -17,7 +17,16 @@ use sampler_core::light::{DistantLight, PointLight, SceneLight, SphereLight};
 const ALBEDO: f32 = 0.5;
 
 fn settings(method: Method, spp: usize) -> Settings {
-    Settings { method, spp, shading_points: 4, brdf_samples: 64, seed: 11, progress: false, shadows: true }
+    Settings {
+        method,
+        spp,
+        shading_points: 4,
+        brdf_samples: 64,
+        seed: 11,
+        progress: false,
+        shadows: true,
+        light_selection: Default::default(),
+    }
 }
 
 /// A Lambert square of side 0.2 at the origin facing +z, seen from straight above so that it

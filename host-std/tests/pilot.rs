@@ -30,6 +30,7 @@ fn chosen(scene: &Scene, env: &Environment, spp: usize, seed: u64) -> String {
         seed,
         progress: false,
         shadows: true,
+        light_selection: Default::default(),
     };
     let image = render(scene, &Bvh::build(scene), Some(&env.hierarchy()), &settings);
     assert_eq!(image.pilot.len(), 1, "one material measured");

@@ -11,7 +11,16 @@ use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, p: usize) -> Settings {
-    Settings { method, spp, shading_points: p, brdf_samples: 64, seed: 7, progress: false, shadows: true }
+    Settings {
+        method,
+        spp,
+        shading_points: p,
+        brdf_samples: 64,
+        seed: 7,
+        progress: false,
+        shadows: true,
+        light_selection: Default::default(),
+    }
 }
 
 fn render_with_threads(scene: &Scene, env: &Environment, s: &Settings, threads: usize) -> Vec<[f32; 3]> {

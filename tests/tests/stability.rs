@@ -15,7 +15,16 @@ use sampler_core::brdf::Lambert;
 fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_samples: usize) -> Rendered {
     let bvh = Bvh::build(scene);
     let h = env.hierarchy();
-    let settings = Settings { method, spp, shading_points: 2, brdf_samples, seed: 3, progress: false, shadows: true };
+    let settings = Settings {
+        method,
+        spp,
+        shading_points: 2,
+        brdf_samples,
+        seed: 3,
+        progress: false,
+        shadows: true,
+        light_selection: Default::default(),
+    };
     render(scene, &bvh, Some(&h), &settings)
 }
 

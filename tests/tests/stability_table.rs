@@ -43,8 +43,16 @@ fn renders(
     let mut time = 0.0;
     let images = seeds
         .map(|seed| {
-            let settings =
-                Settings { method, spp, shading_points, brdf_samples: 256, seed, progress: false, shadows: true };
+            let settings = Settings {
+                method,
+                spp,
+                shading_points,
+                brdf_samples: 256,
+                seed,
+                progress: false,
+                shadows: true,
+                light_selection: Default::default(),
+            };
             let r = render(scene, &bvh, Some(&h), &settings);
             assert!(
                 r.non_finite == 0 && r.pixels.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)),

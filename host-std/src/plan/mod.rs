@@ -12,7 +12,7 @@ pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::cpu_time::process_cpu_time;
-use crate::light::lights::LightTable;
+use crate::light::lights::{LightSelection, LightTable};
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
@@ -42,6 +42,8 @@ pub struct Settings {
     /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
     /// to tell the error that visibility adds from the error of sampling light × BRDF).
     pub shadows: bool,
+    /// How the lights besides the environment are picked.
+    pub light_selection: LightSelection,
 }
 
 impl Settings {
@@ -117,7 +119,7 @@ pub fn render_crop(
     let cones = env.and_then(|e| two_level_cones(e, &plans));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
-    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius());
+    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius(), settings.light_selection);
     let lights = light_table.as_ref().map(LightTable::set);
     let ctx = Context {
         scene,

@@ -11,7 +11,7 @@
 
 use super::{ShadingPoint, times};
 use crate::brdf::Brdf;
-use crate::light::{Light, PowerSelector, SceneLight};
+use crate::light::{Light, LightTree, PowerSelector, SceneLight, SelectedLight};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// What a ray from the shading point meets first.
@@ -33,12 +33,29 @@ pub trait LightRays {
     fn first_hit(&mut self, dir: Vec3) -> FirstHit;
 }
 
-/// A scene's lights, ready to sample: the lights, their power-proportional selection, and
+/// How a light is picked for a shading point.
+#[derive(Clone, Copy, Debug)]
+enum Selection<'a> {
+    /// In proportion to power, wherever the point is.
+    Power(PowerSelector<'a>),
+    /// The tree or one of the lights at infinity in proportion to power, then within the tree
+    /// by each subtree's importance for the point.
+    Tree {
+        /// The lights with a position.
+        tree: LightTree<'a>,
+        /// Over the tree (slot 0) and the lights at infinity (slot k + 1: `distant[k]`).
+        top: PowerSelector<'a>,
+        /// The lights at infinity.
+        distant: &'a [u32],
+    },
+}
+
+/// A scene's lights, ready to sample: the lights, how one is picked for a shading point, and
 /// which of them an escaping ray can see.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSet<'a> {
     lights: &'a [SceneLight],
-    selector: PowerSelector<'a>,
+    selection: Selection<'a>,
     infinite: &'a [u32],
     any_area: bool,
 }
@@ -49,10 +66,61 @@ impl<'a> LightSet<'a> {
     /// selector's length is not the number of lights or an index is out of range.
     #[must_use]
     pub fn new(lights: &'a [SceneLight], selector: PowerSelector<'a>, infinite: &'a [u32]) -> Option<Self> {
-        let valid = selector.len() == lights.len()
-            && infinite.iter().all(|&i| lights.get(i as usize).is_some_and(SceneLight::is_infinite_area));
+        let valid = selector.len() == lights.len() && Self::infinite_valid(lights, infinite);
         let any_area = lights.iter().any(|l| !l.is_delta());
-        valid.then_some(Self { lights, selector, infinite, any_area })
+        valid.then_some(Self { lights, selection: Selection::Power(selector), infinite, any_area })
+    }
+
+    /// The set of `lights` picked through `tree` (over the lights with a position): `top`
+    /// picks the tree (slot 0) or the light at infinity `distant[k]` (slot k + 1), in proportion
+    /// to power. `infinite` as for [`LightSet::new`]. `None` when the lengths disagree or an
+    /// index is out of range.
+    #[must_use]
+    pub fn with_tree(
+        lights: &'a [SceneLight],
+        tree: LightTree<'a>,
+        top: PowerSelector<'a>,
+        distant: &'a [u32],
+        infinite: &'a [u32],
+    ) -> Option<Self> {
+        let valid = top.len() == distant.len() + 1
+            && distant.iter().all(|&i| (i as usize) < lights.len())
+            && Self::infinite_valid(lights, infinite);
+        let any_area = lights.iter().any(|l| !l.is_delta());
+        valid.then_some(Self { lights, selection: Selection::Tree { tree, top, distant }, infinite, any_area })
+    }
+
+    fn infinite_valid(lights: &[SceneLight], infinite: &[u32]) -> bool {
+        infinite.iter().all(|&i| lights.get(i as usize).is_some_and(SceneLight::is_infinite_area))
+    }
+
+    /// A light for the point `p` of shading normal `n`, with the uniform `u`; `None` where no
+    /// light can light the point.
+    #[must_use]
+    pub fn pick(&self, u: f64, p: Vec3, n: Vec3) -> Option<SelectedLight> {
+        match self.selection {
+            Selection::Power(selector) => Some(selector.pick(u)),
+            Selection::Tree { tree, top, distant } => {
+                let slot = top.pick(u);
+                if slot.index == 0 {
+                    tree.pick(slot.u_remapped, p, n).map(|s| SelectedLight { pmf: s.pmf * slot.pmf, ..s })
+                } else {
+                    Some(SelectedLight { index: distant[slot.index - 1] as usize, ..slot })
+                }
+            }
+        }
+    }
+
+    /// The probability that [`LightSet::pick`] returns light `index` at `p` with normal `n`.
+    #[must_use]
+    pub fn pmf(&self, index: usize, p: Vec3, n: Vec3) -> f64 {
+        match self.selection {
+            Selection::Power(selector) => selector.pmf(index),
+            Selection::Tree { tree, top, distant } => match distant.iter().position(|&d| d as usize == index) {
+                Some(k) => top.pmf(k + 1),
+                None => top.pmf(0) * tree.pmf(index, p, n),
+            },
+        }
     }
 
     /// The lights.
@@ -65,12 +133,6 @@ impl<'a> LightSet<'a> {
     #[must_use]
     pub fn has_area_lights(&self) -> bool {
         self.any_area
-    }
-
-    /// The probability that light sampling picks light `index`.
-    #[must_use]
-    pub fn pick_probability(&self, index: usize) -> f64 {
-        self.selector.pmf(index)
     }
 }
 
@@ -92,7 +154,7 @@ pub fn light_sample<B: Brdf + ?Sized>(
     mis: bool,
     rays: &mut impl LightRays,
 ) -> DVec3 {
-    let pick = set.selector.pick(u.x);
+    let Some(pick) = set.pick(u.x, p, sp.frame.n) else { return DVec3::ZERO };
     let light = &set.lights[pick.index];
     let u_light = Vec2::new((pick.u_remapped as f32).min(BELOW_ONE), (u.y as f32).min(BELOW_ONE));
     let Some(s) = light.sample(p, u_light) else { return DVec3::ZERO };
@@ -125,7 +187,7 @@ pub fn brdf_sample<B: Brdf + ?Sized>(
     let received = |index: usize| {
         let light = &set.lights[index];
         let Some(hit) = light.eval(p, dir) else { return DVec3::ZERO };
-        let p_light = set.selector.pmf(index) * light.pdf(p, dir) as f64;
+        let p_light = set.pmf(index, p, sp.frame.n) * light.pdf(p, dir) as f64;
         times(hit.radiance, s.value) / (s.pdf as f64 + p_light)
     };
     match rays.first_hit(dir) {

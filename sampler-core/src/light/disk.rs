@@ -37,6 +37,12 @@ impl DiskLight {
         Ok(Self { center: finite(center)?, frame: Frame::from_normal(unit(normal)?), radius, emission })
     }
 
+    /// Both sides emit.
+    #[must_use]
+    pub fn is_two_sided(&self) -> bool {
+        self.emission.two_sided
+    }
+
     /// The same disk, emitting on both sides when `two_sided`.
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {

@@ -3,7 +3,9 @@
 //! rectangle, a disk, a triangle (the faces of mesh lights) and a distant light with or without an
 //! angular size. Radiometry follows the scene format's `lights` section (docs/scene-format.md).
 //!
-//! Every light implements [`Light`]; [`SceneLight`] holds any of them behind one type. Area
+//! Every light implements [`Light`]; [`SceneLight`] holds any of them behind one type. Many
+//! lights are picked by power ([`PowerSelector`]) or, per shading point, by a light tree
+//! ([`LightTree`] over [`LightBounds`]). Area
 //! lights emit on their front side only unless made two-sided ([`Emission`]). Positions are world
 //! space; directions point from the shading point towards the light.
 //!
@@ -18,6 +20,7 @@
 //! assert!((lamp.pdf(Vec3::ZERO, s.dir) - s.pdf).abs() <= 1e-4 * s.pdf);
 //! ```
 
+mod bounds;
 mod disk;
 mod distant;
 mod point;
@@ -27,8 +30,10 @@ mod select;
 mod sphere;
 mod spherical_rect;
 mod spherical_triangle;
+mod tree;
 mod triangle;
 
+pub use bounds::LightBounds;
 pub use disk::DiskLight;
 pub use distant::{DistantLight, MIN_DISTANT_ANGLE};
 pub use point::PointLight;
@@ -36,6 +41,7 @@ pub use rect::RectLight;
 pub use scene_light::{LightSurface, SceneLight};
 pub use select::{PowerSelector, SelectedLight};
 pub use sphere::SphereLight;
+pub use tree::{LightNode, LightTree, MAX_DEPTH, TreeError};
 pub use triangle::{TriangleLight, TriangleSampling};
 
 use glam::{Vec2, Vec3};

@@ -40,6 +40,12 @@ impl RectLight {
         Ok(Self { p0, e1, e2, normal: cross / area, area, emission })
     }
 
+    /// Both sides emit.
+    #[must_use]
+    pub fn is_two_sided(&self) -> bool {
+        self.emission.two_sided
+    }
+
     /// The same rectangle, emitting on both sides when `two_sided`.
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {

@@ -34,6 +34,12 @@ impl SphereLight {
         Ok(Self { center: finite(center)?, radius, emission })
     }
 
+    /// Both sides emit.
+    #[must_use]
+    pub fn is_two_sided(&self) -> bool {
+        self.emission.two_sided
+    }
+
     /// The same sphere, emitting on both sides when `two_sided`.
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {

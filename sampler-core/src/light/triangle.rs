@@ -59,6 +59,12 @@ impl TriangleLight {
         Ok(Self { v, normal: cross / len, area: 0.5 * len, emission, sampling: TriangleSampling::default() })
     }
 
+    /// Both sides emit.
+    #[must_use]
+    pub fn is_two_sided(&self) -> bool {
+        self.emission.two_sided
+    }
+
     /// The same triangle drawing directions by `sampling`.
     #[must_use]
     pub fn with_sampling(self, sampling: TriangleSampling) -> Self {

@@ -1,6 +1,7 @@
 //! The arguments `render`, `info` and `report` share: the scene to load and how to sample it.
 
 use clap::Args;
+use host_std::light::lights::LightSelection;
 use host_std::plan::Method;
 use host_std::scene::Scene;
 use std::path::PathBuf;
@@ -76,6 +77,19 @@ pub(crate) struct SamplingArgs {
     /// sampling light × BRDF without the error visibility adds).
     #[arg(long)]
     pub(crate) unshadowed: bool,
+    /// How lights besides the environment are picked per shading point: `tree` (a light tree:
+    /// power, distance and orientation) or `power` (in proportion to power alone).
+    #[arg(long, value_name = "tree|power", default_value = "tree", value_parser = parse_light_selection)]
+    pub(crate) light_selection: LightSelection,
+}
+
+/// `--light-selection`'s value.
+fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
+    match s {
+        "tree" => Ok(LightSelection::Tree),
+        "power" => Ok(LightSelection::Power),
+        _ => Err(format!("unknown light selection {s:?} (tree or power)")),
+    }
 }
 
 impl SamplingArgs {
