@@ -6,10 +6,15 @@ written here as OBJ. Run from the repository root:
   python3 docs/scenes/make_light_scenes.py
 
 Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3".
+With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
+DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
+spheres) and pt1000.json (1000 point lights).
 """
 import json
 import math
 import os
+import random
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -65,7 +70,39 @@ def write(name, scene):
         f.write("\n")
 
 
+def many(out, n_tri, n_point, name):
+    """A floor with 20 spheres under n_tri emissive triangles (0.15 wide, facing down, 1.5–3
+    above it) and n_point point lights, all scattered over 20×20."""
+    random.seed(1)
+    lights = []
+    if n_tri:
+        with open(os.path.join(out, name + ".obj"), "w") as f:
+            for i in range(n_tri):
+                x, z, y, s = random.uniform(-10, 10), random.uniform(-10, 10), random.uniform(1.5, 3.0), 0.15
+                f.write(f"v {x} {y} {z}\nv {x + s} {y} {z}\nv {x} {y} {z + s}\nf {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
+        lights.append({"type": "mesh", "file": name + ".obj", "radiance": [20, 18, 15]})
+    for _ in range(n_point):
+        x, z = random.uniform(-10, 10), random.uniform(-10, 10)
+        lights.append({"type": "point", "position": [x, random.uniform(0.5, 2.5), z], "intensity": [0.3, 0.3, 0.4]})
+    shapes = [{"type": "rectangle", "p0": [-12, 0, -12], "e1": [0, 0, 24], "e2": [24, 0, 0],
+               "material": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}}]
+    for i in range(20):
+        x, z = random.uniform(-8, 8), random.uniform(-8, 8)
+        material = ({"type": "roughconductor", "alpha": 0.2, "specular": [0.9, 0.9, 0.9]} if i % 2
+                    else {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]})
+        shapes.append({"type": "sphere", "center": [x, 0.5, z], "radius": 0.5, "material": material})
+    camera = {"origin": [0, 6, 14], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 55, "width": 128, "height": 128}
+    with open(os.path.join(out, name + ".json"), "w") as f:
+        json.dump({"camera": camera, "lights": lights, "shapes": shapes}, f)
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--many":
+        os.makedirs(sys.argv[2], exist_ok=True)
+        for n in [10, 100, 1000, 10000]:
+            many(sys.argv[2], n, 0, f"tri{n}")
+        many(sys.argv[2], 0, 1000, "pt1000")
+        return
     os.makedirs(os.path.join(HERE, "meshes"), exist_ok=True)
     torus(os.path.join(HERE, "meshes", "torus_lamp.obj"))
     for kind, light in LIGHTS.items():

@@ -117,7 +117,7 @@ fn print_lights(scene: &Scene) {
     }
     let list: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} {k}")).collect();
     println!(
-        "lights: {} ({}), picked by power, each sampled by solid angle with MIS",
+        "lights: {} ({}); a render picks one per sample by a light tree (--light-selection), samples it by solid angle, MIS with BRDF samples",
         scene.lights.len(),
         list.join(", ")
     );
