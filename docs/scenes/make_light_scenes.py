@@ -8,7 +8,7 @@ written here as OBJ. Run from the repository root:
 Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3".
 With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
 DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
-spheres) and pt1000.json (1000 point lights).
+spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).
 """
 import json
 import math
@@ -102,6 +102,7 @@ def main():
         for n in [10, 100, 1000, 10000]:
             many(sys.argv[2], n, 0, f"tri{n}")
         many(sys.argv[2], 0, 1000, "pt1000")
+        many(sys.argv[2], 10000, 1000, "both")
         return
     os.makedirs(os.path.join(HERE, "meshes"), exist_ok=True)
     torus(os.path.join(HERE, "meshes", "torus_lamp.obj"))
