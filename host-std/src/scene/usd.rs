@@ -237,18 +237,33 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted
             materials.len() - 1
         })
     };
-    // Sized once: growing by doubling would hold the old and the new buffer at once, and
-    // on a stage of many small gprims this list is a large part of the import's peak.
-    let mut objects = Vec::with_capacity(usd.spheres.len() + usd.meshes.len());
-    for s in &usd.spheres {
-        let shape = Shape::Sphere { center: s.center, radius: s.radius };
-        objects.push(Object { shape, material: material(s.material, s.double_sided) });
-    }
-    // The geometry moves into the scene: a large mesh is held once.
-    for m in std::mem::take(&mut usd.meshes) {
-        let shape = Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs };
-        objects.push(Object { shape, material: material(m.material, m.double_sided) });
-    }
+    let spheres: Vec<Object> = usd
+        .spheres
+        .iter()
+        .map(|s| Object {
+            shape: Shape::Sphere { center: s.center, radius: s.radius },
+            material: material(s.material, s.double_sided),
+        })
+        .collect();
+    // The geometry moves into the scene: a large mesh is held once. The meshes become
+    // objects in their own list's memory (an object is no larger than a mesh record), so
+    // the two lists of a stage of many small meshes are not held at once; the spheres
+    // go first, as they always have.
+    let meshes: Vec<Object> = std::mem::take(&mut usd.meshes)
+        .into_iter()
+        .map(|m| {
+            let shape = Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs };
+            Object { shape, material: material(m.material, m.double_sided) }
+        })
+        .collect();
+    let objects = if spheres.is_empty() {
+        meshes
+    } else {
+        let mut all = spheres;
+        all.reserve_exact(meshes.len());
+        all.extend(meshes);
+        all
+    };
     let cam = usd.camera.clone().unwrap_or_else(|| host_usd::camera::framing((Vec3::splat(-1.0), Vec3::ONE)));
     let (width, height) = image_size(&usd, &cam, size);
     let (pixel_aspect, conform) =

@@ -90,10 +90,12 @@ fn transform(
     double_sided: bool,
 ) -> Result<Mesh, String> {
     let mut remap: HashMap<u32, u32> = HashMap::new();
+    // The lists are sized once: the scene holds every gprim's lists at once, and a list
+    // grown by pushing keeps up to half of it spare.
     let mut positions = Vec::new();
     let mut triangles = Vec::with_capacity(which.len());
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
+    let mut normals = Vec::with_capacity(if local.normals.is_empty() { 0 } else { which.len() });
+    let mut uvs = Vec::with_capacity(if local.uvs.is_empty() { 0 } else { which.len() });
     for &i in which {
         let mut t = local.triangles[i];
         let mut n = local.normals.get(i).copied();
@@ -125,6 +127,7 @@ fn transform(
     if uvs.len() != triangles.len() {
         uvs.clear();
     }
+    positions.shrink_to_fit();
     if positions.iter().any(|p: &Vec3| !p.is_finite()) {
         return Err("a transformed point is not finite".into());
     }

@@ -1193,7 +1193,7 @@ def Xform "Geo" (
         )
         .parse()
         .expect("parse usda");
-        let data = sdf::Data::from_specs(parsed);
+        let data = parsed;
 
         let clips = data
             .try_field(&Path::new("/Geo").unwrap(), "clips")

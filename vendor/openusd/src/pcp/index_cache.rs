@@ -2317,7 +2317,7 @@ mod tests {
     /// test can build a multi-layer stack whose `subLayers` resolve by name.
     fn parse_named_layer(identifier: &str, text: &str) -> sdf::Layer {
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        sdf::Layer::new(identifier, Box::new(sdf::Data::from_specs(data)))
+        sdf::Layer::new(identifier, Box::new(data))
     }
 
     /// Builds a one-layer graph + cache from in-memory USDA text, for
@@ -2581,7 +2581,7 @@ def "A" (
 }
 "#;
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        let layer = sdf::Layer::new("root.usda", Box::new(sdf::Data::from_specs(data)));
+        let layer = sdf::Layer::new("root.usda", Box::new(data));
         let graph = LayerGraph::from_layers(vec![layer], 0, sdf::LayerRegistry::default());
         let mut cache = IndexCache::new(VariantFallbackMap::new(), LoadRules::all(), Vec::new());
 
@@ -2655,7 +2655,7 @@ def "A" (
 }
 "#;
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        let layer = sdf::Layer::new("root.usda", Box::new(sdf::Data::from_specs(data)));
+        let layer = sdf::Layer::new("root.usda", Box::new(data));
         let graph = LayerGraph::from_layers(vec![layer], 0, sdf::LayerRegistry::default());
         let mut cache = IndexCache::new(VariantFallbackMap::new(), LoadRules::all(), Vec::new());
 

@@ -859,7 +859,7 @@ mod tests {
 
     fn layer(id: &str, text: &str) -> sdf::Layer {
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        sdf::Layer::new(id, Box::new(sdf::Data::from_specs(data)))
+        sdf::Layer::new(id, Box::new(data))
     }
 
     fn relocate_count(graph: &LayerGraph) -> usize {

@@ -1732,7 +1732,7 @@ pub(crate) mod tests {
 
     fn parse_usda(text: &str) -> Box<dyn sdf::AbstractData> {
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        Box::new(sdf::Data::from_specs(data))
+        Box::new(data)
     }
 
     /// The child context evaluates an expression-valued selection opinion

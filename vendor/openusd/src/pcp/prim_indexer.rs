@@ -3238,7 +3238,7 @@ mod tests {
 
     fn stack(text: &str) -> LayerGraph {
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        let layer = sdf::Layer::new("root.usd", Box::new(sdf::Data::from_specs(data)));
+        let layer = sdf::Layer::new("root.usd", Box::new(data));
         LayerGraph::from_layers(vec![layer], 0, sdf::LayerRegistry::default())
     }
 
@@ -3276,7 +3276,7 @@ mod tests {
             .iter()
             .map(|(id, text)| {
                 let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-                sdf::Layer::new(*id, Box::new(sdf::Data::from_specs(data)))
+                sdf::Layer::new(*id, Box::new(data))
             })
             .collect();
         LayerGraph::from_layers(layers, session, sdf::LayerRegistry::default())

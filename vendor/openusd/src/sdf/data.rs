@@ -10,7 +10,9 @@ use std::{
 
 use anyhow::Result;
 
+use crate::sdf::spec_table::SpecTable;
 use crate::sdf::{Path, PathMap, SpecData, SpecType, Value};
+use crate::tf;
 
 /// The scene-description storage interface, mirroring C++ `SdfAbstractData`.
 ///
@@ -129,9 +131,12 @@ pub enum DataError {
 }
 
 /// In-memory mutable layer data.
+///
+/// Property specs are stored under their owner's path by name ([`SpecTable`], ppis
+/// patch), so a layer of many prims holds no path node per property.
 #[derive(Default, Debug, Clone)]
 pub struct Data {
-    specs: PathMap<SpecData>,
+    specs: SpecTable,
 }
 
 impl Data {
@@ -140,17 +145,18 @@ impl Data {
         Self::default()
     }
 
-    /// Build a container from a map of pre-parsed spec records, the form a
-    /// reader (e.g. the usda parser) produces.
+    /// Build a container from a map of pre-parsed spec records.
     pub fn from_specs<S>(specs: HashMap<Path, SpecData, S>) -> Self {
         Self {
             specs: specs.into_iter().collect(),
         }
     }
 
-    /// Build a container from the map a reader produces, keyed as the container keys it.
+    /// Build a container from a map of spec records keyed by path.
     pub fn from_spec_map(specs: PathMap<SpecData>) -> Self {
-        Self { specs }
+        Self {
+            specs: specs.into_iter().collect(),
+        }
     }
 
     /// Copy every spec and field from `src` into a new `Data`.
@@ -175,8 +181,31 @@ impl Data {
     /// field-level [`AbstractData::create_spec`], which returns nothing because
     /// the trait can't name `SpecData`.
     pub fn create_spec(&mut self, path: Path, ty: SpecType) -> &mut SpecData {
-        self.specs.insert(path.clone(), SpecData::new(ty));
-        self.specs.get_mut(&path).expect("just inserted")
+        let slot = self.specs.get_or_insert_with(&path, || SpecData::new(ty));
+        *slot = SpecData::new(ty);
+        slot
+    }
+
+    /// Puts `spec` at `path`, returning the spec it replaces.
+    pub fn insert_spec(&mut self, path: Path, spec: SpecData) -> Option<SpecData> {
+        self.specs.insert(path, spec)
+    }
+
+    /// The spec record at `path`, made by `make` if there is none.
+    pub fn spec_or_insert_with(&mut self, path: &Path, make: impl FnOnce() -> SpecData) -> &mut SpecData {
+        self.specs.get_or_insert_with(path, make)
+    }
+
+    /// The spec record of `owner`'s property `name`, made by `make` if there is none;
+    /// an error if `owner` cannot have properties. Passing the name as a token lets a
+    /// reader share one token between every prim that authors the name.
+    pub fn property_or_insert_with(
+        &mut self,
+        owner: &Path,
+        name: &tf::Token,
+        make: impl FnOnce() -> SpecData,
+    ) -> Result<&mut SpecData> {
+        self.specs.property_or_insert_with(owner, name, make)
     }
 
     /// Remove the spec record at `path` and return it, if any.
@@ -197,7 +226,7 @@ impl Data {
     }
 
     /// Iterate `(path, spec)` pairs in unspecified order.
-    pub fn iter(&self) -> impl Iterator<Item = (&Path, &SpecData)> {
+    pub fn iter(&self) -> impl Iterator<Item = (Path, &SpecData)> {
         self.specs.iter()
     }
 
@@ -208,13 +237,18 @@ impl Data {
 
     /// Returns `true` if the container holds no specs.
     pub fn is_empty(&self) -> bool {
-        self.specs.is_empty()
+        self.specs.len() == 0
+    }
+
+    /// Frees the spare capacity a reader's growing lists leave.
+    pub fn shrink_to_fit(&mut self) {
+        self.specs.shrink_to_fit();
     }
 }
 
 impl AbstractData for Data {
     fn has_spec(&self, path: &Path) -> bool {
-        self.specs.contains_key(path)
+        self.specs.contains(path)
     }
 
     fn has_field(&self, path: &Path, field: &str) -> bool {
@@ -236,13 +270,13 @@ impl AbstractData for Data {
     }
 
     fn spec_paths(&self) -> Vec<Path> {
-        let mut paths: Vec<Path> = self.specs.keys().cloned().collect();
+        let mut paths: Vec<Path> = self.specs.iter().map(|(path, _)| path).collect();
         paths.sort_by(|a, b| a.as_str().cmp(b.as_str()));
         paths
     }
 
     fn create_spec(&mut self, path: Path, ty: SpecType) {
-        self.specs.insert(path, SpecData::new(ty));
+        Data::create_spec(self, path, ty);
     }
 
     fn erase_spec(&mut self, path: &Path) {

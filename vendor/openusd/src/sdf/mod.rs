@@ -25,6 +25,7 @@ mod path_table;
 pub mod schema;
 pub mod sink;
 mod spec;
+mod spec_table;
 mod value;
 
 pub use asset_path::AssetPath;

@@ -2324,7 +2324,7 @@ mod tests {
             }
 "#;
         let data = crate::usda::parser::Parser::new(text).parse().expect("parse usda");
-        let layer = sdf::Layer::new("root.usda", Box::new(sdf::Data::from_specs(data)));
+        let layer = sdf::Layer::new("root.usda", Box::new(data));
         let stage = Stage::builder().make_stage(vec![layer], 0, Vec::new());
         // The prim composes from both the direct opinion and the variant.
         assert!(valid(&stage, "/Prim/child"));

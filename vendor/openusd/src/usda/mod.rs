@@ -18,14 +18,13 @@ use crate::{ar, sdf, tf};
 /// Parse `usda` text into an in-memory [`sdf::Data`] store.
 pub fn parse(text: &str) -> Result<sdf::Data> {
     let mut parser = Parser::new(text);
-    let specs = parse_on_own_stack(&mut parser)?;
-    Ok(sdf::Data::from_spec_map(specs))
+    parse_on_own_stack(&mut parser)
 }
 
 /// Runs the recursive-descent parser on a thread whose stack holds
 /// [`parser::MAX_NESTING`] levels (ppis patch, see PATCHED.md), so the depth a layer
 /// may nest does not depend on the caller's stack.
-fn parse_on_own_stack(parser: &mut Parser) -> Result<sdf::PathMap<sdf::SpecData>> {
+fn parse_on_own_stack(parser: &mut Parser) -> Result<sdf::Data> {
     std::thread::scope(|scope| {
         let worker = std::thread::Builder::new()
             .name("usda-parser".into())
@@ -42,11 +41,10 @@ pub fn read_file(path: impl AsRef<Path>) -> Result<sdf::Data> {
     let text = fs::read_to_string(path).with_context(|| format!("Unable to read file: {}", path.display()))?;
 
     let mut parser = Parser::new(&text);
-    let specs = parse_on_own_stack(&mut parser).map_err(|e| match parser.last_error_highlight() {
+    parse_on_own_stack(&mut parser).map_err(|e| match parser.last_error_highlight() {
         Some(h) => e.context(format!("{}:{}: {}", path.display(), h.line, h.column)),
         None => e.context(format!("{}: parse error", path.display())),
-    })?;
-    Ok(sdf::Data::from_spec_map(specs))
+    })
 }
 
 /// Text format (`.usda`) as an [`sdf::FileFormat`], wrapping [`parse`] and

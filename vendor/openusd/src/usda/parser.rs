@@ -37,6 +37,8 @@ pub struct Parser<'a> {
     last_span: Option<Range<usize>>,
     /// Blocks open at the current token (ppis patch).
     depth: usize,
+    /// The token of each property name met so far (ppis patch, see [`Parser::name_token`]).
+    names: HashMap<&'a str, tf::Token>,
 }
 
 /// A path for an error message: long ones keep their start and end.
@@ -76,6 +78,7 @@ impl<'a> Parser<'a> {
             source: data,
             last_span: None,
             depth: 0,
+            names: HashMap::new(),
         }
     }
 
@@ -250,8 +253,8 @@ impl<'a> Parser<'a> {
 
     /// Parse tokens to specs.
     /// Walks the entire token stream, seeding the pseudo root and recursing through every prim.
-    pub fn parse(&mut self) -> Result<sdf::PathMap<sdf::SpecData>> {
-        let mut data = sdf::PathMap::default();
+    pub fn parse(&mut self) -> Result<sdf::Data> {
+        let mut data = sdf::Data::default();
         let current_path = sdf::Path::abs_root();
 
         // Read pseudo root.
@@ -270,7 +273,8 @@ impl<'a> Parser<'a> {
         if !root_children.is_empty() {
             pseudo_root_spec.add(ChildrenKey::PrimChildren, sdf::Value::token_vec(root_children));
         }
-        data.insert(current_path.clone(), pseudo_root_spec);
+        data.insert_spec(current_path.clone(), pseudo_root_spec);
+        data.shrink_to_fit();
         Ok(data)
     }
 
@@ -352,7 +356,7 @@ impl<'a> Parser<'a> {
         &mut self,
         current_path: &sdf::Path,
         parent_children: &mut Vec<String>,
-        data: &mut sdf::PathMap<sdf::SpecData>,
+        data: &mut sdf::Data,
     ) -> Result<()> {
         let mut spec = sdf::SpecData::new(sdf::SpecType::Prim);
 
@@ -405,7 +409,7 @@ impl<'a> Parser<'a> {
         if !variant_sets.is_empty() {
             spec.add(ChildrenKey::VariantSetChildren, sdf::Value::token_vec(variant_sets));
         }
-        data.insert(prim_path, spec);
+        data.insert_spec(prim_path, spec);
 
         Ok(())
     }
@@ -419,8 +423,8 @@ impl<'a> Parser<'a> {
         &mut self,
         path: &sdf::Path,
         owner_spec: &mut sdf::SpecData,
-        data: &mut sdf::PathMap<sdf::SpecData>,
-    ) -> Result<(Vec<String>, Vec<String>, Vec<String>)> {
+        data: &mut sdf::Data,
+    ) -> Result<(Vec<String>, Vec<tf::Token>, Vec<String>)> {
         ensure!(
             path.prim_element_count() <= MAX_NAMESPACE_DEPTH,
             "{}: namespace deeper than {MAX_NAMESPACE_DEPTH} levels",
@@ -428,7 +432,7 @@ impl<'a> Parser<'a> {
         );
         let mut children = Vec::new();
         let mut properties = Vec::new();
-        let mut suffixed_properties = Vec::<String>::new();
+        let mut suffixed_properties = Vec::<tf::Token>::new();
         let mut variant_sets = Vec::new();
 
         self.parse_block('{', '}', |this| {
@@ -462,7 +466,7 @@ impl<'a> Parser<'a> {
         // Append properties that were only declared via suffixed forms
         // (e.g. `.connect`, `.timeSamples`) and never had a bare declaration.
         for name in suffixed_properties {
-            push_unique(&mut properties, &name);
+            push_unique(&mut properties, name);
         }
 
         Ok((children, properties, variant_sets))
@@ -501,7 +505,7 @@ impl<'a> Parser<'a> {
     fn read_variant_set(
         &mut self,
         prim_path: &sdf::Path,
-        data: &mut sdf::PathMap<sdf::SpecData>,
+        data: &mut sdf::Data,
     ) -> Result<String> {
         self.fetch_next()?; // consume `variantSet`
 
@@ -541,25 +545,30 @@ impl<'a> Parser<'a> {
             if !variant_sets.is_empty() {
                 variant_spec.add(ChildrenKey::VariantSetChildren, sdf::Value::token_vec(variant_sets));
             }
-            data.insert(variant_path, variant_spec);
+            data.insert_spec(variant_path, variant_spec);
             Ok(())
         })?;
 
         vset_spec.add(ChildrenKey::VariantChildren, sdf::Value::token_vec(variant_children));
-        data.insert(vset_path, vset_spec);
+        data.insert_spec(vset_path, vset_spec);
 
         Ok(name)
     }
 
-    /// Merge a spec's fields into an existing spec at the given path, or insert it.
-    fn merge_spec(data: &mut sdf::PathMap<sdf::SpecData>, path: sdf::Path, spec: sdf::SpecData) {
-        use std::collections::hash_map::Entry;
-        match data.entry(path) {
-            Entry::Occupied(mut e) => e.get_mut().extend_from(spec),
-            Entry::Vacant(e) => {
-                e.insert(spec);
-            }
+    /// The token for `name` (a property's name or a token value): one per distinct text
+    /// in the layer, shared by every spec, property list and token array that holds it.
+    fn name_token(&mut self, name: &'a str) -> tf::Token {
+        self.names.entry(name).or_insert_with(|| tf::Token::from(name)).clone()
+    }
+
+    /// Merge a spec's fields into `owner`'s property `name`, or insert it there.
+    fn merge_property(data: &mut sdf::Data, owner: &sdf::Path, name: &tf::Token, spec: sdf::SpecData) -> Result<()> {
+        let mut spec = Some(spec);
+        let slot = data.property_or_insert_with(owner, name, || spec.take().expect("made once"))?;
+        if let Some(spec) = spec {
+            slot.extend_from(spec);
         }
+        Ok(())
     }
 
     /// Create an attribute spec with the standard type/custom/variability fields.
@@ -579,9 +588,9 @@ impl<'a> Parser<'a> {
     fn read_attribute(
         &mut self,
         current_path: &sdf::Path,
-        properties: &mut Vec<String>,
-        suffixed_properties: &mut Vec<String>,
-        data: &mut sdf::PathMap<sdf::SpecData>,
+        properties: &mut Vec<tf::Token>,
+        suffixed_properties: &mut Vec<tf::Token>,
+        data: &mut sdf::Data,
     ) -> Result<()> {
         let mut custom = false;
         let list_op = self.try_list_op();
@@ -622,8 +631,9 @@ impl<'a> Parser<'a> {
                 .context("Unable to parse attribute metadata")?;
         }
 
+        let token = self.name_token(name);
         if matches!(suffix, Some(Token::Connect)) {
-            push_unique(suffixed_properties, name);
+            push_unique(suffixed_properties, token.clone());
             if self.try_consume(Token::Punctuation('=')) {
                 let list_op = list_op.or(self.try_list_op());
                 // Connection targets are anchored to the owning prim, like
@@ -635,11 +645,9 @@ impl<'a> Parser<'a> {
                     .into_iter()
                     .map(|p| current_path.make_absolute(&p))
                     .collect();
-                let path = current_path.append_property(name)?;
-
-                let spec = data
-                    .entry(path)
-                    .or_insert_with(|| Self::make_attribute_spec(&type_info, custom, variability));
+                let spec = data.property_or_insert_with(current_path, &token, || {
+                    Self::make_attribute_spec(&type_info, custom, variability)
+                })?;
 
                 let list_op = self
                     .apply_list_op(list_op, targets)
@@ -650,27 +658,23 @@ impl<'a> Parser<'a> {
         }
 
         if matches!(suffix, Some(Token::TimeSamples)) {
-            push_unique(suffixed_properties, name);
+            push_unique(suffixed_properties, token.clone());
             self.ensure_pun('=')?;
             let samples = self.parse_time_samples(type_info)?;
-            let path = current_path.append_property(name)?;
-
-            let spec = data
-                .entry(path)
-                .or_insert_with(|| Self::make_attribute_spec(&type_info, custom, variability));
+            let spec = data.property_or_insert_with(current_path, &token, || {
+                Self::make_attribute_spec(&type_info, custom, variability)
+            })?;
             spec.add(FieldKey::TimeSamples, sdf::Value::TimeSamples(samples));
             return Ok(());
         }
 
         if matches!(suffix, Some(Token::Spline)) {
-            push_unique(suffixed_properties, name);
+            push_unique(suffixed_properties, token.clone());
             self.ensure_pun('=')?;
             let spline = self.parse_spline()?;
-            let path = current_path.append_property(name)?;
-
-            let spec = data
-                .entry(path)
-                .or_insert_with(|| Self::make_attribute_spec(&type_info, custom, variability));
+            let spec = data.property_or_insert_with(current_path, &token, || {
+                Self::make_attribute_spec(&type_info, custom, variability)
+            })?;
             spec.add("spline", spline);
             return Ok(());
         }
@@ -681,30 +685,27 @@ impl<'a> Parser<'a> {
 
         // Check if there's an assignment
         if !self.is_next(Token::Punctuation('=')) {
-            let path = current_path.append_property(name)?;
-            push_unique(properties, name);
+            push_unique(properties, token.clone());
 
             let mut base = Self::make_attribute_spec(&type_info, custom, variability);
             base.extend_from(spec);
-            Self::merge_spec(data, path, base);
-            return Ok(());
+            return Self::merge_property(data, current_path, &token, base);
         }
 
         self.ensure_pun('=')?;
         let value = self.parse_value(type_info)?;
-        let path = current_path.append_property(name)?;
 
         if self.is_next(Token::Punctuation('(')) {
             self.parse_property_metadata(&mut spec)
                 .context("Unable to parse attribute metadata")?;
         }
 
-        push_unique(properties, name);
+        push_unique(properties, token.clone());
 
         let mut base = Self::make_attribute_spec(&type_info, custom, variability);
         base.extend_from(spec);
         base.add(FieldKey::Default, value);
-        Self::merge_spec(data, path, base);
+        Self::merge_property(data, current_path, &token, base)?;
 
         Ok(())
     }
@@ -883,8 +884,8 @@ impl<'a> Parser<'a> {
         &mut self,
         current_path: &sdf::Path,
         custom: bool,
-        properties: &mut Vec<String>,
-        data: &mut sdf::PathMap<sdf::SpecData>,
+        properties: &mut Vec<tf::Token>,
+        data: &mut sdf::Data,
         outer_list_op: Option<Token<'a>>,
     ) -> Result<()> {
         let name = self.expect_name().context("relationship name expected")?;
@@ -901,12 +902,12 @@ impl<'a> Parser<'a> {
         }
 
         let path = current_path.append_property(name)?;
-        push_unique(properties, name);
+        let token = self.name_token(name);
+        push_unique(properties, token.clone());
 
         // Check if there's an assignment
         if !self.is_next(Token::Punctuation('=')) {
-            Self::merge_spec(data, path, spec);
-            return Ok(());
+            return Self::merge_property(data, current_path, &token, spec);
         }
 
         self.ensure_pun('=')?;
@@ -929,8 +930,7 @@ impl<'a> Parser<'a> {
                 .context("Unable to parse relationship metadata")?;
         }
 
-        Self::merge_spec(data, path, spec);
-        Ok(())
+        Self::merge_property(data, current_path, &token, spec)
     }
 
     /// Parse prim metadata contained either within parentheses or directly after the prim
@@ -1570,7 +1570,10 @@ impl<'a> Parser<'a> {
 
             (Type::String, false) => sdf::Value::String(self.fetch_str()?.to_owned()),
             (Type::Token, false) => sdf::Value::token(self.fetch_str()?),
-            (Type::String | Type::Token, true) => sdf::Value::token_vec(self.parse_array::<String>()?),
+            (Type::String | Type::Token, true) => sdf::Value::TokenVec(self.parse_array_with(|this| {
+                let text = this.token_text()?;
+                Ok(this.name_token(text))
+            })?),
 
             (Type::Matrix2d, false) => sdf::Value::Matrix2d(gf::Mat2d(self.parse_matrix::<2, 4>()?)),
             (Type::Matrix3d, false) => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.parse_matrix::<3, 9>()?))),
@@ -1674,6 +1677,15 @@ impl<'a> Parser<'a> {
     where
         <T as FromStr>::Err: std::fmt::Debug,
     {
+        let value_str = self.token_text()?;
+        let value = T::from_str(value_str)
+            .map_err(|err| anyhow!("Failed to parse {} from '{}': {:?}", type_name::<T>(), value_str, err))?;
+
+        Ok(value)
+    }
+
+    /// The text of a single number, identifier or string token (`inf` with its sign).
+    fn token_text(&mut self) -> Result<&'a str> {
         let token = self.fetch_next()?;
         let value_str = match token {
             Token::Number(s) | Token::Identifier(s) | Token::String(s) | Token::NamespacedIdentifier(s) => s,
@@ -1698,10 +1710,7 @@ impl<'a> Parser<'a> {
             }
             _ => bail!("Expected a number, identifier, or string, got {token:?}"),
         };
-        let value = T::from_str(value_str)
-            .map_err(|err| anyhow!("Failed to parse {} from '{}': {:?}", type_name::<T>(), value_str, err))?;
-
-        Ok(value)
+        Ok(value_str)
     }
 
     /// Parse USD's flexible boolean literal forms (identifiers, numeric, or string).
@@ -1927,10 +1936,10 @@ impl<'a> Parser<'a> {
     }
 }
 
-/// Push a string into a Vec if it's not already present.
-fn push_unique(vec: &mut Vec<String>, name: &str) {
-    if !vec.iter().any(|s| s == name) {
-        vec.push(name.to_owned());
+/// Push a name into a Vec if it's not already present.
+fn push_unique(vec: &mut Vec<tf::Token>, name: tf::Token) {
+    if !vec.contains(&name) {
+        vec.push(name);
     }
 }
 
@@ -2399,9 +2408,9 @@ def Xform "Forest_set"
 
         let data = parser.parse().unwrap();
 
-        assert!(data.contains_key(&sdf::Path::abs_root()));
+        assert!(data.spec(&sdf::Path::abs_root()).is_some());
 
-        let pseudo_root = data.get(&sdf::path("/").unwrap()).unwrap();
+        let pseudo_root = data.spec(&sdf::path("/").unwrap()).unwrap();
         assert_eq!(pseudo_root.ty, sdf::SpecType::PseudoRoot);
         let prim_children = pseudo_root.get("primChildren").unwrap().to_owned();
         assert_eq!(
@@ -2414,7 +2423,7 @@ def Xform "Forest_set"
             vec![String::from("Forest_set")]
         );
 
-        let forest_set_prim = data.get(&sdf::path("/Forest_set").unwrap()).unwrap();
+        let forest_set_prim = data.spec(&sdf::path("/Forest_set").unwrap()).unwrap();
         let prim_children = forest_set_prim.get("primChildren").unwrap().to_owned();
         assert_eq!(
             prim_children
@@ -2426,8 +2435,8 @@ def Xform "Forest_set"
             vec![String::from("Outskirts"), String::from("Glade")]
         );
 
-        assert!(data.contains_key(&sdf::path("/Forest_set/Outskirts").unwrap()));
-        assert!(data.contains_key(&sdf::path("/Forest_set/Glade").unwrap()));
+        assert!(data.spec(&sdf::path("/Forest_set/Outskirts").unwrap()).is_some());
+        assert!(data.spec(&sdf::path("/Forest_set/Glade").unwrap()).is_some());
     }
 
     #[test]
@@ -2448,7 +2457,7 @@ def Mesh "M"
         );
 
         let data = parser.parse().unwrap();
-        let normals = data.get(&sdf::path("/M.normals").unwrap()).unwrap();
+        let normals = data.spec(&sdf::path("/M.normals").unwrap()).unwrap();
 
         let interpolation = normals
             .get("interpolation")
@@ -2478,21 +2487,21 @@ def Shader "Image_Texture"
         );
 
         let data = parser.parse().unwrap();
-        let shader = data.get(&sdf::path("/Image_Texture").unwrap()).unwrap();
+        let shader = data.spec(&sdf::path("/Image_Texture").unwrap()).unwrap();
 
-        let double_sided = data.get(&sdf::path("/Image_Texture.doubleSided").unwrap()).unwrap();
+        let double_sided = data.spec(&sdf::path("/Image_Texture.doubleSided").unwrap()).unwrap();
         assert!(matches!(
             double_sided.get(FieldKey::Default.as_str()),
             Some(sdf::Value::Bool(true))
         ));
 
-        let info_spec = data.get(&sdf::path("/Image_Texture.info:id").unwrap()).unwrap();
+        let info_spec = data.spec(&sdf::path("/Image_Texture.info:id").unwrap()).unwrap();
         assert!(matches!(
             info_spec.get(FieldKey::Custom.as_str()),
             Some(sdf::Value::Bool(true))
         ));
 
-        let file_spec = data.get(&sdf::path("/Image_Texture.inputs:file").unwrap()).unwrap();
+        let file_spec = data.spec(&sdf::path("/Image_Texture.inputs:file").unwrap()).unwrap();
         assert!(matches!(
             file_spec
                 .get(FieldKey::Default.as_str()),
@@ -2500,7 +2509,7 @@ def Shader "Image_Texture"
         ));
 
         let output_spec = data
-            .get(&sdf::path("/Image_Texture.outputs:surface").unwrap())
+            .spec(&sdf::path("/Image_Texture.outputs:surface").unwrap())
             .expect("missing outputs:surface spec");
         assert!(matches!(
             output_spec
@@ -2543,7 +2552,7 @@ def Xform "X" {
 
         let data = parser.parse().unwrap();
         let transform = data
-            .get(&sdf::path("/X.xformOp:transform").unwrap())
+            .spec(&sdf::path("/X.xformOp:transform").unwrap())
             .expect("transform spec missing");
         let matrix = transform
             .get(FieldKey::Default.as_str())
@@ -2579,7 +2588,7 @@ def Scope "Root" {
 
         let data = parser.parse().unwrap();
         let transforms = data
-            .get(&sdf::path("/Root.transforms").unwrap())
+            .spec(&sdf::path("/Root.transforms").unwrap())
             .expect("transforms spec missing");
         let matrix = transforms
             .get(FieldKey::Default.as_str())
@@ -2619,7 +2628,7 @@ def Material "Mat"
         );
 
         let data = parser.parse().unwrap();
-        let mat = data.get(&sdf::path("/Mat").unwrap()).unwrap();
+        let mat = data.spec(&sdf::path("/Mat").unwrap()).unwrap();
 
         let props = mat
             .get(sdf::schema::ChildrenKey::PropertyChildren.as_str())
@@ -2629,7 +2638,7 @@ def Material "Mat"
         assert!(props.iter().any(|t| t.as_str() == "outputs:surface"));
 
         let output = data
-            .get(&sdf::path("/Mat.outputs:surface").unwrap())
+            .spec(&sdf::path("/Mat.outputs:surface").unwrap())
             .expect("missing outputs:surface spec");
         assert!(matches!(
             output.get(FieldKey::TypeName.as_str()),
@@ -2662,7 +2671,7 @@ def Scope "Root"
 
         let data = parser.parse().unwrap();
         let rel_spec = data
-            .get(&sdf::path("/Root.material:binding").unwrap())
+            .spec(&sdf::path("/Root.material:binding").unwrap())
             .expect("missing relationship spec");
         let targets = rel_spec
             .get(FieldKey::TargetPaths.as_str())
@@ -2711,7 +2720,7 @@ def Scope "Root"
         let mut parser = Parser::new(input);
         let data = parser.parse().unwrap();
 
-        let root = data.get(&sdf::Path::abs_root()).unwrap();
+        let root = data.spec(&sdf::Path::abs_root()).unwrap();
         assert_eq!(root.ty, sdf::SpecType::PseudoRoot);
     }
 
@@ -2750,7 +2759,7 @@ def Xform "World"
 
         let data = parser.parse().unwrap();
 
-        let world = data.get(&sdf::path("/World").unwrap()).unwrap();
+        let world = data.spec(&sdf::path("/World").unwrap()).unwrap();
 
         let props = world
             .get(ChildrenKey::PropertyChildren.as_str())
@@ -2782,7 +2791,7 @@ def Xform "World"
             .collect::<Vec<_>>()
         );
 
-        let normals = data.get(&sdf::path("/World.normals").unwrap()).unwrap();
+        let normals = data.spec(&sdf::path("/World.normals").unwrap()).unwrap();
         let value = normals.get("default").unwrap();
 
         assert_eq!(
@@ -2798,7 +2807,7 @@ def Xform "World"
             ]
         );
 
-        let order = data.get(&sdf::path("/World.xformOpOrder").unwrap()).unwrap();
+        let order = data.spec(&sdf::path("/World.xformOpOrder").unwrap()).unwrap();
 
         assert_eq!(
             order
@@ -2860,7 +2869,7 @@ def Xform "World"
         );
 
         let data = parser.parse().unwrap();
-        let pseudo_root = data.get(&sdf::Path::abs_root()).unwrap();
+        let pseudo_root = data.spec(&sdf::Path::abs_root()).unwrap();
 
         let sublayers = pseudo_root
             .get(FieldKey::SubLayers.as_str())
@@ -2905,7 +2914,7 @@ def Mesh "Mesh_001" (
         );
 
         let data = parser.parse().unwrap();
-        let mesh = data.get(&sdf::path("/Mesh_001").unwrap()).unwrap();
+        let mesh = data.spec(&sdf::path("/Mesh_001").unwrap()).unwrap();
 
         assert!(mesh
             .get(FieldKey::Active.as_str())
@@ -2941,7 +2950,7 @@ def Mesh "visual" (
         );
 
         let data = parser.parse().unwrap();
-        let mesh = data.get(&sdf::path("/visual").unwrap()).unwrap();
+        let mesh = data.spec(&sdf::path("/visual").unwrap()).unwrap();
 
         let references = mesh
             .get(FieldKey::References.as_str())
@@ -2976,7 +2985,7 @@ def "A" (
         );
 
         let data = parser.parse().unwrap();
-        let prim = data.get(&sdf::path("/A").unwrap()).unwrap();
+        let prim = data.spec(&sdf::path("/A").unwrap()).unwrap();
         let inherits = prim
             .get(FieldKey::InheritPaths.as_str())
             .unwrap()
@@ -3033,19 +3042,19 @@ over "GLOBAL" (
 
         // Check that GLOBAL prim exists and has customData
         let global_path = sdf::Path::from_str("/GLOBAL").unwrap();
-        assert!(specs.contains_key(&global_path), "Should have /GLOBAL prim");
+        assert!(specs.spec(&global_path).is_some(), "Should have /GLOBAL prim");
 
-        let global_spec = &specs[&global_path];
+        let global_spec = specs.spec(&global_path).unwrap();
         assert!(global_spec.contains("customData"), "GLOBAL should have customData");
 
         // Check that PhysicsScene class exists
         let physics_scene_path = sdf::Path::from_str("/PhysicsScene").unwrap();
         assert!(
-            specs.contains_key(&physics_scene_path),
+            specs.spec(&physics_scene_path).is_some(),
             "Should have /PhysicsScene class"
         );
 
-        let physics_scene_spec = &specs[&physics_scene_path];
+        let physics_scene_spec = specs.spec(&physics_scene_path).unwrap();
         assert!(
             physics_scene_spec.contains("customData"),
             "PhysicsScene should have customData"
@@ -3054,12 +3063,12 @@ over "GLOBAL" (
         // Check that attributes were parsed (e.g., physics:gravityDirection)
         let gravity_attr_path = sdf::Path::from_str("/PhysicsScene.physics:gravityDirection").unwrap();
         assert!(
-            specs.contains_key(&gravity_attr_path),
+            specs.spec(&gravity_attr_path).is_some(),
             "Should have physics:gravityDirection attribute"
         );
 
         // Check that the attribute has customData in its metadata
-        let gravity_spec = &specs[&gravity_attr_path];
+        let gravity_spec = specs.spec(&gravity_attr_path).unwrap();
         assert!(
             gravity_spec.contains("customData"),
             "gravity attribute should have customData"
@@ -3090,7 +3099,7 @@ def Xform "root" {
         let specs = parser.parse().expect("stage parsed");
 
         let relationship_path = sdf::Path::new("/root/mesh.material:binding:physics").expect("relationship path valid");
-        let relationship_spec = specs.get(&relationship_path).expect("relationship spec present");
+        let relationship_spec = specs.spec(&relationship_path).expect("relationship spec present");
 
         let bind_material_as = relationship_spec
             .get("bindMaterialAs")
@@ -3149,7 +3158,7 @@ def Xform "Anim"
         let specs = parser.parse().expect("typed timeSamples parsed");
 
         let rotations = specs
-            .get(&sdf::Path::new("/Anim.rotations").unwrap())
+            .spec(&sdf::Path::new("/Anim.rotations").unwrap())
             .and_then(|s| s.get(FieldKey::TimeSamples.as_str()))
             .expect("rotations.timeSamples present");
         let samples = match rotations {
@@ -3166,7 +3175,7 @@ def Xform "Anim"
         }
 
         let translations = specs
-            .get(&sdf::Path::new("/Anim.translations").unwrap())
+            .spec(&sdf::Path::new("/Anim.translations").unwrap())
             .and_then(|s| s.get(FieldKey::TimeSamples.as_str()))
             .expect("translations.timeSamples present");
         let samples = match translations {
@@ -3182,7 +3191,7 @@ def Xform "Anim"
         }
 
         let xform = specs
-            .get(&sdf::Path::new("/Anim.xformOp:transform").unwrap())
+            .spec(&sdf::Path::new("/Anim.xformOp:transform").unwrap())
             .and_then(|s| s.get(FieldKey::TimeSamples.as_str()))
             .expect("xformOp:transform.timeSamples present");
         let samples = match xform {
@@ -3230,7 +3239,7 @@ def Xform "Anim"
 
         let take = |path: &str| {
             let value = specs
-                .get(&sdf::Path::new(path).unwrap())
+                .spec(&sdf::Path::new(path).unwrap())
                 .and_then(|s| s.get(FieldKey::TimeSamples.as_str()))
                 .unwrap_or_else(|| panic!("{path}.timeSamples present"));
             match value {
@@ -3282,7 +3291,7 @@ def Xform "X"
         );
         let specs = parser.parse().expect("lenient timeSamples parsed");
         let value = specs
-            .get(&sdf::Path::new("/X.my:attribute").unwrap())
+            .spec(&sdf::Path::new("/X.my:attribute").unwrap())
             .and_then(|s| s.get(FieldKey::TimeSamples.as_str()))
             .expect("timeSamples present");
         let samples = match value {
@@ -3364,7 +3373,7 @@ def Xform "X"
         let text = "#usda 1.0\nreorder rootPrims = [\"B\", \"A\"]\ndef \"A\" {}\ndef \"B\" {}\n";
         let data = Parser::new(text).parse().expect("reorder rootPrims parses");
         let order = data
-            .get(&sdf::Path::abs_root())
+            .spec(&sdf::Path::abs_root())
             .unwrap()
             .get(FieldKey::PrimOrder.as_str())
             .expect("primOrder on pseudo-root")
@@ -3455,7 +3464,7 @@ def Scope "Root" {
         );
         let data = parser.parse().unwrap();
         let path = sdf::path("/Root").unwrap().append_property("myList").unwrap();
-        let spec = data.get(&path).expect("myList spec not found");
+        let spec = data.spec(&path).expect("myList spec not found");
         assert_eq!(
             spec.get(FieldKey::TypeName.as_str()),
             Some(&sdf::Value::Token("int[]".into()))
@@ -3477,7 +3486,7 @@ over MfScope "TestOver"
         );
         let data = parser.parse().unwrap();
         let path = sdf::path("/TestOver").unwrap();
-        let spec = data.get(&path).expect("TestOver not found");
+        let spec = data.spec(&path).expect("TestOver not found");
         assert_eq!(
             spec.get(FieldKey::Specifier.as_str()),
             Some(&sdf::Value::Specifier(sdf::Specifier::Over))
@@ -3501,11 +3510,11 @@ def "P" {
         );
         let data = parser.parse().unwrap();
         assert_eq!(
-            data.get(&sdf::path("/P.startTime").unwrap()).unwrap().get("default"),
+            data.spec(&sdf::path("/P.startTime").unwrap()).unwrap().get("default"),
             Some(&sdf::Value::TimeCode(sdf::TimeCode(24.0))),
         );
         assert_eq!(
-            data.get(&sdf::path("/P.beats").unwrap()).unwrap().get("default"),
+            data.spec(&sdf::path("/P.beats").unwrap()).unwrap().get("default"),
             Some(&sdf::Value::TimeCodeVec(vec![
                 sdf::TimeCode(0.0),
                 sdf::TimeCode(12.0),
@@ -3530,7 +3539,7 @@ def "P" {
         );
         let data = parser.parse().unwrap();
         let cue = data
-            .get(&sdf::path("/P.cue").unwrap())
+            .spec(&sdf::path("/P.cue").unwrap())
             .unwrap()
             .get(sdf::FieldKey::TimeSamples.as_str())
             .expect("cue.timeSamples present");
@@ -3555,7 +3564,7 @@ def Scope "Root" (
         );
         let data = parser.parse().unwrap();
         let path = sdf::path("/Root").unwrap();
-        let spec = data.get(&path).unwrap();
+        let spec = data.spec(&path).unwrap();
         assert_eq!(spec.get("displayName"), Some(&sdf::Value::String("My Root".into())));
     }
 
@@ -3577,7 +3586,7 @@ def Xform "Root" (
 "#,
         );
         let data = parser.parse().unwrap();
-        let spec = data.get(&sdf::path("/Root").unwrap()).unwrap();
+        let spec = data.spec(&sdf::path("/Root").unwrap()).unwrap();
         assert_eq!(
             spec.get("hide_in_stage_window"),
             Some(&sdf::Value::Token("false".into()))
@@ -3592,7 +3601,7 @@ def Xform "Root" (
         let input = "#usda 1.0\ndef Scope \"R\" (\n    displayName = \"\u{1F680}\"\n)\n{\n}\n";
         let mut parser = Parser::new(input);
         let data = parser.parse().unwrap();
-        let spec = data.get(&sdf::path("/R").unwrap()).unwrap();
+        let spec = data.spec(&sdf::path("/R").unwrap()).unwrap();
         assert_eq!(spec.get("displayName"), Some(&sdf::Value::String("\u{1F680}".into())));
     }
 
@@ -3605,7 +3614,7 @@ def "p" { double x.spline = {} }
         );
         let data = parser.parse().unwrap();
         let d = data
-            .get(&sdf::path("/p.x").unwrap())
+            .spec(&sdf::path("/p.x").unwrap())
             .unwrap()
             .get("spline")
             .unwrap()
@@ -3630,7 +3639,7 @@ def "p" {
         );
         let data = parser.parse().unwrap();
         let d = data
-            .get(&sdf::path("/p.x").unwrap())
+            .spec(&sdf::path("/p.x").unwrap())
             .unwrap()
             .get("spline")
             .unwrap()
@@ -3670,7 +3679,7 @@ def "p" {
         );
         let data = parser.parse().unwrap();
         let d = data
-            .get(&sdf::path("/p.x").unwrap())
+            .spec(&sdf::path("/p.x").unwrap())
             .unwrap()
             .get("spline")
             .unwrap()

@@ -1457,7 +1457,7 @@ mod tests {
 
         let parsed = Parser::new(src).parse().expect("parse asset[] source");
         let files = parsed
-            .get(&path("/M.inputs:files").unwrap())
+            .spec(&path("/M.inputs:files").unwrap())
             .and_then(|s| s.get(FieldKey::Default.as_str()))
             .expect("inputs:files default");
         assert!(
@@ -1465,7 +1465,7 @@ mod tests {
             "parsed as {files:?}, expected AssetPathVec"
         );
 
-        let reader = Data::from_specs(parsed);
+        let reader = parsed;
         let emitted = TextWriter::write_to_string(&reader as &dyn AbstractData).unwrap();
         assert!(emitted.contains("asset[] inputs:files"), "emitted: {emitted}");
         assert!(emitted.contains("@./tex_a.png@"), "emitted: {emitted}");
@@ -1473,7 +1473,7 @@ mod tests {
 
         let reparsed = Parser::new(&emitted).parse().expect("re-parse emitted");
         let files = reparsed
-            .get(&path("/M.inputs:files").unwrap())
+            .spec(&path("/M.inputs:files").unwrap())
             .and_then(|s| s.get(FieldKey::Default.as_str()));
         assert!(matches!(files, Some(Value::AssetPathVec(_))), "re-parsed as {files:?}");
     }
@@ -1551,7 +1551,7 @@ mod tests {
             .parse()
             .unwrap_or_else(|e| panic!("re-parse failed:\n---emitted---\n{text}\n---end---\n{e:#}"));
 
-        let spec = parsed.get(&root).expect("pseudo-root spec should round-trip");
+        let spec = parsed.spec(&root).expect("pseudo-root spec should round-trip");
         let got = spec.get(FieldKey::CustomLayerData.as_str()).expect("customLayerData");
         let Value::Dictionary(got) = got else {
             panic!("expected Dictionary, got {got:?}");
