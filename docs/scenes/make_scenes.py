@@ -21,19 +21,58 @@
                      under the courtyard map: a scene whose cost is in its geometry
                      (knot.ply, binary PLY).
 
-  pip install mitsuba numpy; python3 docs/scenes/make_scenes.py
-The maps and the knot are generated (not committed). Orientation: the project's lat-long convention,
-u = atan2(x, −z)/2π, v = acos(y)/π (docs/conventions.md)."""
+  pip install numpy; python3 docs/scenes/make_scenes.py
+The maps and the knot are generated (not committed). The maps are float32 RGB OpenEXR, written
+here (ZIP-compressed scanlines): numpy is all the script needs. Orientation: the project's
+lat-long convention, u = atan2(x, −z)/2π, v = acos(y)/π (docs/conventions.md)."""
 import os
+import struct
+import zlib
 import numpy as np
-import mitsuba as mi
 
-mi.set_variant("scalar_rgb")
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
+def write_exr(path, img):
+    """img (h, w, 3) as a float32 RGB OpenEXR: scanlines, ZIP compression (16 lines per
+    chunk), the attributes OpenEXR requires and no others."""
+    img = np.ascontiguousarray(img, dtype="<f4")
+    h, w, _ = img.shape
+
+    def attr(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+    chlist = b"".join(c + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
+    window = struct.pack("<4i", 0, 0, w - 1, h - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<i", 2)
+              + attr("channels", "chlist", chlist) + attr("compression", "compression", b"\x03")
+              + attr("dataWindow", "box2i", window) + attr("displayWindow", "box2i", window)
+              + attr("lineOrder", "lineOrder", b"\x00") + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0.0, 0.0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    chunks = []
+    for y0 in range(0, h, 16):
+        # Per scanline the channels in the header's order (B, G, R), each a row of w floats.
+        raw = np.ascontiguousarray(img[y0:y0 + 16, :, ::-1].transpose(0, 2, 1)).tobytes()
+        b = np.frombuffer(raw, dtype=np.uint8)
+        # OpenEXR's ZIP: even bytes then odd bytes, then each byte as the difference from the last.
+        t = np.concatenate([b[0::2], b[1::2]])
+        d = t.copy()
+        d[1:] = (t[1:].astype(np.int16) - t[:-1] + 128) & 0xFF
+        z = zlib.compress(d.tobytes(), 6)
+        data = z if len(z) < len(raw) else raw
+        chunks.append(struct.pack("<ii", y0, len(data)) + data)
+    offset = len(header) + 8 * len(chunks)
+    table = b""
+    for c in chunks:
+        table += struct.pack("<Q", offset)
+        offset += len(c)
+    with open(path, "wb") as f:
+        f.write(header + table + b"".join(chunks))
+
+
 def write(name, img):
-    mi.Bitmap(img.astype(np.float32)).write(os.path.join(HERE, name))
+    write_exr(os.path.join(HERE, name), img.astype(np.float32))
 
 
 write("furnace_env.exr", np.ones((32, 64, 3)))

@@ -1,4 +1,4 @@
-//! The measurements behind the light samplers' choices (docs/perf.md, "Light samplers"):
+//! The measurements behind the light samplers' choices (docs/tuning.md, "Light samplers"):
 //! 1. triangles — per-sample relative variance of the irradiance on a diffuse receiver with
 //!    area sampling and with spherical-triangle sampling, by decade of the solid angle the
 //!    triangle subtends (random triangles, receivers and normals);

@@ -8,7 +8,7 @@ use core::f64::consts::PI;
 use glam::{DVec3, Vec2, Vec3};
 
 /// The smallest solid angle (sr) sampled this way: below it the solid angle's f64 rounding
-/// exceeds ~1e-6 of its value (docs/perf.md, "Light samplers", measures it), and the rectangle
+/// exceeds ~1e-6 of its value (docs/tuning.md, "Light samplers", measures it), and the rectangle
 /// is small and far enough that area sampling is uniform in solid angle to the same order.
 pub const MIN_SOLID_ANGLE: f64 = 1e-8;
 

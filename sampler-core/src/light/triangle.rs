@@ -25,7 +25,7 @@ impl Default for TriangleSampling {
     /// Solid-angle sampling where the triangle subtends at least 0.01 sr, area sampling below:
     /// close triangles gain much from solid-angle sampling (area sampling's density varies with
     /// d²/cos over them), and distant ones, where both are nearly uniform in solid angle, save
-    /// the spherical construction's trigonometry (docs/perf.md, "Light samplers").
+    /// the spherical construction's trigonometry (docs/tuning.md, "Light samplers").
     fn default() -> Self {
         Self::SolidAngle { min_solid_angle: 0.01 }
     }
