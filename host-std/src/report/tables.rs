@@ -52,7 +52,7 @@ pub fn markdown(
     reference_note: &str,
 ) -> String {
     let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
-    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; time = wall clock of the render. Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
+    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; seconds = the render's time by the clock named above (wall clock unless it says CPU). Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
     let regions: Vec<String> =
         measurements.first().map(|m| m.regions.iter().map(|r| r.0.clone()).collect()).unwrap_or_default();
     s.push_str("| method | spp | seconds | RMSE | relMSE |");
