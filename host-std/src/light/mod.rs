@@ -3,6 +3,8 @@
 //! `sampler-core` samples; and the other lights of a scene, as a table the renderer samples
 //! (`lights.rs`). The bottom layer: it depends on nothing else in the crate.
 
+mod distant_in_env;
+pub use distant_in_env::move_distant_lights;
 pub mod environment;
 pub mod image_file;
 pub mod lights;

@@ -55,6 +55,12 @@ impl DistantLight {
         self.frame.n
     }
 
+    /// Half the light's angular diameter, radians (0 for a delta light).
+    #[must_use]
+    pub fn half_angle(&self) -> f32 {
+        libm::asinf(libm::sqrtf(self.sin2_max))
+    }
+
     /// The radiance over the light's disc (0 for a delta light).
     #[must_use]
     pub fn radiance(&self) -> Vec3 {

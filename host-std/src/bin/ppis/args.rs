@@ -81,6 +81,11 @@ pub(crate) struct SamplingArgs {
     /// power, distance and orientation) or `power` (in proportion to power alone).
     #[arg(long, value_name = "tree|power", default_value = "tree", value_parser = parse_light_selection)]
     pub(crate) light_selection: LightSelection,
+    /// Rasterise distant lights with an angular size (the sun) into the environment map, so
+    /// that the map's samplers (the product among them) sample them, instead of sampling each
+    /// by its cone; needs an environment.
+    #[arg(long)]
+    pub(crate) distant_in_env: bool,
 }
 
 /// `--light-selection`'s value.

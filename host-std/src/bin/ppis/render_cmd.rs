@@ -159,10 +159,15 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
     };
     let load_seconds = t_load.elapsed().as_secs_f64();
     let cpu_loaded = cpu();
-    let environment = match &scene.env {
+    let mut environment = match &scene.env {
         Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
         None => None,
     };
+    if args.sampling.distant_in_env
+        && let Some(env) = environment.as_mut()
+    {
+        host_std::light::move_distant_lights(&mut scene.lights, env);
+    }
     let cpu_env = cpu();
     let t_bvh = Instant::now();
     let bvh = pool.install(|| Bvh::build(&scene));

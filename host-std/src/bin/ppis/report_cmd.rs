@@ -97,10 +97,15 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         }
         None => None,
     };
-    let environment = match &scene.env {
+    let mut environment = match &scene.env {
         Some((source, placement)) => Some(Environment::build(source, *placement)?),
         None => None,
     };
+    if args.sampling.distant_in_env
+        && let Some(env) = environment.as_mut()
+    {
+        host_std::light::move_distant_lights(&mut scene.lights, env);
+    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
     let bvh = Bvh::build(&scene);
