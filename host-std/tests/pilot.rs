@@ -1,7 +1,8 @@
 //! `auto`'s pilot checks the rules' plan per material by measurement: not env sampling for a
 //! glossy sphere under a smooth sky (measured away), not BRDF sampling for a matte one under a
 //! sun (a candidate under smooth light only: a pilot would not see the rare sun hits), env sampling in a
-//! matte studio where it measures twice as good as the rules' MIS.
+//! matte studio where it measures twice as good as the rules' MIS; two-level-MIS measured only
+//! where enough samples share its build per shading point, and not chosen where it scores worse.
 
 mod common;
 
@@ -113,4 +114,41 @@ fn a_matte_studio_can_be_env_sampled() {
     let plans: Vec<String> = (0..6).map(|seed| chosen(&scene, &env, 1024, seed)).collect();
     let env_sampled = plans.iter().filter(|p| *p == "env").count();
     assert!(env_sampled >= 2 && plans.iter().all(|p| p == "env" || p == "mis 3:1"), "{plans:?}");
+}
+
+/// What `auto`'s pilot measured on the scene's one material at `spp` and `shading_points`.
+fn measured(scene: &Scene, env: &Environment, spp: usize, shading_points: usize) -> pilot::PilotResult {
+    let settings = Settings {
+        method: Method::Auto,
+        spp,
+        shading_points,
+        brdf_samples: 64,
+        seed: 3,
+        progress: false,
+        shadows: true,
+    };
+    let mut image = render(scene, &Bvh::build(scene), Some(&env.hierarchy()), &settings);
+    assert_eq!(image.pilot.len(), 1, "one material measured");
+    image.pilot.remove(0)
+}
+
+#[test]
+fn two_level_mis_is_measured_only_where_enough_samples_share_its_build_and_chosen_only_where_it_wins() {
+    // A car paint under the sun: two-level-MIS's largest gain per sample over MIS at one
+    // shading point is on such a coat (docs/perf.md, "The two products"), but across a
+    // sphere's pixels it draws little of it, far from the margin its cost asks.
+    use sampler_core::brdf::CarPaint;
+    let scene = sphere(Bsdf::CarPaint(CarPaint::default()));
+    let sun = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
+    let two_level = pilot::PLANS.iter().position(|p| p.strategy.is_two_level()).expect("two-level-MIS is a plan");
+    // `auto`'s own two pairs per shading point: its build per point cannot be repaid, and the
+    // pilot does not spend on it.
+    assert!(!pilot::affordable(two_level, 4));
+    let own = measured(&scene, &sun, 64, 16);
+    assert!(own.scores[two_level].is_none(), "{:?}", own.scores);
+    // 64 samples per shading point: measured, trusted, and not chosen where it scores worse.
+    let shared = measured(&scene, &sun, 64, 1);
+    let scores: Vec<f64> = shared.scores.iter().map(|s| s.unwrap_or(f64::INFINITY)).collect();
+    assert!(scores[two_level].is_finite(), "{scores:?}");
+    assert_ne!(shared.chosen, two_level, "{scores:?}");
 }

@@ -4,6 +4,7 @@
 //! into `render`, never the reverse.
 
 pub mod budget;
+pub mod candidates;
 pub mod method;
 pub mod pilot;
 pub mod rules;
@@ -142,8 +143,14 @@ pub fn render_crop(
         }
         _ => (None, Vec::new()),
     };
+    // A two-level plan the pilot chose reads the cell cones, which the rules' plans did not build.
+    let plans = chosen.as_deref().unwrap_or(&plans);
+    let pilot_cones = match (env, ctx.cones) {
+        (Some(e), None) => two_level_cones(e, plans),
+        _ => None,
+    };
     let pilot_seconds = start.elapsed().as_secs_f64();
-    let image = render_tiles(&Context { plans: chosen.as_deref().unwrap_or(&plans), ..ctx }, crop, start);
+    let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_deref()), ..ctx }, crop, start);
     let render_seconds = start.elapsed().as_secs_f64();
     let render_cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
     let c = image.counters;

@@ -2,8 +2,9 @@
 //! each material's pixels with every candidate plan, twice with independent samples, at the
 //! render's own spp and shading points, scored by variance × cost — the variance from the
 //! pixel pairs' squared differences (relMSE's normalisation), the cost a fixed per-sample
-//! weight per plan ([`PLANS`]), not the pilot's clock, so that the choice, and the image,
-//! depend only on the scene, the settings and the seed. The pilot's samples are independent of
+//! weight per plan and a sampler's build per shading point ([`PLANS`], `plan::candidates`),
+//! not the pilot's clock, so that the choice, and the image, depend only on the scene, the
+//! settings and the seed. The pilot's samples are independent of
 //! the render's (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
 //!
 //! The pilot overrides the rules' plan ([`auto_strategy`](crate::plan::rules::auto_strategy))
@@ -19,38 +20,22 @@
 //! sampling where B·cos is bounded (its weight is B·cos × the map's total power), BRDF sampling
 //! where the lighting is (its weight is L × B·cos/p). And each MIS strategy competes with the
 //! rules' split only: the splits differ by less than the pilot can tell apart
-//! ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the others.
+//! ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the others. A plan
+//! that builds a sampler per shading point (two-level-MIS) competes only where the render's
+//! samples per shading point let it repay its build ([`affordable`]): elsewhere the pilot
+//! is the pilot without it, at no cost.
 
+pub use crate::plan::candidates::{Candidate, PLANS, affordable};
 use crate::plan::method::strategy_name;
 use crate::plan::rules::{SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
 use crate::render::pixel::{Scratch, pixel};
 use crate::render::strategy::{MaterialPlan, Strategy};
-use crate::render::{Context, Options};
+use crate::render::{Context, Options, two_level_cones};
 use crate::scene::Bsdf;
 use rayon::prelude::*;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::points::permutation_element;
 use sampler_core::rng::hash_combine;
-
-/// A plan the pilot may choose, with its cost.
-#[derive(Clone, Copy, Debug)]
-pub struct Candidate {
-    /// The strategy.
-    pub strategy: Strategy,
-    /// Time per visibility sample relative to MIS's pairs, measured once over the benchmark
-    /// scenes (docs/perf.md, "Cost per visibility sample").
-    pub cost: f64,
-}
-
-/// The candidates.
-pub const PLANS: [Candidate; 6] = [
-    Candidate { strategy: Strategy::Env, cost: 1.0 },
-    Candidate { strategy: Strategy::Brdf, cost: 0.78 },
-    Candidate { strategy: Strategy::Mis { env_share: 0.5 }, cost: 1.0 },
-    Candidate { strategy: Strategy::Mis { env_share: 0.75 }, cost: 1.0 },
-    Candidate { strategy: Strategy::ProductMis { product_share: 0.5 }, cost: 1.8 },
-    Candidate { strategy: Strategy::ProductMis { product_share: 0.75 }, cost: 2.07 },
-];
 
 /// How much better than the rule's plan a plan of no higher cost must score to replace it:
 /// above the noise of a score from a few dozen pixel pairs where two plans are alike, below
@@ -120,12 +105,8 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
         Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak),
         Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
-        Strategy::Product
-        | Strategy::Wavelet
-        | Strategy::Ris
-        | Strategy::TwoStage
-        | Strategy::TwoLevel
-        | Strategy::TwoLevelMis { .. } => false,
+        Strategy::TwoLevelMis { .. } => true,
+        Strategy::Product | Strategy::Wavelet | Strategy::Ris | Strategy::TwoStage | Strategy::TwoLevel => false,
     }
 }
 
@@ -142,6 +123,12 @@ pub(crate) fn choose(
 ) -> (Vec<MaterialPlan>, Vec<PilotResult>) {
     let defaults = ctx.plans;
     let Some((found, tasks)) = pilot_tasks(ctx, env_peak) else { return (defaults.to_vec(), Vec::new()) };
+    // The two-level candidates read the cell cones, which the rules' plans do not build.
+    let candidates: Vec<MaterialPlan> =
+        tasks.iter().map(|&(m, c)| MaterialPlan { strategy: PLANS[c].strategy, ..defaults[m] }).collect();
+    let cones = if ctx.cones.is_none() { two_level_cones(env, &candidates) } else { None };
+    let ctx = &Context { cones: ctx.cones.or(cones.as_deref()), ..*ctx };
+    let v = samples_per_point(ctx.options);
     let mut measured: Vec<Measured> = vec![Vec::new(); found.len()];
     for ((m, c), v) in tasks.iter().zip(measure(ctx, env, &found, &tasks)) {
         measured[*m].push((*c, v));
@@ -153,9 +140,9 @@ pub(crate) fn choose(
             continue;
         }
         let pairs: Vec<(usize, &[[[f64; 3]; 2]])> = measured[m].iter().map(|(c, v)| (*c, v.as_slice())).collect();
-        let scores = score(&pairs, pixels.len());
+        let scores = score(&pairs, pixels.len(), v);
         let rule = PLANS.iter().position(|p| p.strategy == defaults[m].strategy);
-        let Some(chosen) = decide(&scores, rule) else { continue };
+        let Some(chosen) = decide(&scores, rule, v) else { continue };
         plans[m] = MaterialPlan { strategy: PLANS[chosen].strategy, ..defaults[m] };
         results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
     }
@@ -184,14 +171,15 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
     }
     // Every (material, candidate) to measure, and the cost of one pilot pixel of all of them,
     // twice.
+    let v = samples_per_point(ctx.options);
     let tasks: Vec<(usize, usize)> = (0..materials)
         .filter(|&m| found[m].len() >= MIN_PIXELS)
         .flat_map(|m| {
             let bsdf = &ctx.scene.materials[m].bsdf;
-            (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))
+            (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak) && affordable(c, v)).map(move |c| (m, c))
         })
         .collect();
-    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost).sum();
+    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost_at(v)).sum();
     let per_material = ((PILOT_SHARE * n as f64 / cost_per_pixel.max(1.0)) as usize).clamp(MIN_PIXELS, MAX_PIXELS);
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
         return None;
@@ -239,12 +227,13 @@ fn measure(
 /// The rule's plan unless another scores [`OVERRIDE_MARGIN`]× better, or
 /// [`COSTLIER_OVERRIDE_MARGIN`]× where it costs more than the rule's (or the rule's was not
 /// measured or not trusted: then the best); `None` when nothing was scored.
-fn decide(scores: &[Option<f64>], rule: Option<usize>) -> Option<usize> {
+fn decide(scores: &[Option<f64>], rule: Option<usize>, samples_per_point: usize) -> Option<usize> {
     let (best, best_score) =
         scores.iter().enumerate().filter_map(|(c, s)| s.map(|s| (c, s))).min_by(|a, b| a.1.total_cmp(&b.1))?;
     match rule.and_then(|r| scores[r].map(|s| (r, s))) {
         Some((r, s)) => {
-            let margin = if PLANS[best].cost > PLANS[r].cost { COSTLIER_OVERRIDE_MARGIN } else { OVERRIDE_MARGIN };
+            let costlier = PLANS[best].cost_at(samples_per_point) > PLANS[r].cost_at(samples_per_point);
+            let margin = if costlier { COSTLIER_OVERRIDE_MARGIN } else { OVERRIDE_MARGIN };
             Some(if best_score * margin >= s { r } else { best })
         }
         None => Some(best),
@@ -255,7 +244,7 @@ fn decide(scores: &[Option<f64>], rule: Option<usize>) -> Option<usize> {
 /// candidates that ran and their pairs per pixel), or `None` when it did not run or its mean
 /// over the pilot pixels disagrees with the median candidate's by more than its own noise
 /// allows (a candidate that missed a rare bright sample in every pilot pixel looks noiseless).
-fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize) -> Vec<Option<f64>> {
+fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize, samples_per_point: usize) -> Vec<Option<f64>> {
     let values: Vec<&[[[f64; 3]; 2]]> = measured.iter().map(|m| m.1).collect();
     // Per pixel and channel, the mean over every candidate's two values: the normaliser.
     let reference: Vec<[f64; 3]> = (0..pixels)
@@ -275,7 +264,7 @@ fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize) -> Vec<Option<f6
     let median = sorted[sorted.len() / 2];
     let mut scores = vec![None; PLANS.len()];
     for ((v, &total), &(c, _)) in values.iter().zip(&totals).zip(measured) {
-        let cost = PLANS[c].cost;
+        let cost = PLANS[c].cost_at(samples_per_point);
         scores[c] = {
             let (mut rel, mut spread) = (0.0, 0.0);
             for (pair, r) in v.iter().zip(&reference) {
@@ -293,6 +282,11 @@ fn score(measured: &[(usize, &[[[f64; 3]; 2]])], pixels: usize) -> Vec<Option<f6
         };
     }
     scores
+}
+
+/// Light samples per shading point of a render of `options`.
+fn samples_per_point(options: &Options) -> usize {
+    options.spp / options.shading_points.max(1)
 }
 
 /// A candidate's name: the method, and its split where it is not half and half
@@ -319,7 +313,7 @@ mod tests {
     #[test]
     fn the_quietest_plan_per_cost_scores_lowest_and_a_plan_that_missed_the_light_is_not_trusted() {
         let n = 16;
-        // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1.
+        // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1, two-level-mis.
         let values = [
             pairs(1.0, 0.5, n),
             pairs(0.02, 0.001, n), // BRDF samples that never found the sun: quiet and wrong
@@ -329,7 +323,7 @@ mod tests {
             pairs(1.0, 0.3, n),
         ];
         let measured: Vec<(usize, &[[[f64; 3]; 2]])> = values.iter().map(|v| v.as_slice()).enumerate().collect();
-        let s = score(&measured, n);
+        let s = score(&measured, n, 4);
         assert!(s[1].is_none(), "{s:?}");
         let s: Vec<f64> = s.iter().map(|s| s.unwrap_or(f64::INFINITY)).collect();
         // Equal variance, cheaper: MIS 3:1 before product-MIS.
@@ -343,22 +337,28 @@ mod tests {
 
     #[test]
     fn the_rules_plan_stands_unless_another_is_measured_better_by_the_margin() {
-        // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1.
+        // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1, two-level-mis.
         let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(4.9)];
-        assert_eq!(decide(&scores, Some(3)), Some(0), "5.1 against 4.0: overridden");
-        assert_eq!(decide(&scores, Some(5)), Some(5), "4.9 against 4.0: kept");
+        assert_eq!(decide(&scores, Some(3), 4), Some(0), "5.1 against 4.0: overridden");
+        assert_eq!(decide(&scores, Some(5), 4), Some(5), "4.9 against 4.0: kept");
         let close = [Some(4.5), None, Some(9.0), Some(5.6), None, None];
-        assert_eq!(decide(&close, Some(3)), Some(3), "5.6 against 4.5: kept");
+        assert_eq!(decide(&close, Some(3), 4), Some(3), "5.6 against 4.5: kept");
         // Product-MIS costs more than MIS: it replaces the rule's MIS only when twice as good.
         let product = [None, None, Some(9.0), None, Some(5.0), None];
-        assert_eq!(decide(&product, Some(2)), Some(2), "5.0 against 9.0, costlier: kept");
+        assert_eq!(decide(&product, Some(2), 4), Some(2), "5.0 against 9.0, costlier: kept");
         let product = [None, None, Some(9.0), None, Some(4.4), None];
-        assert_eq!(decide(&product, Some(2)), Some(4), "4.4 against 9.0, costlier: overridden");
+        assert_eq!(decide(&product, Some(2), 4), Some(4), "4.4 against 9.0, costlier: overridden");
         // MIS costs less than product-MIS: it replaces the rule's product-MIS at the lower margin.
         let cheaper = [None, None, Some(5.0), None, Some(6.5), None];
-        assert_eq!(decide(&cheaper, Some(4)), Some(2), "5.0 against 6.5, cheaper: overridden");
-        assert_eq!(decide(&close, Some(1)), Some(0), "the rule's plan not trusted: the best");
-        assert_eq!(decide(&close, None), Some(0), "no rule: the best");
-        assert_eq!(decide(&[None; 6], Some(2)), None);
+        assert_eq!(decide(&cheaper, Some(4), 4), Some(2), "5.0 against 6.5, cheaper: overridden");
+        assert_eq!(decide(&close, Some(1), 4), Some(0), "the rule's plan not trusted: the best");
+        assert_eq!(decide(&close, None, 4), Some(0), "no rule: the best");
+        assert_eq!(decide(&[None; 7], Some(2), 4), None);
+        // Two-level-MIS, built per shading point, costs more than MIS at any split: it
+        // replaces the rule's MIS only when twice as good.
+        let two_level = [None, None, Some(9.0), None, None, None, Some(5.0)];
+        assert_eq!(decide(&two_level, Some(2), 16), Some(2), "5.0 against 9.0, costlier: kept");
+        let two_level = [None, None, Some(9.0), None, None, None, Some(4.4)];
+        assert_eq!(decide(&two_level, Some(2), 16), Some(6), "4.4 against 9.0, costlier: overridden");
     }
 }
