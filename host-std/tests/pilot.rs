@@ -126,6 +126,7 @@ fn measured(scene: &Scene, env: &Environment, spp: usize, shading_points: usize)
         seed: 3,
         progress: false,
         shadows: true,
+        light_selection: Default::default(),
     };
     let mut image = render(scene, &Bvh::build(scene), Some(&env.hierarchy()), &settings);
     assert_eq!(image.pilot.len(), 1, "one material measured");
