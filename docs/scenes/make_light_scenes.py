@@ -5,7 +5,8 @@ written here as OBJ. Run from the repository root:
 
   python3 docs/scenes/make_light_scenes.py
 
-Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3".
+Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3"; sun_env.json
+(a sun over the map) is docs/tuning.md's, "A sun in the map or by its cone".
 With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
 DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
 spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).
@@ -111,6 +112,12 @@ def main():
     write("lights_env", {"name": "lights_env", "camera": CAMERA,
                          "envmap": {"file": "../envmaps/courtyard.exr", "scale": 0.5},
                          "lights": list(LIGHTS.values()), "shapes": SHAPES})
+    # A sun over the map: docs/tuning.md, "A sun in the map or by its cone".
+    write("sun_env", {"name": "sun_env", "camera": dict(CAMERA, width=128, height=128),
+                      "envmap": {"file": "../envmaps/courtyard.exr", "scale": 0.5},
+                      "lights": [{"type": "distant", "direction": [0.3, 1, 0.4], "irradiance": [3, 2.8, 2.4],
+                                  "angle_deg": 0.53}],
+                      "shapes": SHAPES})
 
 
 if __name__ == "__main__":

@@ -3,7 +3,7 @@
 //! the equal-area texels all subtend the same solid angle, so coverage × radiance keeps the
 //! light's power), and the pyramid rebuilt, so that the map's samplers — the product among them —
 //! sample sun × BRDF together instead of the sun by its own cone. The disc's outline is then
-//! the texels', not exact: what the image gains or loses by it is measured in docs/perf.md,
+//! the texels', not exact: what the image gains or loses by it is measured in docs/tuning.md,
 //! "A sun in the map or by its cone".
 
 use crate::light::environment::Environment;
