@@ -22,7 +22,7 @@ fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
         seed: 5,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     }
 }
 

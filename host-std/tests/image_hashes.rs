@@ -91,7 +91,7 @@ fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
         seed: 11,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     }
 }
 

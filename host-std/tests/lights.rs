@@ -25,7 +25,7 @@ fn settings(method: Method, spp: usize) -> Settings {
         seed: 11,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     }
 }
 

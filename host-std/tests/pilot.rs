@@ -31,7 +31,7 @@ fn chosen(scene: &Scene, env: &Environment, spp: usize, seed: u64) -> String {
         seed,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     };
     let image = render(scene, &Bvh::build(scene), Some(&env.hierarchy()), &settings);
     assert_eq!(image.pilot.len(), 1, "one material measured");
@@ -126,7 +126,7 @@ fn measured(scene: &Scene, env: &Environment, spp: usize, shading_points: usize)
         seed: 3,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     };
     let mut image = render(scene, &Bvh::build(scene), Some(&env.hierarchy()), &settings);
     assert_eq!(image.pilot.len(), 1, "one material measured");

@@ -19,7 +19,7 @@ fn settings(method: Method, spp: usize, p: usize) -> Settings {
         seed: 7,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     }
 }
 

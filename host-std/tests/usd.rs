@@ -96,7 +96,7 @@ fn dome_light_orientation_matches_the_convention() {
             seed: 3,
             progress: false,
             shadows: true,
-            light_selection: Default::default(),
+            lights: Default::default(),
         };
         let image = render(&c.scene, &bvh, Some(&env.hierarchy()), &settings);
         let got = highlight(&image.pixels, image.width as u32);
@@ -164,7 +164,7 @@ fn textures_are_looked_up_at_each_hit() {
         seed: 5,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     };
     let image = render(&c.scene, &bvh, Some(&env.hierarchy()), &settings);
     let at = |x: usize, y: usize| image.pixels[y * image.width + x];

@@ -31,7 +31,7 @@ fn render_scene(scene: &Scene, seed: u64) -> Vec<[f32; 3]> {
         seed,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     };
     render(scene, &bvh, Some(&env.hierarchy()), &settings).pixels
 }

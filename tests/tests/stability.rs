@@ -23,7 +23,7 @@ fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_sample
         seed: 3,
         progress: false,
         shadows: true,
-        light_selection: Default::default(),
+        lights: Default::default(),
     };
     render(scene, &bvh, Some(&h), &settings)
 }

@@ -51,7 +51,7 @@ fn renders(
                 seed,
                 progress: false,
                 shadows: true,
-                light_selection: Default::default(),
+                lights: Default::default(),
             };
             let r = render(scene, &bvh, Some(&h), &settings);
             assert!(

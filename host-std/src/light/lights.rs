@@ -19,6 +19,22 @@ pub enum LightSelection {
     Power,
 }
 
+/// How a render samples the lights besides the environment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightOptions {
+    /// How a light is picked.
+    pub selection: LightSelection,
+    /// Where the scene has an environment too, the share of each shading point's visibility
+    /// samples spent on these lights (at least one sample each way).
+    pub share: f64,
+}
+
+impl Default for LightOptions {
+    fn default() -> Self {
+        Self { selection: LightSelection::Tree, share: 0.5 }
+    }
+}
+
 /// The lights and their selection, kept for a render.
 pub struct LightTable<'a> {
     lights: &'a [SceneLight],

@@ -13,7 +13,7 @@ pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::cpu_time::process_cpu_time;
-use crate::light::lights::{LightSelection, LightTable};
+use crate::light::lights::{LightOptions, LightTable};
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
@@ -43,8 +43,8 @@ pub struct Settings {
     /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
     /// to tell the error that visibility adds from the error of sampling light × BRDF).
     pub shadows: bool,
-    /// How the lights besides the environment are picked.
-    pub light_selection: LightSelection,
+    /// How the lights besides the environment are sampled.
+    pub lights: LightOptions,
 }
 
 impl Settings {
@@ -58,6 +58,7 @@ impl Settings {
             seed: self.seed,
             progress: self.progress,
             shadows: self.shadows,
+            light_share: self.lights.share,
         }
     }
 }
@@ -120,7 +121,7 @@ pub fn render_crop(
     let cones = env.and_then(|e| two_level_cones(e, &plans));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
-    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius(), settings.light_selection);
+    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius(), settings.lights.selection);
     let lights = light_table.as_ref().map(LightTable::set);
     let ctx = Context {
         scene,

@@ -44,6 +44,9 @@ pub struct Options {
     /// Trace shadow rays (false: every direction counts as visible — unshadowed direct light,
     /// to tell the error that visibility adds from the error of sampling light × BRDF).
     pub shadows: bool,
+    /// With an environment and other lights, the share of a shading point's visibility samples
+    /// spent on the other lights.
+    pub light_share: f64,
 }
 
 /// What every pixel of a render reads.

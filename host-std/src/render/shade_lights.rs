@@ -19,13 +19,13 @@ use sampler_core::rng::hash_combine;
 const BATCH: usize = 16;
 
 /// Visibility samples per shading point for the environment and for the other lights: the
-/// whole budget for whichever the scene has, and where it has both, half of it for the lights
-/// (at least one sample each).
+/// whole budget for whichever the scene has, and where it has both, the options' share of it
+/// for the lights (rounded, at least one sample each).
 pub(crate) fn budgets(ctx: &Context<'_, '_>) -> (usize, usize) {
     let budget = (ctx.options.spp / ctx.options.shading_points.max(1)).max(1);
     match (ctx.env.is_some(), ctx.lights.is_some()) {
         (true, true) => {
-            let lights = (budget / 2).max(1);
+            let lights = ((ctx.options.light_share * budget as f64).round() as usize).clamp(1, budget.max(2) - 1);
             ((budget - lights).max(1), lights)
         }
         (true, false) => (budget, 0),

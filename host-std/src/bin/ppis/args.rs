@@ -1,7 +1,7 @@
 //! The arguments `render`, `info` and `report` share: the scene to load and how to sample it.
 
 use clap::Args;
-use host_std::light::lights::LightSelection;
+use host_std::light::lights::{LightOptions, LightSelection};
 use host_std::plan::Method;
 use host_std::scene::Scene;
 use std::path::PathBuf;
@@ -81,11 +81,23 @@ pub(crate) struct SamplingArgs {
     /// power, distance and orientation) or `power` (in proportion to power alone).
     #[arg(long, value_name = "tree|power", default_value = "tree", value_parser = parse_light_selection)]
     pub(crate) light_selection: LightSelection,
+    /// With an environment and other lights, the share of each shading point's visibility
+    /// samples spent on the other lights, in (0, 1).
+    #[arg(long, value_name = "SHARE", default_value_t = 0.5, value_parser = parse_share)]
+    pub(crate) light_share: f64,
     /// Rasterise distant lights with an angular size (the sun) into the environment map, so
     /// that the map's samplers (the product among them) sample them, instead of sampling each
     /// by its cone; needs an environment.
     #[arg(long)]
     pub(crate) distant_in_env: bool,
+}
+
+/// `--light-share`'s value.
+fn parse_share(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a share in (0, 1)")),
+    }
 }
 
 /// `--light-selection`'s value.
@@ -98,6 +110,11 @@ fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
 }
 
 impl SamplingArgs {
+    /// How the lights besides the environment are sampled.
+    pub(crate) fn lights(&self) -> LightOptions {
+        LightOptions { selection: self.light_selection, share: self.light_share }
+    }
+
     /// --width and --height, as given.
     pub(crate) fn size(&self) -> (Option<u32>, Option<u32>) {
         (self.width, self.height)

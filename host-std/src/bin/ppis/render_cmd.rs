@@ -87,7 +87,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         seed: args.sampling.seed,
         progress: true,
         shadows: !args.sampling.unshadowed,
-        light_selection: args.sampling.light_selection,
+        lights: args.sampling.lights(),
     };
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);

@@ -121,7 +121,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         seed: args.sampling.seed,
         progress: false,
         shadows: !args.sampling.unshadowed,
-        light_selection: args.sampling.light_selection,
+        lights: args.sampling.lights(),
     };
     let (reference, note) = match given {
         Some(given) => given,
