@@ -119,6 +119,18 @@ fn dark_hidden_and_partly_rendered_lights_are_notes() {
 }
 
 #[test]
+fn a_dome_takes_its_colour_temperature() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("dome.usda");
+    let dome = "def DomeLight \"D\" { bool inputs:enableColorTemperature = 1\n float inputs:colorTemperature = 4000 }";
+    std::fs::write(&file, format!("#usda 1.0\n{dome}\n")).unwrap();
+    let s = host_usd::load(&file).unwrap();
+    let expected = host_usd::blackbody::rgb(4000.0).as_vec3();
+    assert!(close(s.dome.unwrap().radiance, expected));
+    assert!(s.skipped.is_empty(), "{:?}", s.skipped);
+}
+
+#[test]
 fn a_z_up_stage_turns_its_lights_with_its_geometry() {
     let s = host_usd::load(&fixture("lights_z.usda")).unwrap();
     let Emitter::Distant { direction, .. } = light(&s, "/Up").emitter else { panic!() };
