@@ -2,7 +2,8 @@
 //! image centre +Z, u = ¼ → +X (u = ½ − atan2(x, z)/2π, v = ½ − asin(y)/π), then the
 //! light's world rotation. DomeLight_1 with `poleAxis = Z`, or `poleAxis = scene` (also when
 //! unset) on a Z-up stage, first adds rotateX(+90°), taking the pole to +Z; the legacy
-//! DomeLight ignores upAxis. Radiance = texture · color · intensity · 2^exposure.
+//! DomeLight ignores upAxis. Radiance = texture · color · intensity · 2^exposure (·
+//! the blackbody colour of `colorTemperature` when enabled; `normalize` does not apply).
 
 use crate::scene::Dome;
 use crate::stage::{PrimPath, Stage, Value};
@@ -38,10 +39,10 @@ pub fn read(
         }
         _ => Vec3::ONE,
     };
+    let mut radiance = color * (intensity * exposure.exp2()) as f32;
     if scalar("enableColorTemperature", 0.0)? != 0.0 {
-        notes.push("enableColorTemperature ignored".to_string());
+        radiance *= crate::blackbody::rgb(scalar("colorTemperature", crate::blackbody::WHITE_KELVIN)?).as_vec3();
     }
-    let radiance = color * (intensity * exposure.exp2()) as f32;
 
     let format = light_input(stage, prim, "texture:format")?.and_then(|v| v.token().map(str::to_string));
     let format = format.unwrap_or_else(|| "automatic".into());

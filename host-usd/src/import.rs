@@ -13,6 +13,7 @@ use std::path::Path;
 use std::time::Instant;
 
 mod gprim;
+mod lights;
 mod material_binding;
 mod prototypes;
 mod walk;
@@ -57,8 +58,8 @@ const STRUCTURE: [&str; 10] = [
     "RenderSettings",
     "RenderProduct",
 ];
-const OTHER_LIGHTS: [&str; 7] =
-    ["SphereLight", "RectLight", "DiskLight", "DistantLight", "CylinderLight", "GeometryLight", "PortalLight"];
+/// Lights not rendered (the others are `crate::lights::KINDS`, the dome and MeshLightAPI).
+const OTHER_LIGHTS: [&str; 3] = ["GeometryLight", "PortalLight", "PluginLight"];
 const SKELETAL: [&str; 4] = ["SkelRoot", "Skeleton", "SkelAnimation", "BlendShape"];
 
 struct Importer<'a> {
@@ -133,6 +134,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         spheres: Vec::new(),
         materials: Vec::new(),
         dome: None,
+        lights: Vec::new(),
         camera: None,
         render_settings: None,
         bounds: None,

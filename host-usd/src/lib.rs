@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod blackbody;
 pub mod camera;
 pub mod conformance;
 pub mod dome;
@@ -12,6 +13,7 @@ mod guard;
 pub mod import;
 pub mod inherit;
 pub mod instancer;
+pub mod lights;
 pub mod material;
 pub mod mesh;
 pub mod primvar;

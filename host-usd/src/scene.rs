@@ -160,6 +160,8 @@ pub struct UsdScene {
     pub materials: Vec<Material>,
     /// The DomeLight, if the stage has one.
     pub dome: Option<Dome>,
+    /// The other UsdLux lights rendered (distant, sphere, rect, disk, cylinder, mesh lights).
+    pub lights: Vec<crate::lights::UsdLight>,
     /// The camera to render through, if the stage has one.
     pub camera: Option<Camera>,
     /// The UsdRenderSettings that apply (`render_settings`), if the stage has any.

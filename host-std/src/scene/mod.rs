@@ -13,5 +13,7 @@ pub mod texture;
 pub mod usd;
 #[cfg(feature = "usd")]
 pub mod usd_info;
+#[cfg(feature = "usd")]
+pub mod usd_lights;
 
 pub use model::*;

@@ -294,6 +294,7 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted
         (source, placement)
     });
     let name = usd.file.file_name().map_or_else(|| "usd".into(), |n| n.to_string_lossy().into_owned());
-    let scene = Scene { name, camera, objects, materials, env, lights: Vec::new(), hide_emitters: false };
+    let lights = crate::scene::usd_lights::convert(&usd.lights, &mut notes);
+    let scene = Scene { name, camera, objects, materials, env, lights, hide_emitters: false };
     Converted { scene, notes, usd, files }
 }

@@ -51,6 +51,9 @@ pub fn print_import(u: &host_usd::UsdScene) {
         ),
         None => println!("  lights: no DomeLight (a render builds no env hierarchy)"),
     }
+    for l in &u.lights {
+        println!("    {}", crate::scene::usd_lights::describe(l));
+    }
     match &u.camera {
         Some(c) => println!(
             "  camera: {} (focal length {}, aperture {} × {})",

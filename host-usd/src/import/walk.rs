@@ -74,6 +74,9 @@ impl Importer<'_> {
             } else {
                 let proxy = stage.is_instance_proxy(prim).map_err(fail(prim))?;
                 self.scene.counts.instances += usize::from(proxy);
+                if stage.applied_schemas(prim).map_err(fail(prim))?.iter().any(|s| s == "MeshLightAPI") {
+                    return Ok(self.mesh_light(prim, t).map_err(fail(prim))?);
+                }
                 self.gprim(prim, t, &prim.to_string(), &(self.conversion * world)).map_err(fail(prim))?;
             }
         } else if t == "Camera" {
@@ -94,8 +97,12 @@ impl Importer<'_> {
             let (d, notes) = dome::read(stage, prim, t, z_up, &world, &self.conversion).map_err(fail(prim))?;
             notes.into_iter().for_each(|n| self.skip(prim, n));
             self.scene.dome = Some(d);
+        } else if crate::lights::KINDS.contains(&t) {
+            self.light(prim, t).map_err(fail(prim))?;
         } else if OTHER_LIGHTS.contains(&t) {
-            self.skip(prim, format!("{t} not rendered (only a DomeLight lights the scene)"));
+            let why =
+                if t == "GeometryLight" { " (deprecated by UsdLux: MeshLightAPI on the mesh renders)" } else { "" };
+            self.skip(prim, format!("{t} not rendered{why}"));
         } else if SKELETAL.contains(&t) {
             self.skip(prim, format!("{t}: skinning not applied (meshes render in their rest pose)"));
         } else if !STRUCTURE.contains(&t) {

@@ -1,0 +1,189 @@
+//! UsdLux lights besides the dome, as plain data in the renderer's frame, and the inputs every
+//! light shares (LightAPI): emitted radiance L = intensity · 2^exposure · color ·
+//! blackbody(colorTemperature) (when enabled) / sizeFactor, where sizeFactor is the light's
+//! world-space area for area lights and π sin²θmax for an angular DistantLight when
+//! `normalize` is on, and 1 otherwise (the schema's "Quantities and units"). Each input is
+//! read as `inputs:<name>`, or by its pre-21.02 name without the prefix.
+//!
+//! The geometry of each kind is built by `import/lights.rs`; this file holds what they share.
+
+use crate::blackbody;
+use crate::stage::{PrimPath, Stage, Value};
+use glam::{DVec3, Vec3};
+
+/// Prim types read as lights here (the DomeLight is `dome.rs`'s).
+pub const KINDS: [&str; 5] = ["SphereLight", "RectLight", "DiskLight", "DistantLight", "CylinderLight"];
+
+/// What a light emits and where, in the renderer's frame (Y up, scene units).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Emitter {
+    /// A point: a SphereLight with `treatAsPoint`, of the sphere's intensity π r² L.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity (RGB, per steradian).
+        intensity: Vec3,
+    },
+    /// A SphereLight emitting outwards.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius in world units.
+        radius: f32,
+        /// Radiance leaving its surface.
+        radiance: Vec3,
+    },
+    /// A RectLight: `p0 + s·e1 + t·e2`, s, t ∈ [0, 1], emitting towards `e1 × e2` (its local −Z).
+    Rect {
+        /// A corner.
+        p0: Vec3,
+        /// First edge.
+        e1: Vec3,
+        /// Second edge.
+        e2: Vec3,
+        /// Radiance leaving its front.
+        radiance: Vec3,
+    },
+    /// A DiskLight emitting along `normal` (its local −Z).
+    Disk {
+        /// Centre.
+        center: Vec3,
+        /// Unit front normal.
+        normal: Vec3,
+        /// Radius in world units.
+        radius: f32,
+        /// Radiance leaving its front.
+        radiance: Vec3,
+    },
+    /// Emitting triangles: a mesh with MeshLightAPI, or a CylinderLight's tessellated side.
+    Triangles {
+        /// Points in world space.
+        positions: Vec<Vec3>,
+        /// Counter-clockwise seen from the emitting side.
+        triangles: Vec<[u32; 3]>,
+        /// Radiance leaving each triangle's front.
+        radiance: Vec3,
+        /// Both sides emit (a `doubleSided` mesh).
+        two_sided: bool,
+    },
+    /// A DistantLight.
+    Distant {
+        /// Unit direction from the scene towards the light (its local +Z).
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: Vec3,
+        /// Full angular diameter in degrees, in [0, 180).
+        angle_deg: f32,
+    },
+}
+
+/// A light the import renders.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UsdLight {
+    /// The light's prim.
+    pub path: String,
+    /// Its prim type (`SphereLight`, …, or `Mesh` for a mesh with MeshLightAPI).
+    pub prim_type: String,
+    /// What it emits, where.
+    pub emitter: Emitter,
+}
+
+/// A light input: `inputs:<name>`, or the pre-21.02 `<name>`.
+pub fn input(stage: &Stage, prim: &PrimPath, name: &str) -> Result<Option<Value>, String> {
+    match stage.value(prim, &format!("inputs:{name}"))? {
+        Some(v) => Ok(Some(v)),
+        None => stage.value(prim, name),
+    }
+}
+
+/// A scalar light input with its schema fallback; a value that is not finite is an error.
+pub fn scalar(stage: &Stage, prim: &PrimPath, name: &str, fallback: f64) -> Result<f64, String> {
+    let v = input(stage, prim, name)?.and_then(|v| v.scalar()).unwrap_or(fallback);
+    if v.is_finite() { Ok(v) } else { Err(format!("inputs:{name} is {v}, not a finite number")) }
+}
+
+/// The LightAPI inputs of a light: its scalar emission (intensity · 2^exposure · color ·
+/// blackbody) before any size normalisation, and whether `normalize` is on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// intensity · 2^exposure · color (· the blackbody colour).
+    pub rgb: DVec3,
+    /// `inputs:normalize`: divide by the light's size.
+    pub normalize: bool,
+}
+
+impl Emission {
+    /// Reads the LightAPI inputs of `prim` (`intensity` falls back to `fallback_intensity`:
+    /// 50000 for a DistantLight, 1 for the others). A value that is not finite, a negative
+    /// intensity or colour component is an error naming the input.
+    pub fn read(stage: &Stage, prim: &PrimPath, fallback_intensity: f64) -> Result<Self, String> {
+        let intensity = scalar(stage, prim, "intensity", fallback_intensity)?;
+        let exposure = scalar(stage, prim, "exposure", 0.0)?;
+        if intensity < 0.0 {
+            return Err(format!("inputs:intensity is negative ({intensity})"));
+        }
+        let color = match input(stage, prim, "color")? {
+            Some(Value::Numbers { values, .. }) if values.len() >= 3 => DVec3::new(values[0], values[1], values[2]),
+            _ => DVec3::ONE,
+        };
+        if !color.is_finite() || color.min_element() < 0.0 {
+            return Err(format!("inputs:color {:?} has a negative or non-finite component", color.to_array()));
+        }
+        let mut rgb = color * intensity * exposure.exp2();
+        if scalar(stage, prim, "enableColorTemperature", 0.0)? != 0.0 {
+            rgb *= blackbody::rgb(scalar(stage, prim, "colorTemperature", blackbody::WHITE_KELVIN)?);
+        }
+        if !rgb.is_finite() {
+            return Err(format!("intensity {intensity} · 2^{exposure} overflows"));
+        }
+        let normalize = scalar(stage, prim, "normalize", 0.0)? != 0.0;
+        Ok(Emission { rgb, normalize })
+    }
+
+    /// The radiance of an area light of world-space area `area`.
+    pub fn radiance(&self, area: f64) -> Vec3 {
+        let size = if self.normalize { area } else { 1.0 };
+        (self.rgb / size).as_vec3()
+    }
+}
+
+/// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
+/// cone, focus and IES profile, light filters, the diffuse and specular multipliers, shadow
+/// controls, and (for `type_name`) a RectLight's texture and a CylinderLight's `treatAsLine`.
+pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
+    let mut notes = Vec::new();
+    let authored =
+        |name: &str| -> Result<Option<f64>, String> { Ok(input(stage, prim, name)?.and_then(|v| v.scalar())) };
+    if authored("shaping:cone:angle")?.is_some_and(|a| a < 90.0) {
+        notes.push("ShapingAPI cone angle not rendered (the light emits over its whole hemisphere)".into());
+    }
+    if authored("shaping:focus")?.is_some_and(|f| f > 0.0) {
+        notes.push("ShapingAPI focus not rendered".into());
+    }
+    if let Some(Value::Asset { authored, .. }) = input(stage, prim, "shaping:ies:file")?
+        && !authored.is_empty()
+    {
+        notes.push(format!("IES profile {authored} not rendered"));
+    }
+    if !stage.targets(prim, "light:filters")?.is_empty() {
+        notes.push("light filters not rendered".into());
+    }
+    for (name, what) in [("diffuse", "diffuse multiplier"), ("specular", "specular multiplier")] {
+        if authored(name)?.is_some_and(|v| v != 1.0) {
+            notes.push(format!("inputs:{name} ({what}) not rendered; the light is physical"));
+        }
+    }
+    if stage.value(prim, "inputs:shadow:enable")?.and_then(|v| v.scalar()) == Some(0.0) {
+        notes.push("ShadowAPI shadow:enable = false not honoured (the light casts shadows)".into());
+    }
+    if type_name == "RectLight"
+        && let Some(Value::Asset { authored, .. }) = input(stage, prim, "texture:file")?
+        && !authored.is_empty()
+    {
+        notes.push(format!("texture:file {authored} not rendered (the rectangle emits its colour)"));
+    }
+    if type_name == "CylinderLight" && stage.value(prim, "treatAsLine")?.and_then(|v| v.scalar()) == Some(1.0) {
+        notes.push("treatAsLine ignored (rendered as the cylinder)".into());
+    }
+    Ok(notes)
+}

@@ -1,0 +1,183 @@
+//! UsdLux lights (fixtures authored with Pixar's library by `tests/fixtures/make_lights.py`):
+//! each kind imports at its world position and size with the schema's radiance (intensity ·
+//! 2^exposure · color · blackbody, divided by the area with `normalize`); pre-21.02 names are
+//! read; dark, invisible and partly supported lights are notes; a NaN or negative input is an
+//! error naming the prim; the blackbody colour agrees with Pixar's (divided by its 6500 K
+//! colour, which the schema makes white) within 1% from 3000 K up and 5% below.
+
+use glam::Vec3;
+use host_usd::lights::{Emitter, UsdLight};
+use host_usd::{UsdError, UsdScene};
+use std::f32::consts::PI;
+use std::path::PathBuf;
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)
+}
+
+fn light<'a>(s: &'a UsdScene, path: &str) -> &'a UsdLight {
+    s.lights.iter().find(|l| l.path == path).unwrap_or_else(|| panic!("no light {path}: {:?}", s.skipped))
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() <= 1e-4 * b.length().max(1.0)
+}
+
+fn notes_of<'a>(s: &'a UsdScene, path: &str) -> Vec<&'a str> {
+    s.skipped.iter().filter(|k| k.path == path).map(|k| k.what.as_str()).collect()
+}
+
+#[test]
+fn each_kind_imports_at_its_place_and_size_with_the_schemas_radiance() {
+    let s = host_usd::load(&fixture("lights.usda")).unwrap();
+    let Emitter::Sphere { center, radius, radiance } = light(&s, "/World/Sphere").emitter else { panic!() };
+    assert!(close(center, Vec3::new(1.0, 2.0, 3.0)) && (radius - 1.0).abs() < 1e-6);
+    assert!(close(radiance, Vec3::new(6.0, 3.0, 1.5)), "3 · 2¹ · color: {radiance}");
+    // treatAsPoint: the sphere's intensity π r² L.
+    let Emitter::Point { position, intensity } = light(&s, "/World/Point").emitter else { panic!() };
+    assert!(close(position, Vec3::new(0.0, 4.0, 0.0)));
+    assert!(close(intensity, Vec3::splat(16.0 * PI * 0.0625)), "{intensity}");
+    // 2 × 0.5 scaled ×3 in X: 6 × 0.5 facing down, normalised by its area 3.
+    let Emitter::Rect { p0, e1, e2, radiance } = light(&s, "/World/Rect").emitter else { panic!() };
+    let normal = e1.cross(e2);
+    assert!(close(normal.normalize(), -Vec3::Y), "emits towards world −Y: {normal}");
+    assert!((normal.length() - 3.0).abs() < 1e-5);
+    assert!(close(p0 + 0.5 * (e1 + e2), Vec3::new(0.0, 3.0, 0.0)));
+    assert!(close(radiance, Vec3::splat(10.0)), "30 / 3: {radiance}");
+    // Turned −90° about Y: its −Z faces world +X; 3000 K is warm.
+    let Emitter::Disk { center, normal, radius, radiance } = light(&s, "/World/Disk").emitter else { panic!() };
+    assert!(close(center, Vec3::new(-2.0, 1.0, 0.0)) && close(normal, Vec3::X) && (radius - 0.4).abs() < 1e-6);
+    assert!(radiance.x > radiance.y && radiance.y > radiance.z && radiance.x > 5.0, "{radiance}");
+    let expected = host_usd::blackbody::rgb(3000.0).as_vec3() * 5.0;
+    assert!(close(radiance, expected));
+    // The default DistantLight: 0.53°, 50000 (not normalised), light from +Z turned by −30° about X.
+    let Emitter::Distant { direction, irradiance, angle_deg } = light(&s, "/World/Sun").emitter else { panic!() };
+    let t = (-30f32).to_radians();
+    assert!(close(direction, Vec3::new(0.0, -t.sin(), t.cos())), "{direction}");
+    assert!((angle_deg - 0.53).abs() < 1e-6);
+    let e = 50000.0 * PI * (0.5 * 0.53f32).to_radians().sin().powi(2);
+    assert!(close(irradiance, Vec3::splat(e)), "π sin²θ · L: {irradiance} vs {e}");
+    // Angle 0: a delta light whose intensity is its irradiance.
+    let Emitter::Distant { irradiance, angle_deg, .. } = light(&s, "/World/Delta").emitter else { panic!() };
+    assert!(angle_deg == 0.0 && close(irradiance, Vec3::splat(2.0)));
+    // A normalised CylinderLight: its tessellated side has the cylinder's area 2π r l.
+    let Emitter::Triangles { ref positions, ref triangles, radiance, two_sided } = light(&s, "/World/Tube").emitter
+    else {
+        panic!()
+    };
+    let area: f32 = triangles
+        .iter()
+        .map(|t| {
+            0.5 * (positions[t[1] as usize] - positions[t[0] as usize])
+                .cross(positions[t[2] as usize] - positions[t[0] as usize])
+                .length()
+        })
+        .sum();
+    assert!((area - 2.0 * PI * 0.1 * 2.0).abs() < 1e-4 * area, "{area}");
+    assert!(!two_sided && close(radiance, Vec3::splat(4.0 / area)));
+    // Each facet faces outwards from the axis (local X at y = 1, z = −2).
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let out = (a + b + c) / 3.0 - Vec3::new((a.x + b.x + c.x) / 3.0, 1.0, -2.0);
+        assert!((b - a).cross(c - a).dot(out) > 0.0);
+    }
+    // A doubleSided mesh light of area 1, normalised; its mesh is not also a surface.
+    let Emitter::Triangles { ref positions, radiance, two_sided, .. } = light(&s, "/World/Panel").emitter else {
+        panic!()
+    };
+    assert!(two_sided && close(radiance, Vec3::splat(2.0)) && close(positions[0], Vec3::new(5.0, 0.0, 0.0)));
+    assert!(s.meshes.is_empty(), "the MeshLightAPI mesh is a light only");
+    // Pre-21.02 names.
+    let Emitter::Rect { e1, e2, radiance, .. } = light(&s, "/World/OldRect").emitter else { panic!() };
+    assert!(
+        close(radiance, Vec3::new(3.5, 7.0, 7.0))
+            && (e2.length() - 0.5).abs() < 1e-6
+            && (e1.length() - 1.0).abs() < 1e-6
+    );
+}
+
+#[test]
+fn dark_hidden_and_partly_rendered_lights_are_notes() {
+    let s = host_usd::load(&fixture("lights.usda")).unwrap();
+    for (path, needle) in [
+        ("/World/Dark", "emits nothing"),
+        ("/World/NoSize", "radius 0"),
+        ("/World/Hidden", "invisible"),
+        ("/World/Spot", "cone angle"),
+        ("/World/Spot", "non-uniform scale"),
+        ("/World/Portal", "PortalLight not rendered"),
+    ] {
+        let notes = notes_of(&s, path);
+        assert!(notes.iter().any(|n| n.contains(needle)), "{path}: {needle:?} not in {notes:?}");
+    }
+    for path in ["/World/Dark", "/World/NoSize", "/World/Hidden", "/World/Portal"] {
+        assert!(s.lights.iter().all(|l| l.path != path), "{path} is not rendered");
+    }
+    // The spot still renders, as a sphere.
+    assert!(matches!(light(&s, "/World/Spot").emitter, Emitter::Sphere { .. }));
+    assert_eq!(s.lights.len(), 10, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
+}
+
+#[test]
+fn a_dome_takes_its_colour_temperature() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("dome.usda");
+    let dome = "def DomeLight \"D\" { bool inputs:enableColorTemperature = 1\n float inputs:colorTemperature = 4000 }";
+    std::fs::write(&file, format!("#usda 1.0\n{dome}\n")).unwrap();
+    let s = host_usd::load(&file).unwrap();
+    let expected = host_usd::blackbody::rgb(4000.0).as_vec3();
+    assert!(close(s.dome.unwrap().radiance, expected));
+    assert!(s.skipped.is_empty(), "{:?}", s.skipped);
+}
+
+#[test]
+fn a_z_up_stage_turns_its_lights_with_its_geometry() {
+    let s = host_usd::load(&fixture("lights_z.usda")).unwrap();
+    let Emitter::Distant { direction, .. } = light(&s, "/Up").emitter else { panic!() };
+    assert!(close(direction, Vec3::Y), "{direction}");
+}
+
+#[test]
+fn a_light_that_cannot_exist_is_an_error_naming_the_prim() {
+    let dir = tempfile::tempdir().unwrap();
+    for (body, needle) in [
+        ("def SphereLight \"L\" { float inputs:intensity = nan }", "inputs:intensity"),
+        ("def RectLight \"L\" { color3f inputs:color = (1, -1, 1) }", "inputs:color"),
+        ("def DiskLight \"L\" { float inputs:radius = -1 }", "inputs:radius"),
+        ("def DistantLight \"L\" { float inputs:intensity = -5 }", "negative"),
+    ] {
+        let file = dir.path().join("bad.usda");
+        std::fs::write(&file, format!("#usda 1.0\n{body}\n")).unwrap();
+        match host_usd::load(&file) {
+            Err(UsdError::Prim { prim, message, .. }) => {
+                assert_eq!(prim, "/L");
+                assert!(message.contains(needle), "{body}: {message}");
+            }
+            other => panic!("{body}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn the_blackbody_colour_is_pixars_up_to_the_schemas_white_at_6500_k() {
+    let text = std::fs::read_to_string(fixture("blackbody.json")).unwrap();
+    let pixar: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text).unwrap();
+    let rgb = |k: &str| -> [f64; 3] {
+        let v = pixar[k].as_array().unwrap();
+        [0, 1, 2].map(|c| v[c].as_f64().unwrap())
+    };
+    let white = rgb("6500");
+    for (k, _) in &pixar {
+        let p = rgb(k);
+        let kelvin: f64 = k.parse().unwrap();
+        let ours = host_usd::blackbody::rgb(kelvin);
+        // Pixar interpolates a table, host-usd integrates a fit of the CIE observer: they
+        // differ most where the locus bends fastest, below 3000 K.
+        let tolerance = if kelvin >= 3000.0 { 0.01 } else { 0.05 };
+        for c in 0..3 {
+            let expected = p[c] / white[c];
+            let d = (ours[c] - expected).abs();
+            assert!(d <= tolerance * expected.max(0.1), "{k} K channel {c}: {} vs {expected}", ours[c]);
+        }
+    }
+}
