@@ -29,6 +29,7 @@ fn render_mean(scene: &Scene, seed: u64) -> Vec<f64> {
         seed,
         progress: false,
         shadows: true,
+        lights: Default::default(),
     };
     let image = render(scene, &bvh, None, &settings);
     image.pixels.iter().map(|p| f64::from(p[0] + p[1] + p[2])).collect()
