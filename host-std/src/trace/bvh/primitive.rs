@@ -12,7 +12,7 @@ pub enum Primitive {
         center: Vec3,
         /// Radius.
         radius: f32,
-        /// What it is the surface of ([`super::Surface::id`]).
+        /// What it is the surface of: a [`super::Surface`] as an id.
         surface: u32,
     },
     /// v0 and two edges; the front face is normalize(e1 × e2).
@@ -23,7 +23,7 @@ pub enum Primitive {
         e1: Vec3,
         /// The edge from `v0` to the third vertex.
         e2: Vec3,
-        /// What it is the surface of ([`super::Surface::id`]).
+        /// What it is the surface of: a [`super::Surface`] as an id.
         surface: u32,
         /// Index into the corner attributes, or `NO_ATTRS` (face normal, no texture
         /// coordinates).
