@@ -63,7 +63,7 @@ def _frame_to_world(center, normal, scale):
     return M.tolist()
 
 def light_dict(l, base_dir, override=None):
-    """One entry of a scene's `lights` (scene JSON that `ppis` itself does not read) as a Mitsuba emitter or emitting shape."""
+    """One entry of a scene's `lights` (docs/scene-format.md) as a Mitsuba emitter or emitting shape."""
     import math
     import numpy as np
     import mitsuba as mi
