@@ -116,13 +116,7 @@ impl<'a> LightTree<'a> {
             if here.leaf {
                 return Some(SelectedLight { index: here.index as usize, pmf, u_remapped: u });
             }
-            let (first, second) = (node + 1, here.index as usize);
-            let (a, b) =
-                (self.nodes[first].bounds.importance(p, n) as f64, self.nodes[second].bounds.importance(p, n) as f64);
-            if a + b <= 0.0 || (a + b).is_nan() {
-                return None;
-            }
-            let p_first = a / (a + b);
+            let (first, second, p_first) = self.children(node, p, n)?;
             if u < p_first {
                 (node, pmf, u) = (first, pmf * p_first, (u / p_first).min(ONE_BELOW));
             } else {
@@ -141,19 +135,26 @@ impl<'a> LightTree<'a> {
             if here.leaf {
                 return if here.index as usize == index { pmf } else { 0.0 };
             }
-            let (first, second) = (node + 1, here.index as usize);
-            let (a, b) =
-                (self.nodes[first].bounds.importance(p, n) as f64, self.nodes[second].bounds.importance(p, n) as f64);
-            if a + b <= 0.0 || (a + b).is_nan() {
-                return 0.0;
-            }
+            let Some((first, second, p_first)) = self.children(node, p, n) else { return 0.0 };
             if path >> depth & 1 == 0 {
-                (node, pmf) = (first, pmf * a / (a + b));
+                (node, pmf) = (first, pmf * p_first);
             } else {
-                (node, pmf) = (second, pmf * b / (a + b));
+                (node, pmf) = (second, pmf * (1.0 - p_first));
             }
         }
         0.0
+    }
+
+    /// The children of the inner node `node` and the probability of descending into the first
+    /// at `p` with normal `n`, in proportion to their importances there; `None` where neither
+    /// can light the point.
+    #[inline]
+    fn children(&self, node: usize, p: glam::Vec3, n: glam::Vec3) -> Option<(usize, usize, f64)> {
+        let (first, second) = (node + 1, self.nodes[node].index as usize);
+        let a = self.nodes[first].bounds.importance(p, n) as f64;
+        let b = self.nodes[second].bounds.importance(p, n) as f64;
+        let total = a + b;
+        (total > 0.0 && !total.is_nan()).then(|| (first, second, a / total))
     }
 }
 
