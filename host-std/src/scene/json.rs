@@ -8,7 +8,7 @@ use crate::scene::json_lights::{self, JsonLight};
 use crate::scene::mesh;
 use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::brdf::{CarPaint, Lambert, Phong, RoughConductor};
-use sampler_core::glam::{Mat4, Vec3};
+use sampler_core::glam::Vec3;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -241,13 +241,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 if !face_normals {
                     return Err(invalid(format!("shapes[{k}]: only face normals are supported (face_normals: true)")));
                 }
-                let file = dir.join(file);
-                let (mut positions, triangles) = mesh::load(&file)?;
-                if let Some(m) = to_world {
-                    // Row-major in the file; glam is column-major.
-                    let m = Mat4::from_cols_array_2d(&m).transpose();
-                    positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
-                }
+                let (positions, triangles) = mesh::load_placed(&dir.join(file), to_world)?;
                 (Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() }, material)
             }
         };

@@ -4,8 +4,9 @@
 //! naming it and what is wrong.
 
 use crate::scene::mesh;
-use sampler_core::glam::{Mat4, Vec3};
-use sampler_core::light::{DiskLight, DistantLight, PointLight, RectLight, SceneLight, SphereLight, TriangleLight};
+use crate::scene::mesh_light::push_triangle_lights;
+use sampler_core::glam::Vec3;
+use sampler_core::light::{DiskLight, DistantLight, PointLight, RectLight, SceneLight, SphereLight};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -86,25 +87,13 @@ pub(super) fn lights_of(light: JsonLight, dir: &Path) -> Result<Vec<SceneLight>,
     })
 }
 
-/// The triangles of a mesh light, each a light (faces without an area are left out: they emit
-/// nothing and no ray meets them).
+/// The triangles of a mesh light, each a light (faces without an area are left out).
 fn mesh_light(file: &Path, to_world: Option<[[f32; 4]; 4]>, radiance: Vec3) -> Result<Vec<SceneLight>, String> {
-    let (mut positions, triangles) = mesh::load(file).map_err(|e| e.to_string())?;
-    if let Some(m) = to_world {
-        // Row-major in the file; glam is column-major.
-        let m = Mat4::from_cols_array_2d(&m).transpose();
-        positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
-    }
+    let (positions, triangles) = mesh::load_placed(file, to_world).map_err(|e| e.to_string())?;
     let mut lights = Vec::with_capacity(triangles.len());
-    for t in &triangles {
-        match TriangleLight::new(t.map(|i| positions[i as usize]), radiance) {
-            Ok(l) => lights.push(l.into()),
-            Err(sampler_core::light::LightError::ZeroArea) => {}
-            Err(e) => return Err(format!("{}: {e}", file.display())),
-        }
+    match push_triangle_lights(&positions, &triangles, radiance, false, &mut lights) {
+        Ok(0) => Err(format!("{}: no face of the mesh has an area", file.display())),
+        Ok(_) => Ok(lights),
+        Err(e) => Err(format!("{}: {e}", file.display())),
     }
-    if lights.is_empty() {
-        return Err(format!("{}: no face of the mesh has an area", file.display()));
-    }
-    Ok(lights)
 }

@@ -1,7 +1,7 @@
 //! Triangle meshes from OBJ (`tobj`) and PLY (`ply.rs`) files: positions and triangles only
 //! (the scene format uses face normals). Polygons are fan-triangulated; indices are checked.
 
-use sampler_core::glam::Vec3;
+use sampler_core::glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 
 /// Why a mesh cannot be loaded.
@@ -39,6 +39,18 @@ pub enum MeshError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// Positions and triangles of a mesh file, its positions moved by `to_world` where given (the
+/// scene format's row-major 4×4 matrix).
+pub fn load_placed(path: &Path, to_world: Option<[[f32; 4]; 4]>) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), MeshError> {
+    let (mut positions, triangles) = load(path)?;
+    if let Some(m) = to_world {
+        // Row-major in the file; glam is column-major.
+        let m = Mat4::from_cols_array_2d(&m).transpose();
+        positions.iter_mut().for_each(|p| *p = m.transform_point3(*p));
+    }
+    Ok((positions, triangles))
 }
 
 /// Positions and triangles of a mesh file.

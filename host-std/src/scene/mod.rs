@@ -6,6 +6,7 @@ pub mod builtin;
 pub mod json;
 mod json_lights;
 pub mod mesh;
+mod mesh_light;
 mod model;
 pub mod ply;
 pub mod texture;

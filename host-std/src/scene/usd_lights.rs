@@ -2,10 +2,9 @@
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
 //! light per face with an area. A light the core cannot build is a note naming its prim.
 
+use crate::scene::mesh_light::push_triangle_lights;
 use host_usd::lights::{Emitter, UsdLight};
-use sampler_core::light::{
-    DiskLight, DistantLight, LightError, PointLight, RectLight, SceneLight, SphereLight, TriangleLight,
-};
+use sampler_core::light::{DiskLight, DistantLight, LightError, PointLight, RectLight, SceneLight, SphereLight};
 
 /// The core's lights for `lights`, with a note in `notes` for each one that cannot be built.
 pub(crate) fn convert(lights: &[UsdLight], notes: &mut Vec<String>) -> Vec<SceneLight> {
@@ -30,18 +29,7 @@ fn push(e: &Emitter, out: &mut Vec<SceneLight>) -> Result<(), LightError> {
             out.push(DistantLight::new(*direction, *irradiance, angle_deg.to_radians())?.into())
         }
         Emitter::Triangles { positions, triangles, radiance, two_sided } => {
-            let before = out.len();
-            for t in triangles {
-                match TriangleLight::new(t.map(|i| positions[i as usize]), *radiance) {
-                    Ok(l) => out.push(l.with_two_sided(*two_sided).into()),
-                    // A face without an area emits nothing and no ray meets it.
-                    Err(LightError::ZeroArea) => {}
-                    Err(e) => {
-                        out.truncate(before);
-                        return Err(e);
-                    }
-                }
-            }
+            push_triangle_lights(positions, triangles, *radiance, *two_sided, out)?;
         }
     }
     Ok(())

@@ -1,0 +1,30 @@
+//! A mesh light as the core's lights: one triangle light per face with an area (a face without
+//! one emits nothing and no ray meets it), for the scene format's `mesh` lights and USD's mesh
+//! and cylinder lights alike.
+
+use sampler_core::glam::Vec3;
+use sampler_core::light::SceneLight;
+use sampler_core::light::{LightError, TriangleLight};
+
+/// Appends the triangle lights of the mesh (`positions`, `triangles`) emitting `radiance`, on both
+/// sides when `two_sided`, to `out`; returns how many. On an error `out` is left as it was.
+pub(crate) fn push_triangle_lights(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    radiance: Vec3,
+    two_sided: bool,
+    out: &mut Vec<SceneLight>,
+) -> Result<usize, LightError> {
+    let before = out.len();
+    for t in triangles {
+        match TriangleLight::new(t.map(|i| positions[i as usize]), radiance) {
+            Ok(l) => out.push(l.with_two_sided(two_sided).into()),
+            Err(LightError::ZeroArea) => {}
+            Err(e) => {
+                out.truncate(before);
+                return Err(e);
+            }
+        }
+    }
+    Ok(out.len() - before)
+}
