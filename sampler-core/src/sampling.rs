@@ -54,6 +54,23 @@ pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(d.x, d.y, z)
 }
 
+/// [`square_to_cosine_hemisphere`] for four points (`ux`, `uy` their coordinates), bit for bit:
+/// the concentric map's branches by selects. Returns the directions' x, y and z.
+#[inline]
+#[must_use]
+pub fn square_to_cosine_hemisphere_x4(ux: Vec4, uy: Vec4) -> [Vec4; 3] {
+    let sp = Vec4::splat;
+    let (a, b) = (sp(2.0) * ux - sp(1.0), sp(2.0) * uy - sp(1.0));
+    let wide = a.abs().cmpgt(b.abs());
+    let r = Vec4::select(wide, a, b);
+    let turn = Vec4::select(wide, sp(0.125) * (b / a), sp(0.25) - sp(0.125) * (a / b));
+    let (s, c) = sin_cos_2pi_x4(Vec4::select(turn.cmplt(Vec4::ZERO), turn + sp(1.0), turn));
+    let centre = a.cmpeq(Vec4::ZERO) & b.cmpeq(Vec4::ZERO);
+    let (x, y) = (Vec4::select(centre, Vec4::ZERO, r * c), Vec4::select(centre, Vec4::ZERO, r * s));
+    let z = crate::mapping::sqrt4((sp(1.0) - (x * x + y * y)).max(Vec4::ZERO));
+    [x, y, z]
+}
+
 /// Density of [`square_to_cosine_hemisphere`] with respect to solid angle.
 #[inline]
 #[must_use]
@@ -144,6 +161,25 @@ pub fn basis_around(a: Vec3) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The four-wide cosine warp is the scalar one's bits, on a grid that includes the centre,
+    /// the diagonals and the edges.
+    #[test]
+    fn cosine_hemisphere_x4_is_the_scalar_warp() {
+        let n = 64;
+        let grid = |i: usize| Vec2::new((i % (n + 1)) as f32, (i / (n + 1)) as f32) / n as f32;
+        for first in (0..(n + 1) * (n + 1) - 3).step_by(4) {
+            let quad: [Vec2; 4] = core::array::from_fn(|k| grid(first + k));
+            let [x, y, z] = square_to_cosine_hemisphere_x4(
+                Vec4::new(quad[0].x, quad[1].x, quad[2].x, quad[3].x),
+                Vec4::new(quad[0].y, quad[1].y, quad[2].y, quad[3].y),
+            );
+            for (k, u) in quad.iter().enumerate() {
+                let v = square_to_cosine_hemisphere(*u);
+                assert_eq!([x[k], y[k], z[k]].map(f32::to_bits), v.to_array().map(f32::to_bits), "{u}");
+            }
+        }
+    }
 
     #[test]
     fn cosine_hemisphere_stays_on_top() {

@@ -103,18 +103,14 @@ impl Brdf for RoughConductor {
         if wo.z <= 0.0 {
             return 0;
         }
-        // Per view, once: the stretched view and G1(wo)/(4 cosθo).
+        // Per view, once: G1(wo)/(4 cosθo). m is the half vector of (wo, wi) by construction:
+        // D is evaluated at it without recomputing it.
         let g = &self.ggx;
-        let w = g.stretch(wo);
         let spec = luminance(self.specular);
         let k = spec * g.g1(wo) / (4.0 * wo.z);
-        for (p, o) in u.iter().zip(out.iter_mut()) {
-            let m = g.sample_visible_stretched(w, *p);
-            let wi = reflect(wo, m);
-            // m is the half vector of (wo, wi) by construction: no need to recompute it.
-            *o = BrdfDraw { wi, value: g.d(m) * g.g1(wi) * k };
-        }
-        u.len().min(out.len())
+        let n = u.len().min(out.len());
+        self.sample_batch_x4(wo, k, &u[..n], &mut out[..n]);
+        n
     }
 }
 

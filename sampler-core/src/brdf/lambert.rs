@@ -3,9 +3,9 @@
 use super::{Brdf, BrdfDraw, BrdfSample};
 use crate::cone::Cone;
 use crate::env::luminance;
-use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf, square_to_cosine_hemisphere_x4};
 use core::f32::consts::FRAC_1_PI;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// f = albedo / π, sampled ∝ cosθ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,10 +47,17 @@ impl Brdf for Lambert {
         if wo.z <= 0.0 {
             return 0;
         }
-        let albedo = luminance(self.albedo);
-        for (p, o) in u.iter().zip(out.iter_mut()) {
-            let wi = square_to_cosine_hemisphere(*p);
-            *o = BrdfDraw { wi, value: albedo * FRAC_1_PI * wi.z.max(0.0) };
+        // Four at a time: the same bits as one by one (`square_to_cosine_hemisphere_x4`).
+        let scale = Vec4::splat(luminance(self.albedo) * FRAC_1_PI);
+        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
+            let at = |j: usize| us.get(j).copied().unwrap_or(Vec2::ZERO);
+            let (ux, uy) =
+                (Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x), Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y));
+            let [x, y, z] = square_to_cosine_hemisphere_x4(ux, uy);
+            let value = scale * z.max(Vec4::ZERO);
+            for (j, o) in os.iter_mut().take(us.len()).enumerate() {
+                *o = BrdfDraw { wi: Vec3::new(x[j], y[j], z[j]), value: value[j] };
+            }
         }
         u.len().min(out.len())
     }

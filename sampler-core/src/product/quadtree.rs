@@ -35,6 +35,9 @@ pub const FILL_PRIOR: f32 = 2.0;
 /// Samples in a parent from which an empty child's B̃ also looks at B at its centre.
 pub const EVAL_EMPTY_FROM: usize = 4;
 
+/// Samples in a node from which its split searches for its children's bounds instead of counting.
+const SEARCH_FROM: usize = 32;
+
 /// Bits per axis of the quantised square coordinates; also the largest possible depth.
 pub const COORD_BITS: u32 = 24;
 
@@ -263,9 +266,15 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     }
 
     /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
-    /// sorted, so counting each of the next two Morton bits' digits gives them (cheaper than
-    /// three binary searches for the short runs that make up most of the tree).
+    /// sorted by the next two Morton bits' digit, so three binary searches find them in a long
+    /// run, and counting each digit in a short one (most of the tree's runs, where a scan costs
+    /// less than the searches' unpredictable branches).
     fn split(&self, depth: u32, lo: usize, hi: usize) -> [usize; 5] {
+        if hi - lo >= SEARCH_FROM {
+            let run = &self.keys[lo..hi];
+            let below = |d: usize| lo + run.partition_point(|&k| digit(k, depth) < d);
+            return [lo, below(1), below(2), below(3), hi];
+        }
         // Register accumulators (an array of counters would chain through memory).
         let (mut below1, mut below2, mut below3) = (0usize, 0usize, 0usize);
         for &k in &self.keys[lo..hi] {
