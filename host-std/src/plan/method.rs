@@ -90,12 +90,14 @@ impl Method {
     /// built per shading point the power of two nearest √(build cost / sample cost), the
     /// split that minimises error × time when a point's light and its footprint vary alike
     /// (docs/tuning.md, "Shading points per pixel"). SIS and Lightcuts shade every stratum or a
-    /// whole cut at each shading point, whatever the budget: one "sample" per point, so that
-    /// spp counts their shading points.
+    /// whole cut at each shading point, whatever the budget, so for them V only sets P = spp/V:
+    /// 64, so that a point costs about what its 64 samples cost the sampling methods (a few
+    /// hundred shadow rays and BRDF evaluations) and `ppis report`'s spp range suits them too.
     #[must_use]
     pub fn samples_per_point(self) -> usize {
         match self {
-            Method::Env | Method::Brdf | Method::Ris | Method::Sis | Method::Lightcuts => 1,
+            Method::Env | Method::Brdf | Method::Ris => 1,
+            Method::Sis | Method::Lightcuts => 64,
             Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
             Method::TwoLevel => 2,
             Method::TwoStage => 4,
