@@ -239,6 +239,7 @@ fn sis_strata_and_lightcuts_allocate_nothing() {
     let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
     let m = cells_len(&env);
     let (mut dirs, mut nearest, mut labels) = (vec![Vec3::ZERO; m], vec![0.0; m], vec![0u32; m]);
+    let mut intensity = vec![0.0f32; m];
     let mut strata = vec![Stratum::default(); 300];
     let mut lights = vec![CutLight { kind: CutLightKind::Point, at: Vec3::ZERO, intensity: Vec3::ZERO }; 310];
     let mut order = vec![0u32; lights.len()];
@@ -247,7 +248,13 @@ fn sis_strata_and_lightcuts_allocate_nothing() {
     let brdf = RoughConductor::new(0.2, Vec3::ONE);
     let mut rng = Pcg32::new(4, 5);
     ARMED.with(|a| a.set(true));
-    let buffers = SisBuffers { dirs: &mut dirs, nearest: &mut nearest, labels: &mut labels, strata: &mut strata };
+    let buffers = SisBuffers {
+        dirs: &mut dirs,
+        intensity: &mut intensity,
+        nearest: &mut nearest,
+        labels: &mut labels,
+        strata: &mut strata,
+    };
     let count = build_strata(&env, buffers).unwrap();
     for (light, s) in lights.iter_mut().zip(&strata[..count]) {
         *light = CutLight { kind: CutLightKind::Directional, at: s.dir, intensity: s.irradiance.as_vec3() };

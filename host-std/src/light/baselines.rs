@@ -20,8 +20,15 @@ use sampler_core::sis::{SisBuffers, Stratum, build_strata, cells_len};
 pub fn sis_strata(env: &EnvHierarchy<'_>, n: usize) -> Vec<Stratum> {
     let m = cells_len(env);
     let (mut dirs, mut nearest, mut labels) = (vec![Vec3::ZERO; m], vec![0.0; m], vec![0u32; m]);
+    let mut intensity = vec![0.0f32; m];
     let mut strata = vec![Stratum::default(); n.max(1)];
-    let buffers = SisBuffers { dirs: &mut dirs, nearest: &mut nearest, labels: &mut labels, strata: &mut strata };
+    let buffers = SisBuffers {
+        dirs: &mut dirs,
+        intensity: &mut intensity,
+        nearest: &mut nearest,
+        labels: &mut labels,
+        strata: &mut strata,
+    };
     let count = build_strata(env, buffers).expect("buffers sized by cells_len, at least one stratum");
     strata.truncate(count);
     strata.retain(|s| s.irradiance.max_element() > 0.0);

@@ -262,10 +262,17 @@ mod tests {
         let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
         let m = cells_len(&env);
         let (mut dirs, mut nearest, mut labels) = (vec![Vec3::ZERO; m], vec![0.0; m], vec![0u32; m]);
+        let mut intensity = vec![0.0f32; m];
         let mut strata = vec![Stratum::default(); n];
         let count = build_strata(
             &env,
-            SisBuffers { dirs: &mut dirs, nearest: &mut nearest, labels: &mut labels, strata: &mut strata },
+            SisBuffers {
+                dirs: &mut dirs,
+                intensity: &mut intensity,
+                nearest: &mut nearest,
+                labels: &mut labels,
+                strata: &mut strata,
+            },
         )
         .unwrap();
         let mut out: Vec<CutLight> = strata[..count]

@@ -76,17 +76,20 @@ pub fn stratify_level(env: &EnvHierarchy<'_>) -> u32 {
     env.finest_level().min(MAX_STRATIFY_LEVEL)
 }
 
-/// Cells of scratch (`dirs`, `nearest`, `labels`) [`build_strata`] needs for `env`.
+/// Cells of scratch (`dirs`, `intensity`, `nearest`, `labels`) [`build_strata`] needs for
+/// `env`.
 #[must_use]
 pub fn cells_len(env: &EnvHierarchy<'_>) -> usize {
     1 << (2 * stratify_level(env))
 }
 
-/// The caller's buffers of a stratification: per cell ([`cells_len`]) its direction, the
-/// cosine to its nearest centre, and its stratum; per stratum (N) its light.
+/// The caller's buffers of a stratification: per cell ([`cells_len`]) its direction, its
+/// intensity, the cosine to its nearest centre, and its stratum; per stratum (N) its light.
 pub struct SisBuffers<'a> {
     /// Per cell: its centre's world direction.
     pub dirs: &'a mut [Vec3],
+    /// Per cell: its intensity relative to the map's mean.
+    pub intensity: &'a mut [f32],
     /// Per cell: the cosine of the angle to its nearest centre.
     pub nearest: &'a mut [f32],
     /// Per cell (row-major): the stratum it belongs to.
@@ -99,7 +102,7 @@ pub struct SisBuffers<'a> {
 /// fewer cells, or fewer lit cells than a layer asks for); returns how many. A black map gives
 /// strata of zero irradiance.
 pub fn build_strata(env: &EnvHierarchy<'_>, buffers: SisBuffers<'_>) -> Result<usize, SisError> {
-    let SisBuffers { dirs, nearest, labels, strata } = buffers;
+    let SisBuffers { dirs, intensity, nearest, labels, strata } = buffers;
     let n = strata.len();
     if n == 0 {
         return Err(SisError::NoStrata);
@@ -107,35 +110,43 @@ pub fn build_strata(env: &EnvHierarchy<'_>, buffers: SisBuffers<'_>) -> Result<u
     let level = stratify_level(env);
     let side = 1u32 << level;
     let m = (side * side) as usize;
-    if dirs.len() < m || nearest.len() < m || labels.len() < m {
+    if dirs.len() < m || intensity.len() < m || nearest.len() < m || labels.len() < m {
         return Err(SisError::BufferTooSmall);
     }
     let (dirs, nearest, labels) = (&mut dirs[..m], &mut nearest[..m], &mut labels[..m]);
-    let intensity = |k: usize| env.node_relative(Cell::new(level, k as u32 % side, k as u32 / side));
+    let intensity = &mut intensity[..m];
     let inv = 1.0 / side as f32;
-    for (k, d) in dirs.iter_mut().enumerate() {
+    for (k, (d, l)) in dirs.iter_mut().zip(intensity.iter_mut()).enumerate() {
         let (x, y) = (k as u32 % side, k as u32 / side);
         *d = env.dir_of(Vec2::new((x as f32 + 0.5) * inv, (y as f32 + 0.5) * inv));
+        *l = env.node_relative(Cell::new(level, x, y));
     }
     nearest.iter_mut().for_each(|c| *c = -2.0);
-    let sigma = std_dev(m, &intensity);
-    let layer_of = |k: usize| layer(intensity(k), sigma);
-    let quotas = layer_quotas(m, n, &intensity, &layer_of);
+    let sigma = std_dev(intensity);
+    let quotas = layer_quotas(intensity, n, sigma);
     let mut centres = 0usize;
     let mut carry = 0usize;
     for j in (0..LAYERS).rev() {
         let mut quota = quotas[j] + carry;
+        let eligible = |k: usize| layer(intensity[k], sigma) >= j;
+        // The first centre of a layer by a scan; the next ones found while the nearest
+        // cosines are updated.
+        let mut next = farthest(centres, nearest, intensity, eligible);
         while quota > 0 && centres < n {
-            let Some(k) = next_centre(centres, nearest, &intensity, |k| layer_of(k) >= j) else { break };
+            let Some(k) = next else { break };
+            (nearest[k], labels[k]) = (CENTRE, centres as u32);
             let c = dirs[k];
+            let mut best: Option<(f32, usize)> = None;
             for (i, d) in dirs.iter().enumerate() {
                 let cos = d.dot(c);
                 if cos > nearest[i] {
                     (nearest[i], labels[i]) = (cos, centres as u32);
                 }
+                if nearest[i] < CENTRE && best.is_none_or(|(b, _)| nearest[i] < b) && eligible(i) {
+                    best = Some((nearest[i], i));
+                }
             }
-            // The centre is its own nearest, whatever rounding says.
-            (nearest[k], labels[k]) = (2.0, centres as u32);
+            next = best.map(|(_, i)| i);
             strata[centres] = Stratum { dir: c, ..Stratum::default() };
             centres += 1;
             quota -= 1;
@@ -147,15 +158,15 @@ pub fn build_strata(env: &EnvHierarchy<'_>, buffers: SisBuffers<'_>) -> Result<u
 }
 
 /// The standard deviation of the cells' intensities.
-fn std_dev(m: usize, intensity: &impl Fn(usize) -> f32) -> f32 {
+fn std_dev(intensity: &[f32]) -> f32 {
     let (mut s, mut s2) = (0.0f64, 0.0f64);
-    for k in 0..m {
-        let l = intensity(k) as f64;
-        s += l;
-        s2 += l * l;
+    for &l in intensity {
+        s += l as f64;
+        s2 += l as f64 * l as f64;
     }
-    let mean = s / m as f64;
-    libm::sqrt((s2 / m as f64 - mean * mean).max(0.0)) as f32
+    let m = intensity.len() as f64;
+    let mean = s / m;
+    libm::sqrt((s2 / m - mean * mean).max(0.0)) as f32
 }
 
 /// The layer of a cell of intensity `l`: ⌊l/σ⌋, at most the last.
@@ -164,17 +175,13 @@ fn layer(l: f32, sigma: f32) -> usize {
 }
 
 /// Strata per layer: N in proportion to each layer's Γ = L̄^a Δω^b, by largest remainders.
-fn layer_quotas(
-    m: usize,
-    n: usize,
-    intensity: &impl Fn(usize) -> f32,
-    layer_of: &impl Fn(usize) -> usize,
-) -> [usize; LAYERS] {
+fn layer_quotas(intensity: &[f32], n: usize, sigma: f32) -> [usize; LAYERS] {
+    let m = intensity.len();
     let (mut count, mut sum) = ([0usize; LAYERS], [0.0f64; LAYERS]);
-    for k in 0..m {
-        let j = layer_of(k);
+    for &l in intensity {
+        let j = layer(l, sigma);
         count[j] += 1;
-        sum[j] += intensity(k) as f64;
+        sum[j] += l as f64;
     }
     let cell_solid_angle = FULL_SPHERE / m as f64;
     let mut gamma = [0.0f64; LAYERS];
@@ -208,22 +215,20 @@ fn layer_quotas(
     quotas
 }
 
+/// The nearest-centre cosine that marks a centre (above any cosine).
+const CENTRE: f32 = 2.0;
+
 /// The next centre among the cells `eligible` holds for: the first centre at the brightest
 /// cell, then the cell farthest from every centre so far (the smallest cosine to its nearest;
 /// the lowest index among equals). `None` where every eligible cell is a centre.
-fn next_centre(
-    placed: usize,
-    nearest: &[f32],
-    intensity: &impl Fn(usize) -> f32,
-    eligible: impl Fn(usize) -> bool,
-) -> Option<usize> {
+fn farthest(placed: usize, nearest: &[f32], intensity: &[f32], eligible: impl Fn(usize) -> bool) -> Option<usize> {
     let mut best: Option<(f32, usize)> = None;
     for (k, &cos) in nearest.iter().enumerate() {
-        if cos >= 2.0 || !eligible(k) {
+        if cos >= CENTRE || !eligible(k) {
             continue;
         }
         // Before any centre, the brightest cell is the farthest.
-        let key = if placed == 0 { -intensity(k) } else { cos };
+        let key = if placed == 0 { -intensity[k] } else { cos };
         if best.is_none_or(|(b, _)| key < b) {
             best = Some((key, k));
         }
@@ -289,8 +294,15 @@ mod tests {
     fn strata(env: &EnvHierarchy<'_>, n: usize) -> (Vec<Stratum>, Vec<u32>) {
         let m = cells_len(env);
         let (mut dirs, mut nearest, mut labels) = (vec![Vec3::ZERO; m], vec![0.0; m], vec![0u32; m]);
+        let mut intensity = vec![0.0f32; m];
         let mut strata = vec![Stratum::default(); n];
-        let buffers = SisBuffers { dirs: &mut dirs, nearest: &mut nearest, labels: &mut labels, strata: &mut strata };
+        let buffers = SisBuffers {
+            dirs: &mut dirs,
+            intensity: &mut intensity,
+            nearest: &mut nearest,
+            labels: &mut labels,
+            strata: &mut strata,
+        };
         let count = build_strata(env, buffers).unwrap();
         strata.truncate(count);
         (strata, labels)
@@ -360,10 +372,12 @@ mod tests {
         let (strata, labels) = strata(&env, 100);
         assert_eq!((strata.len(), labels.len()), (16, 16), "one stratum per cell at most");
         let (mut d, mut c, mut l) = (vec![Vec3::ZERO; 16], vec![0.0; 16], vec![0; 16]);
-        let empty = SisBuffers { dirs: &mut d, nearest: &mut c, labels: &mut l, strata: &mut [] };
+        let mut i = vec![0.0f32; 16];
+        let empty = SisBuffers { dirs: &mut d, intensity: &mut i, nearest: &mut c, labels: &mut l, strata: &mut [] };
         assert_eq!(build_strata(&env, empty), Err(SisError::NoStrata));
         let mut one = [Stratum::default()];
-        let short = SisBuffers { dirs: &mut d[..3], nearest: &mut c, labels: &mut l, strata: &mut one };
+        let short =
+            SisBuffers { dirs: &mut d[..3], intensity: &mut i, nearest: &mut c, labels: &mut l, strata: &mut one };
         assert_eq!(build_strata(&env, short), Err(SisError::BufferTooSmall));
     }
 }
