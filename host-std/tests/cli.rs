@@ -49,6 +49,11 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["info", "--no-such-flag"], "--no-such-flag");
     fails(dir, &["report", "--methods", "mis,nope"], "nope");
     fails(dir, &["report", "--spp", "0"], "--spp");
+    // The baselines' parameters.
+    fails(dir, &["render", "--method", "sis", "--sis-lights", "0"], "--sis-lights");
+    fails(dir, &["render", "--method", "lightcuts", "--lightcut-error", "0"], "--lightcut-error");
+    fails(dir, &["render", "--method", "lightcuts", "--lightcut-error=-0.1"], "--lightcut-error");
+    fails(dir, &["report", "--methods", "sis", "--sis-lights=-3"], "--sis-lights");
     // A K above the largest arena names both; no silent clamp.
     fails(
         dir,

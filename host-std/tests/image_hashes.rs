@@ -35,6 +35,8 @@ const EXPECTED: &[(&str, u64)] = &[
     ("default/two-stage", 0x0de22621b956bfb7),
     ("default/two-level", 0x3ca8f671241ecd42),
     ("default/two-level-mis", 0xda44e5951cd4798e),
+    ("default/sis", 0xd5fd282a7d493f4b),
+    ("default/lightcuts", 0xee84e2a10fe97911),
     ("default/auto", 0x50d04501c3043ed6),
     ("default/product-mis unshadowed", 0x956ede7ab6519a50),
     ("twins.json/product-mis", 0x11fdfd0798bb34f9),

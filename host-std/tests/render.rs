@@ -37,7 +37,7 @@ fn the_image_is_bit_identical_at_any_thread_count() {
     scene.camera.height = 36;
     let env = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
     // Product-MIS reuses samplers from pixel to pixel within a tile: still thread-independent.
-    for method in [Method::Product, Method::ProductMis, Method::Mis, Method::Auto] {
+    for method in [Method::Product, Method::ProductMis, Method::Mis, Method::Auto, Method::Sis, Method::Lightcuts] {
         let s = settings(method, 8, 2);
         let one = render_with_threads(&scene, &env, &s, 1);
         for threads in [2, 8] {
@@ -84,7 +84,14 @@ fn white_furnace_every_method_converges_to_albedo_times_radiance() {
         let mean: f64 = pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64;
         let var: f64 = pixels.iter().map(|p| (p[1] as f64 - mean).powi(2)).sum::<f64>() / (pixels.len() - 1) as f64;
         let se = (var / pixels.len() as f64).sqrt();
-        assert!((mean - 1.0).abs() < 3.0 * se + 2e-3, "{method}: furnace mean {mean} (SE {se})");
+        // The deterministic baselines within their stated bias (docs/renderer.md): SIS's
+        // strata, and Lightcuts' cut, whose clusters each stay under 2% of the total.
+        let bias = match method {
+            Method::Sis => 5e-3,
+            Method::Lightcuts => 0.04,
+            _ => 0.0,
+        };
+        assert!((mean - 1.0).abs() < 3.0 * se + 2e-3 + bias, "{method}: furnace mean {mean} (SE {se})");
     }
 }
 

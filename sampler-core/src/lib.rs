@@ -60,7 +60,7 @@ pub mod points;
 pub mod rng;
 pub mod sampling;
 
-pub use baselines::{two_level, two_stage};
+pub use baselines::{lightcuts, sis, two_level, two_stage};
 pub use product::{bilinear, quadtree, sampler, wavelet};
 pub use sphere::{cell, cone, latlong, mapping, warp};
 

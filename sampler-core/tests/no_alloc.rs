@@ -223,3 +223,54 @@ fn wavefront(sampler: &ProductSampler<'_, '_>, sp: &ShadingPoint<'_, dyn Brdf + 
     }
     sink
 }
+
+/// The seed's baselines: structured importance sampling's strata and a Lightcuts tree built
+/// into caller buffers, and 1 000 cuts.
+#[test]
+fn sis_strata_and_lightcuts_allocate_nothing() {
+    use sampler_core::lightcuts::{CutEntry, CutLight, CutLightKind, CutNode, LightcutTree, lightcut};
+    use sampler_core::sis::{SisBuffers, Stratum, build_strata, cells_len};
+    let level = 6;
+    let n = 1usize << level;
+    let mut rgb = vec![[0.2f32, 0.3, 0.5]; n * n];
+    rgb[n * 20 + 40] = [1e4; 3];
+    let mut pyramid = vec![0.0; pyramid_len(level)];
+    build_pyramid(level, &rgb, &mut pyramid).unwrap();
+    let env = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
+    let m = cells_len(&env);
+    let (mut dirs, mut nearest, mut labels) = (vec![Vec3::ZERO; m], vec![0.0; m], vec![0u32; m]);
+    let mut intensity = vec![0.0f32; m];
+    let mut strata = vec![Stratum::default(); 300];
+    let mut lights = vec![CutLight { kind: CutLightKind::Point, at: Vec3::ZERO, intensity: Vec3::ZERO }; 310];
+    let mut order = vec![0u32; lights.len()];
+    let mut nodes = vec![CutNode::default(); LightcutTree::nodes_len(lights.len())];
+    let mut heap = vec![CutEntry::default(); 1000];
+    let brdf = RoughConductor::new(0.2, Vec3::ONE);
+    let mut rng = Pcg32::new(4, 5);
+    ARMED.with(|a| a.set(true));
+    let buffers = SisBuffers {
+        dirs: &mut dirs,
+        intensity: &mut intensity,
+        nearest: &mut nearest,
+        labels: &mut labels,
+        strata: &mut strata,
+    };
+    let count = build_strata(&env, buffers).unwrap();
+    for (light, s) in lights.iter_mut().zip(&strata[..count]) {
+        *light = CutLight { kind: CutLightKind::Directional, at: s.dir, intensity: s.irradiance.as_vec3() };
+    }
+    for (k, light) in lights.iter_mut().enumerate().skip(count) {
+        *light = CutLight { kind: CutLightKind::Point, at: Vec3::new(k as f32, 1.0, 2.0), intensity: Vec3::ONE };
+    }
+    let tree = LightcutTree::build(&lights, &mut order, &mut nodes).unwrap();
+    let mut sink = 0.0f64;
+    for _ in 0..1000 {
+        let normal = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 1.0).normalize();
+        let sp = ShadingPoint { frame: Frame::from_normal(normal), wo: Vec3::Z, brdf: &brdf };
+        sink += lightcut(&tree, Vec3::ZERO, &sp, 0.02, &mut heap, |_, _| true).estimate.x;
+    }
+    ARMED.with(|a| a.set(false));
+    let allocations = COUNT.with(|c| c.get());
+    assert!(sink.is_finite());
+    assert_eq!(allocations, 0, "the baselines allocated {allocations} times");
+}

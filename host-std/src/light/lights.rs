@@ -19,7 +19,8 @@ pub enum LightSelection {
     Power,
 }
 
-/// How a render samples the lights besides the environment.
+/// How a render samples the lights besides the environment, and how the seed's baselines
+/// (`--method sis`, `--method lightcuts`) turn the lights into theirs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightOptions {
     /// How a light is picked.
@@ -27,11 +28,20 @@ pub struct LightOptions {
     /// Where the scene has an environment too, the share of each shading point's visibility
     /// samples spent on these lights (at least one sample each way).
     pub share: f64,
+    /// Strata of structured importance sampling (`--sis-lights`).
+    pub sis_lights: usize,
+    /// Lightcuts' relative error bound per cluster (`--lightcut-error`).
+    pub lightcut_error: f32,
 }
 
 impl Default for LightOptions {
     fn default() -> Self {
-        Self { selection: LightSelection::Tree, share: 0.5 }
+        Self {
+            selection: LightSelection::Tree,
+            share: 0.5,
+            sis_lights: sampler_core::sis::DEFAULT_LIGHTS,
+            lightcut_error: sampler_core::lightcuts::DEFAULT_ERROR,
+        }
     }
 }
 

@@ -31,6 +31,13 @@ pub enum Method {
     TwoLevel,
     /// MIS of the two-level product and BRDF samples, in pairs.
     TwoLevelMis,
+    /// Structured importance sampling (Agarwal et al. 2003): the map as N pre-integrated
+    /// directional lights, every one shaded at every shading point. Deterministic and biased.
+    Sis,
+    /// Lightcuts (Walter et al. 2005): the map as directional lights and the scene's point
+    /// lights in a light tree, a cut per shading point under a relative error bound.
+    /// Deterministic and biased.
+    Lightcuts,
     /// Per material, the strategy of `auto`'s rules ([`rules::auto_strategy`]), checked by a
     /// pilot render of the material's pixels that replaces it where another measures
     /// [`OVERRIDE_MARGIN`](crate::plan::pilot::OVERRIDE_MARGIN)× as good (`plan::pilot`).
@@ -39,7 +46,7 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order `--help` lists them.
-    pub const ALL: [Method; 11] = [
+    pub const ALL: [Method; 13] = [
         Method::Product,
         Method::Wavelet,
         Method::Env,
@@ -50,6 +57,8 @@ impl Method {
         Method::TwoStage,
         Method::TwoLevel,
         Method::TwoLevelMis,
+        Method::Sis,
+        Method::Lightcuts,
         Method::Auto,
     ];
 
@@ -67,6 +76,8 @@ impl Method {
             Method::TwoStage => "two-stage",
             Method::TwoLevel => "two-level",
             Method::TwoLevelMis => "two-level-mis",
+            Method::Sis => "sis",
+            Method::Lightcuts => "lightcuts",
             Method::Auto => "auto",
         }
     }
@@ -78,11 +89,15 @@ impl Method {
     /// techniques whose sampler is built once per render or per pixel; and for the samplers
     /// built per shading point the power of two nearest √(build cost / sample cost), the
     /// split that minimises error × time when a point's light and its footprint vary alike
-    /// (docs/tuning.md, "Shading points per pixel").
+    /// (docs/tuning.md, "Shading points per pixel"). SIS and Lightcuts shade every stratum or a
+    /// whole cut at each shading point, whatever the budget, so for them V only sets P = spp/V:
+    /// 64, so that a point costs about what its 64 samples cost the sampling methods (a few
+    /// hundred shadow rays and BRDF evaluations) and `ppis report`'s spp range suits them too.
     #[must_use]
     pub fn samples_per_point(self) -> usize {
         match self {
             Method::Env | Method::Brdf | Method::Ris => 1,
+            Method::Sis | Method::Lightcuts => 64,
             Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
             Method::TwoLevel => 2,
             Method::TwoStage => 4,
@@ -106,6 +121,8 @@ impl Method {
             Method::TwoStage => Strategy::TwoStage,
             Method::TwoLevel => Strategy::TwoLevel,
             Method::TwoLevelMis => Strategy::TwoLevelMis { two_level_share: 0.5 },
+            Method::Sis => Strategy::Sis,
+            Method::Lightcuts => Strategy::Lightcuts,
             Method::Auto => rules::auto_strategy(bsdf, env_peak),
         }
     }
@@ -124,6 +141,8 @@ impl Method {
             Strategy::TwoStage => Method::TwoStage,
             Strategy::TwoLevel => Method::TwoLevel,
             Strategy::TwoLevelMis { .. } => Method::TwoLevelMis,
+            Strategy::Sis => Method::Sis,
+            Strategy::Lightcuts => Method::Lightcuts,
         }
     }
 

@@ -13,11 +13,12 @@ pub use budget::ShadingPoints;
 pub use method::Method;
 
 use crate::cpu_time::process_cpu_time;
+use crate::light::baselines::{LightcutTable, sis_strata};
 use crate::light::lights::{LightOptions, LightTable};
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
-use crate::render::{Context, Options, summed_area_table, two_level_cones};
+use crate::render::{Context, Lightcuts, Options, summed_area_table, two_level_cones};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
@@ -91,6 +92,28 @@ pub struct Rendered {
     pub pilot_seconds: f64,
 }
 
+/// The lights of the seed's baselines, built for a render that uses them, and what building
+/// them took.
+struct Baselines {
+    strata: Option<Vec<sampler_core::sis::Stratum>>,
+    cuts: Option<LightcutTable>,
+    seconds: f64,
+    cpu_seconds: Option<f64>,
+}
+
+impl Baselines {
+    fn build(scene: &Scene, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Self {
+        let (start, cpu_start) = (Instant::now(), process_cpu_time());
+        let strata = match (settings.method, env) {
+            (Method::Sis, Some(e)) => Some(sis_strata(e, settings.lights.sis_lights)),
+            _ => None,
+        };
+        let cuts = (settings.method == Method::Lightcuts).then(|| LightcutTable::new(env, &scene.lights));
+        let cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
+        Self { strata, cuts, seconds: start.elapsed().as_secs_f64(), cpu_seconds }
+    }
+}
+
 /// Renders the scene. `env` is `None` when the scene has no environment light.
 pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> Rendered {
     let frame = Crop::full(scene.camera.width as usize, scene.camera.height as usize);
@@ -121,7 +144,11 @@ pub fn render_crop(
     let cones = env.and_then(|e| two_level_cones(e, &plans));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
-    let light_table = LightTable::new(&scene.lights, bvh.bounding_radius(), settings.lights.selection);
+    let baselines = Baselines::build(scene, env, settings);
+    let cut_tree = baselines.cuts.as_ref().map(|t| Lightcuts { tree: t.tree(), error: settings.lights.lightcut_error });
+    // Under Lightcuts the standard estimator keeps the lights its tree does not hold.
+    let scene_lights = baselines.cuts.as_ref().map_or(&scene.lights[..], |t| &t.rest[..]);
+    let light_table = LightTable::new(scene_lights, bvh.bounding_radius(), settings.lights.selection);
     let lights = light_table.as_ref().map(LightTable::set);
     let ctx = Context {
         scene,
@@ -130,6 +157,8 @@ pub fn render_crop(
         lights: lights.as_ref(),
         sat: sat.as_deref(),
         cones: cones.as_deref(),
+        strata: baselines.strata.as_deref(),
+        lightcuts: cut_tree.as_ref(),
         camera: &camera,
         options: &options,
         plans: &plans,
@@ -152,8 +181,13 @@ pub fn render_crop(
     };
     let pilot_seconds = start.elapsed().as_secs_f64();
     let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_deref()), ..ctx }, crop, start);
-    let render_seconds = start.elapsed().as_secs_f64();
-    let render_cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
+    // The baselines' lights are built per render: their build is part of their cost.
+    let render_seconds = start.elapsed().as_secs_f64() + baselines.seconds;
+    let render_cpu_seconds = cpu_start
+        .zip(process_cpu_time())
+        .map(|(a, b)| b.saturating_sub(a).as_secs_f64())
+        .zip(baselines.cpu_seconds)
+        .map(|(r, b)| r + b);
     let c = image.counters;
     Rendered {
         width: image.width,

@@ -106,7 +106,13 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak),
         Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
         Strategy::TwoLevelMis { .. } => true,
-        Strategy::Product | Strategy::Wavelet | Strategy::Ris | Strategy::TwoStage | Strategy::TwoLevel => false,
+        Strategy::Product
+        | Strategy::Wavelet
+        | Strategy::Ris
+        | Strategy::TwoStage
+        | Strategy::TwoLevel
+        | Strategy::Sis
+        | Strategy::Lightcuts => false,
     }
 }
 

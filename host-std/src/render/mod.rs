@@ -15,9 +15,11 @@ pub mod pixel;
 pub mod product_arena;
 pub mod sampler_cache;
 pub mod shade;
+mod shade_cuts;
 mod shade_lights;
 pub mod strategy;
 pub mod tiles;
+pub use shade_cuts::Lightcuts;
 pub(crate) mod wavefront;
 
 use crate::scene::Scene;
@@ -65,6 +67,12 @@ pub struct Context<'a, 'e> {
     /// The cell cones of the two-level product's coarse level, built when a material is
     /// sampled with it.
     pub cones: Option<&'a [sampler_core::cone::Cone]>,
+    /// Structured importance sampling's strata of `env`, built when a material is shaded
+    /// with them.
+    pub strata: Option<&'a [sampler_core::sis::Stratum]>,
+    /// Lightcuts' tree, when the method is Lightcuts: it then shades the environment and the
+    /// lights it holds at every shading point, in place of the environment's estimators.
+    pub lightcuts: Option<&'a Lightcuts<'a>>,
     /// The camera.
     pub camera: &'a Camera,
     /// How pixels are sampled.

@@ -6,6 +6,7 @@
 
 use crate::render::sampler_cache::{Lead, SamplerCache};
 use crate::render::shade::{self, CountingVisibility, Run, Sampling};
+use crate::render::shade_cuts::shade_cuts;
 use crate::render::shade_lights::{budgets, shade_lights};
 use crate::render::strategy::Strategy;
 use crate::render::wavefront::{self, WaveBuffers};
@@ -19,6 +20,7 @@ use sampler_core::estimator::ShadingPoint;
 use sampler_core::frame::Frame;
 use sampler_core::glam::{DVec2, DVec3, Vec3};
 use sampler_core::light::Light;
+use sampler_core::lightcuts::CutEntry;
 use sampler_core::points::{permutation_element, sobol02};
 use sampler_core::rng::hash_combine;
 
@@ -49,6 +51,8 @@ pub struct Scratch {
     hits: Vec<Hit>,
     /// The wavefronts' buffers.
     waves: WaveBuffers,
+    /// Lightcuts' cut.
+    cuts: Vec<CutEntry>,
     /// What the tile's pixels did so far.
     pub counters: Counters,
 }
@@ -61,6 +65,7 @@ impl Scratch {
             cache: SamplerCache::new(materials),
             hits: Vec::with_capacity(shading_points.clamp(1, GROUP)),
             waves: WaveBuffers::default(),
+            cuts: Vec::new(),
             counters: Counters::default(),
         }
     }
@@ -109,7 +114,9 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
             }
         }
         let (env_budget, light_budget) = budgets(ctx);
-        if let Some(env) = ctx.env {
+        if let Some(cuts) = ctx.lightcuts {
+            sum += shade_cuts(ctx, cuts, &scratch.hits, &mut scratch.cuts, &mut scratch.counters);
+        } else if let Some(env) = ctx.env {
             sample_light(ctx, env, seeds, env_budget, scratch, &mut sum);
         } else {
             scratch.counters.shading_points += scratch.hits.len() as u64;
@@ -203,7 +210,7 @@ fn sample_light(
     scratch: &mut Scratch,
     sum: &mut DVec3,
 ) {
-    let Scratch { cache, hits, waves, counters } = scratch;
+    let Scratch { cache, hits, waves, counters, .. } = scratch;
     let n = hits.len();
     let p = ctx.options.shading_points.max(1);
     let shadows = ctx.options.shadows;

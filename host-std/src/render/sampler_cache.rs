@@ -110,6 +110,12 @@ impl SamplerCache {
             Strategy::TwoLevelMis { two_level_share } => {
                 Sampling::TwoLevelMis { sampler: self.two_level(ctx, env, lead), two_level_share }
             }
+            Strategy::Sis => {
+                Sampling::Sis(ctx.strata.expect("the strata are built when a material is shaded with SIS"))
+            }
+            Strategy::Lightcuts => {
+                unreachable!("Lightcuts shades through shade_cuts, never the environment's estimators")
+            }
         }
     }
 

@@ -11,6 +11,7 @@ use sampler_core::glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::points::sobol02;
 use sampler_core::rng::hash_combine;
 use sampler_core::sampler::ProductSampler;
+use sampler_core::sis::Stratum;
 use sampler_core::two_level::TwoLevelSampler;
 use sampler_core::two_stage::TwoStageSampler;
 
@@ -71,6 +72,8 @@ pub enum Sampling<'s, 'e> {
         /// Share of the budget spent on two-level samples; ½ spends it in pairs.
         two_level_share: f64,
     },
+    /// Structured importance sampling: every stratum, as a directional light.
+    Sis(&'s [Stratum]),
 }
 
 /// Where a shading point's samples come from: the pixel's light-sample seed, and the block of
@@ -111,7 +114,22 @@ pub fn shade<B: Brdf + ?Sized>(
         Sampling::Ris => ris(env, sp, budget, run, vis),
         Sampling::Product(sampler) => sampled_only(sampler, sp, budget, run, vis),
         Sampling::TwoStage(sampler) => sampled_only(sampler, sp, budget, run, vis),
+        Sampling::Sis(strata) => strata_sum(strata, sp, vis),
     }
+}
+
+/// Structured importance sampling's estimate: the sum over the strata of BRDF × cosine ×
+/// visibility in the stratum's direction × its irradiance, whatever the budget (one shadow ray
+/// per stratum the surface can reflect).
+fn strata_sum<B: Brdf + ?Sized>(strata: &[Stratum], sp: &ShadingPoint<'_, B>, vis: &mut impl Visibility) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    for s in strata {
+        let f = sp.eval(s.dir).as_dvec3() * s.irradiance;
+        if f.cmpgt(DVec3::ZERO).any() && f.is_finite() && vis.visible(s.dir) {
+            sum += f;
+        }
+    }
+    sum
 }
 
 /// The mean of `n` samples of one technique: `batch` gets each batch of this shading point's

@@ -44,6 +44,13 @@ pub enum Strategy {
         /// Share of the budget spent on two-level samples; ½ spends it in pairs.
         two_level_share: f64,
     },
+    /// Structured importance sampling: every stratum of the map a directional light
+    /// ([`Context::strata`](crate::render::Context::strata)).
+    Sis,
+    /// Lightcuts: a cut through the light tree per shading point
+    /// ([`Context::lightcuts`](crate::render::Context::lightcuts)), covering the map and the
+    /// point lights.
+    Lightcuts,
 }
 
 /// The coarse level of the two-level product: 16 × 16 cells of the equal-area square (clamped

@@ -61,6 +61,15 @@ impl Regions {
     }
 }
 
+/// The relative bias of `image`'s mean against `reference`'s (same size): Σ image / Σ
+/// reference − 1 over pixels and channels; 0 against a black reference.
+#[must_use]
+pub fn relative_bias(image: &[[f32; 3]], reference: &[[f32; 3]]) -> f64 {
+    let sum = |px: &[[f32; 3]]| px.iter().flatten().map(|&c| c as f64).sum::<f64>();
+    let r = sum(reference);
+    if r > 0.0 { sum(image) / r - 1.0 } else { 0.0 }
+}
+
 /// RMSE and relMSE of `image` against `reference` (same size).
 pub fn errors(image: &[[f32; 3]], reference: &[[f32; 3]]) -> (f64, f64) {
     let (mut se, mut rel) = (0.0f64, 0.0f64);

@@ -225,7 +225,7 @@ mod tests {
 
     fn m(method: Method, k: Option<usize>, spp: usize, seconds: f64, relmse: f64) -> Measurement {
         let regions = vec![("diffuse".into(), 0.0, 2.0 * relmse)];
-        Measurement { method, brdf_samples: k, spp, seconds, rmse: 0.0, relmse, regions, plans: Vec::new() }
+        Measurement { method, brdf_samples: k, spp, seconds, rmse: 0.0, relmse, bias: 0.0, regions, plans: Vec::new() }
     }
 
     #[test]

@@ -71,6 +71,9 @@ pub struct Measurement {
     pub rmse: f64,
     /// relMSE over all pixels and channels.
     pub relmse: f64,
+    /// The image's mean over the reference's, less one: the bias of a converged deterministic
+    /// method (SIS, Lightcuts), noise otherwise.
+    pub bias: f64,
     /// (region, RMSE, relMSE) for each region of `Regions`.
     pub regions: Vec<(String, f64, f64)>,
     /// `auto`: per material its label and the plan its pilot settled on (empty otherwise).
@@ -131,6 +134,7 @@ pub fn sweep(
     let mut measure = |series: Series, spp: usize| {
         let image = plan::render(scene, bvh, env, &settings(series, spp));
         let (rmse, relmse) = errors(&image.pixels, reference);
+        let bias = errors::relative_bias(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
         let plans = image
             .pilot
@@ -145,7 +149,7 @@ pub fn sweep(
             .collect();
         let (method, k) = (series.method, series.brdf_samples);
         let seconds = timing.clock.seconds(&image);
-        let m = Measurement { method, brdf_samples: k, spp, seconds, rmse, relmse, regions, plans };
+        let m = Measurement { method, brdf_samples: k, spp, seconds, rmse, relmse, bias, regions, plans };
         progress(&m);
         m
     };
@@ -239,6 +243,7 @@ mod tests {
             seconds,
             rmse: relmse.sqrt(),
             relmse,
+            bias: 0.0,
             regions,
             plans: Vec::new(),
         }

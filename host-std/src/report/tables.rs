@@ -52,18 +52,19 @@ pub fn markdown(
     reference_note: &str,
 ) -> String {
     let mut s = format!("# Error against time: {scene}\n\n{threads} threads; reference: {reference_note}.\n");
-    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; seconds = the render's time by the clock named above (wall clock unless it says CPU). Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
+    s.push_str("relMSE = mean (x − r)²/(r² + 0.01) over pixels and channels; bias = the image's mean over the reference's, less one; seconds = the render's time by the clock named above (wall clock unless it says CPU). Regions: pixels whose centre ray hits a material of that kind and lobe width (GGX α, Phong exponent).\n\n");
     let regions: Vec<String> =
         measurements.first().map(|m| m.regions.iter().map(|r| r.0.clone()).collect()).unwrap_or_default();
-    s.push_str("| method | spp | seconds | RMSE | relMSE |");
+    s.push_str("| method | spp | seconds | RMSE | relMSE | bias |");
     for r in &regions {
         let _ = write!(s, " relMSE {r} |");
     }
-    s.push_str("\n|---|---|---|---|---|");
+    s.push_str("\n|---|---|---|---|---|---|");
     s.push_str(&"---|".repeat(regions.len()));
     s.push('\n');
     for m in measurements {
-        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} |", m.series(), m.spp, m.seconds, m.rmse, m.relmse);
+        let row = (m.series(), m.spp, m.seconds, m.rmse, m.relmse, 100.0 * m.bias);
+        let _ = write!(s, "| {} | {} | {:.3} | {:.4e} | {:.4e} | {:+.2}% |", row.0, row.1, row.2, row.3, row.4, row.5);
         for r in &m.regions {
             let _ = write!(s, " {:.4e} |", r.2);
         }

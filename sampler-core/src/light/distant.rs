@@ -61,6 +61,12 @@ impl DistantLight {
         libm::asinf(libm::sqrtf(self.sin2_max))
     }
 
+    /// The irradiance it delivers to a surface facing it (RGB).
+    #[must_use]
+    pub fn irradiance(&self) -> Vec3 {
+        self.irradiance
+    }
+
     /// The radiance over the light's disc (0 for a delta light).
     #[must_use]
     pub fn radiance(&self) -> Vec3 {

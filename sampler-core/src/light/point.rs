@@ -22,6 +22,12 @@ impl PointLight {
     pub fn position(&self) -> Vec3 {
         self.position
     }
+
+    /// Its radiant intensity (RGB, W/sr).
+    #[must_use]
+    pub fn intensity(&self) -> Vec3 {
+        self.intensity
+    }
 }
 
 impl Light for PointLight {

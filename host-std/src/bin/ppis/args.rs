@@ -90,6 +90,31 @@ pub(crate) struct SamplingArgs {
     /// by its cone; needs an environment.
     #[arg(long)]
     pub(crate) distant_in_env: bool,
+    /// `--method sis`: the strata (directional lights) the environment is stratified into
+    /// (the paper's 300 by default), each shaded at every shading point.
+    #[arg(long, value_name = "N", default_value_t = sampler_core::sis::DEFAULT_LIGHTS, value_parser = parse_sis_lights)]
+    pub(crate) sis_lights: usize,
+    /// `--method lightcuts`: the relative error bound each cluster of a cut stays under (the
+    /// paper's 0.02), in (0, 1).
+    #[arg(long, value_name = "E", default_value_t = sampler_core::lightcuts::DEFAULT_ERROR, value_parser = parse_lightcut_error)]
+    pub(crate) lightcut_error: f32,
+}
+
+/// `--sis-lights`'s value: at least one stratum, at most 65 536 (a stratum per cell of the
+/// stratification's finest level).
+fn parse_sis_lights(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=65_536).contains(&n) => Ok(n),
+        _ => Err(format!("{s:?} is not a number of strata in 1..=65536")),
+    }
+}
+
+/// `--lightcut-error`'s value.
+fn parse_lightcut_error(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a relative error in (0, 1)")),
+    }
 }
 
 /// `--light-share`'s value.
@@ -110,9 +135,14 @@ fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
 }
 
 impl SamplingArgs {
-    /// How the lights besides the environment are sampled.
+    /// How the lights besides the environment are sampled, and the baselines' lights.
     pub(crate) fn lights(&self) -> LightOptions {
-        LightOptions { selection: self.light_selection, share: self.light_share }
+        LightOptions {
+            selection: self.light_selection,
+            share: self.light_share,
+            sis_lights: self.sis_lights,
+            lightcut_error: self.lightcut_error,
+        }
     }
 
     /// --width and --height, as given.

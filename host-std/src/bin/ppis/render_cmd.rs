@@ -20,8 +20,10 @@ use std::time::Instant;
 pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
-    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage, two-level, two-level-mis
-    /// or auto. The default, auto, picks per material the plan with the least error at equal
+    /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage, two-level, two-level-mis,
+    /// sis, lightcuts or auto. sis (structured importance sampling) and lightcuts are the
+    /// seed's deterministic, biased baselines: each shading point shades every stratum or a
+    /// whole cut: P = spp/64 shading points per pixel (docs/renderer.md). The default, auto, picks per material the plan with the least error at equal
     /// time, from rules checked by a pilot render (docs/perf.md#auto-and-its-pilot).
     #[arg(long, default_value = "auto", value_parser = parse_method)]
     pub(crate) method: Method,

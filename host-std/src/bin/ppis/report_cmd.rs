@@ -148,12 +148,13 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
             timing,
             |m| {
                 eprintln!(
-                    "ppis: {:>20} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}",
+                    "ppis: {:>20} {:>6} spp  {:>8.3} s  RMSE {:.4e}  relMSE {:.4e}  bias {:+.2}%",
                     m.series().to_string(),
                     m.spp,
                     m.seconds,
                     m.rmse,
-                    m.relmse
+                    m.relmse,
+                    100.0 * m.bias
                 );
             },
         )
