@@ -147,6 +147,13 @@ impl PartialEq<Token> for &str {
     }
 }
 
+/// A token hashes as its text (above), so maps keyed by tokens look up by `&str` (ppis patch).
+impl std::borrow::Borrow<str> for Token {
+    fn borrow(&self) -> &str {
+        self.as_str()
+    }
+}
+
 impl Hash for Token {
     fn hash<H: Hasher>(&self, state: &mut H) {
         self.as_str().hash(state);

@@ -33,6 +33,7 @@ use super::prim_index::{
 };
 use super::prim_indexer::ExprVarDeps;
 use super::prim_resolve::InvalidTargetKind;
+use super::property_kinds::properties_of_both_kinds;
 use super::relocates::{apply_child_relocates, chain_through_relocates, effective_relocates};
 use super::{Error, LayerId, MapFunction, StackIdentity, VariantFallbackMap};
 
@@ -1762,8 +1763,9 @@ impl IndexCache {
         let Some(index) = self.store.index_at(prim_path) else {
             return;
         };
+        let both_kinds = properties_of_both_kinds(graph, index);
         let mut conflicts = Vec::new();
-        for name in names {
+        for name in names.iter().filter(|name| both_kinds.contains(*name)) {
             let Ok(prop_path) = prim_path.append_property(name) else {
                 continue;
             };

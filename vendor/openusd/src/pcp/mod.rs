@@ -302,6 +302,7 @@ pub(crate) mod prim_graph;
 pub(crate) mod prim_index;
 pub(crate) mod prim_indexer;
 pub(crate) mod prim_resolve;
+mod property_kinds;
 mod relocates;
 
 use crate::sdf::schema::FieldKey;

@@ -98,6 +98,9 @@ use crate::sdf::schema::{ChildrenKey, FieldKey};
 use crate::sdf::{self, LayerOffset, Path, Value};
 use crate::tf::Token;
 
+mod task_queue;
+use task_queue::TaskQueue;
+
 use super::compose_site::{collect_payloads_in, compose_arc_list_in, compose_references_in, evaluate_expression};
 use super::layer_graph::{ExternalStack, LoadFailure};
 use super::layer_stack::LayerStackId;
@@ -481,7 +484,7 @@ pub(crate) struct Indexer<'a, 'f> {
     /// `Task::PriorityOrder` heap) rather than a fixed `Ord`, because variant
     /// tasks break ties by live node strength, which a standalone `Ord` cannot
     /// see.
-    tasks: Vec<Task>,
+    tasks: TaskQueue,
     /// `(node, kind)` pairs already enqueued for an implied-class or
     /// implied-specializes task (C++ `taskUniq`): implied propagation re-reaches
     /// the same node from several arcs, so the task is deduplicated to avoid
@@ -539,7 +542,7 @@ impl<'a, 'f> Indexer<'a, 'f> {
             frame: None,
             frame_depth: 0,
             output: PrimIndexGraph::default(),
-            tasks: Vec::new(),
+            tasks: TaskQueue::default(),
             implied_seen: HashSet::new(),
             root_contributes: true,
             errors: Vec::new(),
@@ -1147,8 +1150,10 @@ impl<'a, 'f> Indexer<'a, 'f> {
     /// because the per-prim task count is small and variant ties consult live
     /// node strength (see [`task_priority_cmp`](Self::task_priority_cmp)).
     fn take_best_task(&mut self) -> Option<Task> {
-        let best = (0..self.tasks.len()).max_by(|&i, &j| self.task_priority_cmp(&self.tasks[i], &self.tasks[j]))?;
-        Some(self.tasks.swap_remove(best))
+        let mut tasks = std::mem::take(&mut self.tasks);
+        let best = tasks.take_best(|a, b| self.task_priority_cmp(a, b));
+        self.tasks = tasks;
+        best
     }
 
     /// Orders two tasks by drain priority — the greater task drains first (C++
@@ -2101,7 +2106,7 @@ impl<'a, 'f> Indexer<'a, 'f> {
     /// (C++ `RetryVariantTasks`): a newly selected variant may have introduced
     /// authored selections that those sets should now see.
     fn retry_variant_tasks(&mut self) {
-        for task in &mut self.tasks {
+        for task in self.tasks.scanned_mut() {
             task.kind = match task.kind {
                 TaskKind::EvalNodeVariantFallback | TaskKind::EvalNodeVariantNoneFound => {
                     TaskKind::EvalNodeVariantAuthored

@@ -7,6 +7,8 @@
 //! prim that authors it. A property whose path does not take apart into a structured owner
 //! and name ([`Path::as_property`]) keeps an entry of its own.
 
+use std::collections::HashMap;
+
 use crate::sdf::{Path, PathMap, SpecData};
 use crate::tf;
 
@@ -14,19 +16,60 @@ use crate::tf;
 #[derive(Debug, Default, Clone)]
 struct Entry {
     spec: Option<SpecData>,
-    /// Sorted by name, names unique.
+    /// In the order they were added, names unique.
     properties: Vec<(tf::Token, SpecData)>,
+    /// Each property's slot by name, once there are more than [`SCAN_LIMIT`]: a scan (or a
+    /// sorted insertion) per property made a prim of `n` properties cost `n²`.
+    index: Option<Box<HashMap<tf::Token, u32>>>,
 }
 
+/// How many properties an entry scans before it indexes them: most prims own a handful.
+const SCAN_LIMIT: usize = 16;
+
 impl Entry {
-    /// The slot of `name` among the properties, or where it would go.
-    fn find(&self, name: &str) -> Result<usize, usize> {
-        self.properties.binary_search_by(|(token, _)| token.as_str().cmp(name))
+    /// The slot of `name` among the properties.
+    fn find(&self, name: &str) -> Option<usize> {
+        match &self.index {
+            Some(index) => index.get(name).map(|&at| at as usize),
+            None => self.properties.iter().position(|(token, _)| token.as_str() == name),
+        }
+    }
+
+    /// Appends a property not yet here, returning its slot.
+    fn push(&mut self, name: tf::Token, spec: SpecData) -> usize {
+        let at = self.properties.len();
+        if let Some(index) = &mut self.index {
+            index.insert(name.clone(), slot(at));
+        }
+        self.properties.push((name, spec));
+        if self.index.is_none() && self.properties.len() > SCAN_LIMIT {
+            let index = self.properties.iter().enumerate().map(|(at, (name, _))| (name.clone(), slot(at)));
+            self.index = Some(Box::new(index.collect()));
+        }
+        at
+    }
+
+    /// Removes the property at slot `at`; the last property takes its slot.
+    fn remove(&mut self, at: usize) -> SpecData {
+        let (name, spec) = self.properties.swap_remove(at);
+        if let Some(index) = &mut self.index {
+            index.remove(name.as_str());
+            if let Some((moved, _)) = self.properties.get(at) {
+                index.insert(moved.clone(), slot(at));
+            }
+        }
+        spec
     }
 
     fn is_empty(&self) -> bool {
         self.spec.is_none() && self.properties.is_empty()
     }
+}
+
+/// A property's slot as the index holds it (a prim owns fewer than 2³² properties: each
+/// takes bytes of its layer).
+fn slot(at: usize) -> u32 {
+    u32::try_from(at).expect("fewer than 2^32 properties")
 }
 
 /// A map from spec path to [`SpecData`], storing property specs under their owners.
@@ -54,7 +97,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get(key)?;
         match name {
-            Some(name) => entry.find(name).ok().map(|at| &entry.properties[at].1),
+            Some(name) => entry.find(name).map(|at| &entry.properties[at].1),
             None => entry.spec.as_ref(),
         }
     }
@@ -63,7 +106,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         match name {
-            Some(name) => entry.find(name).ok().map(|at| &mut entry.properties[at].1),
+            Some(name) => entry.find(name).map(|at| &mut entry.properties[at].1),
             None => entry.spec.as_mut(),
         }
     }
@@ -112,11 +155,10 @@ impl SpecTable {
     ) -> &mut SpecData {
         let entry = self.entries.entry(owner.clone()).or_default();
         let at = match entry.find(name) {
-            Ok(at) => at,
-            Err(at) => {
-                entry.properties.insert(at, (token(), make()));
+            Some(at) => at,
+            None => {
                 self.len += 1;
-                at
+                entry.push(token(), make())
             }
         };
         &mut entry.properties[at].1
@@ -133,7 +175,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         let removed = match name {
-            Some(name) => entry.find(name).ok().map(|at| entry.properties.remove(at).1),
+            Some(name) => entry.find(name).map(|at| entry.remove(at)),
             None => entry.spec.take(),
         };
         if entry.is_empty() {
@@ -159,6 +201,9 @@ impl SpecTable {
     pub(crate) fn shrink_to_fit(&mut self) {
         for entry in self.entries.values_mut() {
             entry.properties.shrink_to_fit();
+            if let Some(index) = &mut entry.index {
+                index.shrink_to_fit();
+            }
         }
     }
 }
@@ -205,6 +250,36 @@ mod tests {
         assert!(table.contains(&path("/A.z").unwrap()));
         assert!(table.remove(&path("/B.r").unwrap()).is_some() && table.remove(&path("/B.r").unwrap()).is_none());
         assert_eq!(table.len(), 3);
+    }
+
+    /// A prim with more properties than an entry scans answers the same, removals included.
+    #[test]
+    fn many_properties_are_indexed() {
+        let mut table = SpecTable::default();
+        let owner = path("/A").unwrap();
+        let n = 5 * SCAN_LIMIT;
+        for i in (0..n).rev() {
+            let ty = if i % 2 == 0 { SpecType::Attribute } else { SpecType::Relationship };
+            let name = tf::Token::from(format!("p{i}"));
+            table.property_or_insert_with(&owner, &name, || spec(ty)).unwrap();
+        }
+        for i in (0..n).step_by(3) {
+            assert!(table.remove(&path(&format!("/A.p{i}")).unwrap()).is_some());
+        }
+        assert_eq!(table.len(), n - n.div_ceil(3));
+        for i in 0..n {
+            let found = table.get(&path(&format!("/A.p{i}")).unwrap()).map(|s| s.ty);
+            let expected = if i % 3 == 0 {
+                None
+            } else if i % 2 == 0 {
+                Some(SpecType::Attribute)
+            } else {
+                Some(SpecType::Relationship)
+            };
+            assert_eq!(found, expected, "p{i}");
+        }
+        let again = table.property_or_insert_with(&owner, &tf::Token::from("p1"), || spec(SpecType::Attribute));
+        assert_eq!(again.unwrap().ty, SpecType::Relationship);
     }
 
     /// Inserting at a path that holds a spec replaces it; merging through the accessor keeps it.

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
+mod names;
 pub mod parser;
 pub mod token;
 mod writer;

@@ -12,6 +12,7 @@ use crate::sdf::{
 };
 use crate::tf;
 
+use super::names::OrderedNames;
 use super::token::Token;
 
 type LexResult<'source> = std::result::Result<Token<'source>, ()>;
@@ -431,8 +432,8 @@ impl<'a> Parser<'a> {
             abbreviated(path)
         );
         let mut children = Vec::new();
-        let mut properties = Vec::new();
-        let mut suffixed_properties = Vec::<tf::Token>::new();
+        let mut properties = OrderedNames::default();
+        let mut suffixed_properties = OrderedNames::default();
         let mut variant_sets = Vec::new();
 
         self.parse_block('{', '}', |this| {
@@ -465,11 +466,9 @@ impl<'a> Parser<'a> {
 
         // Append properties that were only declared via suffixed forms
         // (e.g. `.connect`, `.timeSamples`) and never had a bare declaration.
-        for name in suffixed_properties {
-            push_unique(&mut properties, name);
-        }
+        properties.extend(suffixed_properties);
 
-        Ok((children, properties, variant_sets))
+        Ok((children, properties.into_vec(), variant_sets))
     }
 
     /// Parse `reorder nameChildren = [...]`, `reorder properties = [...]`, or
@@ -588,8 +587,8 @@ impl<'a> Parser<'a> {
     fn read_attribute(
         &mut self,
         current_path: &sdf::Path,
-        properties: &mut Vec<tf::Token>,
-        suffixed_properties: &mut Vec<tf::Token>,
+        properties: &mut OrderedNames,
+        suffixed_properties: &mut OrderedNames,
         data: &mut sdf::Data,
     ) -> Result<()> {
         let mut custom = false;
@@ -633,7 +632,7 @@ impl<'a> Parser<'a> {
 
         let token = self.name_token(name);
         if matches!(suffix, Some(Token::Connect)) {
-            push_unique(suffixed_properties, token.clone());
+            suffixed_properties.push(token.clone());
             if self.try_consume(Token::Punctuation('=')) {
                 let list_op = list_op.or(self.try_list_op());
                 // Connection targets are anchored to the owning prim, like
@@ -658,7 +657,7 @@ impl<'a> Parser<'a> {
         }
 
         if matches!(suffix, Some(Token::TimeSamples)) {
-            push_unique(suffixed_properties, token.clone());
+            suffixed_properties.push(token.clone());
             self.ensure_pun('=')?;
             let samples = self.parse_time_samples(type_info)?;
             let spec = data.property_or_insert_with(current_path, &token, || {
@@ -669,7 +668,7 @@ impl<'a> Parser<'a> {
         }
 
         if matches!(suffix, Some(Token::Spline)) {
-            push_unique(suffixed_properties, token.clone());
+            suffixed_properties.push(token.clone());
             self.ensure_pun('=')?;
             let spline = self.parse_spline()?;
             let spec = data.property_or_insert_with(current_path, &token, || {
@@ -685,7 +684,7 @@ impl<'a> Parser<'a> {
 
         // Check if there's an assignment
         if !self.is_next(Token::Punctuation('=')) {
-            push_unique(properties, token.clone());
+            properties.push(token.clone());
 
             let mut base = Self::make_attribute_spec(&type_info, custom, variability);
             base.extend_from(spec);
@@ -700,7 +699,7 @@ impl<'a> Parser<'a> {
                 .context("Unable to parse attribute metadata")?;
         }
 
-        push_unique(properties, token.clone());
+        properties.push(token.clone());
 
         let mut base = Self::make_attribute_spec(&type_info, custom, variability);
         base.extend_from(spec);
@@ -884,7 +883,7 @@ impl<'a> Parser<'a> {
         &mut self,
         current_path: &sdf::Path,
         custom: bool,
-        properties: &mut Vec<tf::Token>,
+        properties: &mut OrderedNames,
         data: &mut sdf::Data,
         outer_list_op: Option<Token<'a>>,
     ) -> Result<()> {
@@ -903,7 +902,7 @@ impl<'a> Parser<'a> {
 
         let path = current_path.append_property(name)?;
         let token = self.name_token(name);
-        push_unique(properties, token.clone());
+        properties.push(token.clone());
 
         // Check if there's an assignment
         if !self.is_next(Token::Punctuation('=')) {
@@ -1933,13 +1932,6 @@ impl<'a> Parser<'a> {
         T: From<[E; N]>,
     {
         Ok(self.parse_array_of_tuples::<E, N>()?.into_iter().map(T::from).collect())
-    }
-}
-
-/// Push a name into a Vec if it's not already present.
-fn push_unique(vec: &mut Vec<tf::Token>, name: tf::Token) {
-    if !vec.contains(&name) {
-        vec.push(name);
     }
 }
 
