@@ -62,6 +62,15 @@ impl Method {
         Method::Auto,
     ];
 
+    /// Whether the method's expected image is the true one. Structured importance sampling
+    /// and Lightcuts are biased by design (the map as finitely many directional lights; a cut
+    /// under an error bound), so unbiasedness checks leave them out and report their bias
+    /// instead.
+    #[must_use]
+    pub fn is_unbiased(self) -> bool {
+        !matches!(self, Method::Sis | Method::Lightcuts)
+    }
+
     /// The name `--method` takes.
     #[must_use]
     pub fn name(self) -> &'static str {
