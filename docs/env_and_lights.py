@@ -3,7 +3,7 @@
 environment and a sun at equal time"): every environment method, the sun by its cone or in the
 map, and the lights' share of each shading point's budget, in one table.
 
-  python3 docs/env_and_lights.py --out DIR [--size 128] [--ppis target/release/ppis] SCENE.json
+  python3 docs/env_and_lights.py --out DIR [--size 128] [--shares 0.25,0.5,0.75] [--ppis target/release/ppis] SCENE.json
 
 Renders two converged references with MIS (8192 spp, 1024 shading points, seed 777): the scene
 as written, and with `--distant-in-env` (a sun rasterised into the map is a slightly different
@@ -14,8 +14,8 @@ light, so those variants are measured against their own). Then one `ppis report`
 - `map`: mis, product-mis, auto with `--distant-in-env` (only where the scene has a distant light
   with an angle);
 - `share-S`: mis and product-mis at 16 visibility samples per shading point with
-  `--light-share S` for S in ¼, ½, ¾ (at the default four per point the split is one light pair
-  and one environment pair whatever the share).
+  `--light-share S` for S in --shares (default ¼, ½, ¾; at the default four per point the split is
+  one light pair and one environment pair whatever the share).
 
 Every variant's relMSE per region is interpolated log-log at t, the CPU time of `cone`'s MIS at
 1024 spp (* marks a value extrapolated past a variant's measured times), and printed as one
@@ -23,7 +23,6 @@ Markdown table, a row per variant and method, a column per region: relMSE at t f
 every other row's relMSE over it (< 1: better than cone MIS). The reports stay in DIR/VARIANT/ (report.md: per-spp figures and `auto`'s plans)."""
 import argparse, csv, json, math, os, subprocess, sys
 
-SHARES = ['0.25', '0.5', '0.75']
 ORDER = ['mis', 'product-mis', 'auto', 'sis', 'lightcuts']
 
 
@@ -37,12 +36,12 @@ def has_sun(scene):
     return any(l['type'] == 'distant' and l.get('angle_deg', 0) > 0 for l in lights)
 
 
-def variants(has_distant):
+def variants(has_distant, shares):
     """(name, methods, extra flags, uses the map reference)."""
     out = [('cone', 'mis,product-mis,auto,sis,lightcuts', [], False)]
     if has_distant:
         out.append(('map', 'mis,product-mis,auto', ['--distant-in-env'], True))
-    for s in SHARES:
+    for s in shares:
         out.append(('share-' + s, 'mis,product-mis', ['--samples-per-point', '16', '--light-share', s], False))
     return out
 
@@ -84,6 +83,7 @@ def main():
     ap.add_argument('--out', required=True)
     ap.add_argument('--size', default='128')
     ap.add_argument('--ppis', default='target/release/ppis')
+    ap.add_argument('--shares', default='0.25,0.5,0.75', help='the lights\' shares at V = 16')
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     size = ['--width', a.size, '--height', a.size]
@@ -95,7 +95,7 @@ def main():
         run([a.ppis, 'render', a.scene, '--method', 'mis', '--spp', '8192', '--shading-points', '1024',
              '--seed', '777', '-o', path] + size + (['--distant-in-env'] if in_map else []))
     curves = {}
-    for name, methods, flags, in_map in variants(sun):
+    for name, methods, flags, in_map in variants(sun, a.shares.split(',')):
         folder = os.path.join(a.out, name)
         table = os.path.join(folder, 'error_vs_time.csv')
         if not os.path.exists(table):
