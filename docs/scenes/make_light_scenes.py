@@ -6,7 +6,9 @@ written here as OBJ. Run from the repository root:
   python3 docs/scenes/make_light_scenes.py
 
 Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3"; sun_env.json
-(a sun over the map) is docs/tuning.md's, "A sun in the map or by its cone".
+(a sun over the map) and lights_env.json are measured at equal time in docs/perf.md, "An
+environment, a sun and lights at equal time" (docs/env_and_lights.py); lights_env.json's USD twin
+is host-usd/tests/fixtures/lights_env.usda.
 With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
 DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
 spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).

@@ -3,12 +3,16 @@
 //! library by `host-usd/tests/fixtures/make_lights.py`: a SphereLight with `treatAsPoint`, a
 //! SphereLight with exposure, a normalised RectLight, a scaled DiskLight, an angular
 //! DistantLight and a mesh with MeshLightAPI) hold lights of the JSON lights' power, and
-//! render, at 32 × 32, to the JSON original's mean within noise.
+//! render, at 32 × 32, to the JSON original's mean within noise; so does the twin of
+//! `docs/scenes/lights_env.json`, every one of those lights together under a DomeLight of the
+//! courtyard map.
 #![cfg(feature = "usd")]
 
+use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::{Method, Settings, render};
 use host_std::scene::{Scene, json, usd};
 use host_std::trace::bvh::Bvh;
+use sampler_core::glam::Mat3;
 use sampler_core::light::Light;
 use std::path::PathBuf;
 
@@ -31,7 +35,8 @@ fn render_mean(scene: &Scene, seed: u64) -> Vec<f64> {
         shadows: true,
         lights: Default::default(),
     };
-    let image = render(scene, &bvh, None, &settings);
+    let env = scene.env.clone().map(|(source, placement)| Environment::build(&source, placement).unwrap());
+    let image = render(scene, &bvh, env.as_ref().map(Environment::hierarchy).as_ref(), &settings);
     image.pixels.iter().map(|p| f64::from(p[0] + p[1] + p[2])).collect()
 }
 
@@ -39,38 +44,63 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
+/// Loads `docs/scenes/{name}.json` and its twin `host-usd/tests/fixtures/{name}.usda` at 32 × 32
+/// and checks that they hold the same camera, lights and environment and render alike.
+fn twin_renders_like_its_original(name: &str) {
+    let mut original = json::load(&root().join(format!("docs/scenes/{name}.json"))).unwrap();
+    (original.camera.width, original.camera.height) = (SIZE, SIZE);
+    let file = root().join(format!("host-usd/tests/fixtures/{name}.usda"));
+    let options = usd::Options { width: Some(SIZE), height: Some(SIZE), ..Default::default() };
+    let twin = usd::load(&file, &options).unwrap();
+    assert!(twin.notes.is_empty(), "{name}: {:?}", twin.notes);
+    let twin = twin.scene;
+    assert!((twin.camera.fov_y_deg - original.camera.fov_y_deg).abs() < 1e-3, "{name}");
+    assert!((twin.camera.origin - original.camera.origin).length() < 1e-5, "{name}");
+    assert_eq!(twin.env.is_some(), original.env.is_some(), "{name}: an environment in one only");
+    if let (Some((source, at)), Some((source_json, at_json))) = (&twin.env, &original.env) {
+        // The same map, as bright and in the same frame (the dome is not rotated). A dome's
+        // texture is read into memory, named by its path.
+        let file = |s: &EnvSource| match s {
+            EnvSource::File(path) | EnvSource::Bytes { name: path, .. } => path.canonicalize().unwrap(),
+            _ => panic!("{name}: the environment is not a map"),
+        };
+        assert_eq!(file(source), file(source_json), "{name}");
+        let radiance = |p: &Placement| p.tint.map(|t| t * p.scale);
+        assert_eq!(radiance(at), radiance(at_json), "{name}");
+        let frame = |p: &Placement| Mat3::from_rotation_y(p.rotate_y_deg.to_radians()) * p.rotation;
+        assert!(frame(at).abs_diff_eq(frame(at_json), 1e-6), "{name}: the map's frame");
+    }
+    // The same emitters: as many lights, of the same power.
+    assert_eq!(twin.lights.len(), original.lights.len(), "{name}");
+    let power = |s: &Scene| s.lights.iter().map(|l| l.power(10.0)).sum::<sampler_core::glam::Vec3>();
+    let (p, q) = (power(&twin), power(&original));
+    assert!((p - q).abs().max_element() <= 1e-4 * q.max_element(), "{name}: power {p} against {q}");
+    // The image's mean within 4 standard errors (from two renders of the original) plus 0.5%.
+    // Pixels are clamped to a few times the mean first, the same way in every image: the
+    // near-mirror sphere's highlights of small lights are rare bright samples that would
+    // swamp the estimate of the error, and equal images stay equal under any clamp.
+    let (a, b) = (render_mean(&original, 1), render_mean(&original, 3));
+    let clamp = 4.0 * mean(&a);
+    let clamped = |v: Vec<f64>| v.into_iter().map(|x| x.min(clamp)).collect::<Vec<f64>>();
+    let (a, b) = (clamped(a), clamped(b));
+    let n = a.len() as f64;
+    let se = (a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / (2.0 * n * n)).sqrt();
+    let reference = mean(&a);
+    let bound = 4.0 * std::f64::consts::SQRT_2 * se + 0.005 * reference;
+    assert!(bound < 0.03 * reference, "{name}: the test resolves a 3% error ({bound:.3e} of {reference:.3e})");
+    let got = mean(&clamped(render_mean(&twin, 2)));
+    eprintln!("{name}: USD {got:.5}, JSON {reference:.5}, bound {bound:.2e}");
+    assert!((got - reference).abs() < bound, "{name}: USD {got:.5}, JSON {reference:.5}, bound {bound:.2e}");
+}
+
 #[test]
 fn usd_light_twins_render_like_their_json_originals() {
     for kind in KINDS {
-        let mut original = json::load(&root().join(format!("docs/scenes/light_{kind}.json"))).unwrap();
-        (original.camera.width, original.camera.height) = (SIZE, SIZE);
-        let file = root().join(format!("host-usd/tests/fixtures/light_{kind}.usda"));
-        let options = usd::Options { width: Some(SIZE), height: Some(SIZE), ..Default::default() };
-        let twin = usd::load(&file, &options).unwrap();
-        assert!(twin.notes.is_empty(), "{kind}: {:?}", twin.notes);
-        let twin = twin.scene;
-        assert!((twin.camera.fov_y_deg - original.camera.fov_y_deg).abs() < 1e-3, "{kind}");
-        assert!((twin.camera.origin - original.camera.origin).length() < 1e-5, "{kind}");
-        // The same emitters: as many lights, of the same power.
-        assert_eq!(twin.lights.len(), original.lights.len(), "{kind}");
-        let power = |s: &Scene| s.lights.iter().map(|l| l.power(10.0)).sum::<sampler_core::glam::Vec3>();
-        let (p, q) = (power(&twin), power(&original));
-        assert!((p - q).abs().max_element() <= 1e-4 * q.max_element(), "{kind}: power {p} against {q}");
-        // The image's mean within 4 standard errors (from two renders of the original) plus 0.5%.
-        // Pixels are clamped to a few times the mean first, the same way in every image: the
-        // near-mirror sphere's highlights of small lights are rare bright samples that would
-        // swamp the estimate of the error, and equal images stay equal under any clamp.
-        let (a, b) = (render_mean(&original, 1), render_mean(&original, 3));
-        let clamp = 4.0 * mean(&a);
-        let clamped = |v: Vec<f64>| v.into_iter().map(|x| x.min(clamp)).collect::<Vec<f64>>();
-        let (a, b) = (clamped(a), clamped(b));
-        let n = a.len() as f64;
-        let se = (a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / (2.0 * n * n)).sqrt();
-        let reference = mean(&a);
-        let bound = 4.0 * std::f64::consts::SQRT_2 * se + 0.005 * reference;
-        assert!(bound < 0.03 * reference, "{kind}: the test resolves a 3% error ({bound:.3e} of {reference:.3e})");
-        let got = mean(&clamped(render_mean(&twin, 2)));
-        eprintln!("{kind}: USD {got:.5}, JSON {reference:.5}, bound {bound:.2e}");
-        assert!((got - reference).abs() < bound, "{kind}: USD {got:.5}, JSON {reference:.5}, bound {bound:.2e}");
+        twin_renders_like_its_original(&format!("light_{kind}"));
     }
+}
+
+#[test]
+fn usd_twin_of_every_light_under_an_environment_renders_like_its_json_original() {
+    twin_renders_like_its_original("lights_env");
 }
