@@ -656,7 +656,7 @@ mod tests {
             .unwrap();
 
         // USDC bytes are `[x, y, z, w]`; reader returns `(w, x, y, z)`.
-        assert_eq!(quat, gf::quatd(2.4, 5.3, 6.3, 5.2));
+        assert_eq!(*quat, gf::quatd(2.4, 5.3, 6.3, 5.2));
 
         let quat = data
             .get_field(&sdf::path("/World.quatdArr")?, "default")?

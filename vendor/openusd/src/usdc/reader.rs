@@ -1101,7 +1101,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
             Type::Vec4d if value.is_inlined() => {
                 let [x, y, z, w] = to_vec::<f64, 4>(self.unpack_value(value)?);
-                sdf::Value::Vec4d(gf::vec4d(x, y, z, w))
+                sdf::Value::Vec4d(Box::new(gf::vec4d(x, y, z, w)))
             }
             Type::Vec4i if value.is_inlined() => {
                 let [x, y, z, w] = to_vec::<i32, 4>(self.unpack_value(value)?);
@@ -1121,7 +1121,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
             Type::Vec4h => sdf::Value::Vec4h(self.unpack_value::<gf::Vec4h>(value)?),
             Type::Vec4f => sdf::Value::Vec4f(self.unpack_value::<gf::Vec4f>(value)?),
-            Type::Vec4d => sdf::Value::Vec4d(self.unpack_value::<gf::Vec4d>(value)?),
+            Type::Vec4d => sdf::Value::Vec4d(Box::new(self.unpack_value::<gf::Vec4d>(value)?)),
             Type::Vec4i => sdf::Value::Vec4i(self.unpack_value::<gf::Vec4i>(value)?),
 
             //
@@ -1147,7 +1147,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             ),
 
             Type::Matrix2d if value.is_inlined() => {
-                sdf::Value::Matrix2d(gf::Mat2d(to_mat_diag::<2, 4>(self.unpack_value(value)?)))
+                sdf::Value::Matrix2d(Box::new(gf::Mat2d(to_mat_diag::<2, 4>(self.unpack_value(value)?))))
             }
             Type::Matrix3d if value.is_inlined() => {
                 sdf::Value::Matrix3d(Box::new(gf::Mat3d(to_mat_diag::<3, 9>(self.unpack_value(value)?))))
@@ -1156,7 +1156,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 sdf::Value::Matrix4d(Box::new(gf::Matrix4d(to_mat_diag::<4, 16>(self.unpack_value(value)?))))
             }
 
-            Type::Matrix2d => sdf::Value::Matrix2d(gf::Mat2d(self.unpack_value::<[f64; 4]>(value)?)),
+            Type::Matrix2d => sdf::Value::Matrix2d(Box::new(gf::Mat2d(self.unpack_value::<[f64; 4]>(value)?))),
             Type::Matrix3d => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.unpack_value::<[f64; 9]>(value)?))),
             Type::Matrix4d => sdf::Value::Matrix4d(Box::new(gf::Matrix4d(self.unpack_value::<[f64; 16]>(value)?))),
 
@@ -1354,7 +1354,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     map.insert(key, value);
                 }
 
-                sdf::Value::VariantSelectionMap(map)
+                sdf::Value::from(map)
             }
 
             Type::TimeSamples => {
@@ -1403,14 +1403,14 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
 
             // Empty dictionary.
-            Type::Dictionary if value.is_inlined() => sdf::Value::Dictionary(HashMap::default()),
+            Type::Dictionary if value.is_inlined() => sdf::Value::Dictionary(Box::default()),
             Type::Dictionary => {
                 ensure!(!value.is_compressed(), "Dictionary {ty} can't be compressed");
                 ensure!(!value.is_array(), "Dictionary {ty} can't be inlined");
 
                 self.set_position(value.payload())?;
 
-                sdf::Value::Dictionary(self.read_custom_data()?)
+                sdf::Value::from(self.read_custom_data()?)
             }
 
             Type::ValueBlock => sdf::Value::ValueBlock,
