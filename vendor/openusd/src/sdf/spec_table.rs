@@ -42,8 +42,10 @@ impl Entry {
             index.insert(name.clone(), slot(at));
         }
         // A prim's few properties are held for the layer's life in a list of exactly their
-        // number; past the scan limit the list grows by doubling, as a prim of `n` properties
-        // would otherwise copy it `n` times.
+        // number. Shrinking a doubled list once the layer is parsed (`shrink_to_fit`) leaves
+        // its tail as a hole in the heap that the import's later, differently sized blocks
+        // do not fill. Past the scan limit the list grows by doubling, as a prim of `n`
+        // properties would otherwise copy it `n` times.
         if self.properties.len() < SCAN_LIMIT {
             self.properties.reserve_exact(1);
         }

@@ -1863,9 +1863,12 @@ impl<'a> Parser<'a> {
             out.push(parse_element(this)?);
             Ok(())
         })?;
-        // The array is held for the layer's life; a one-token `xformOpOrder` would
-        // otherwise keep room for four (ppis patch, see PATCHED.md).
-        out.shrink_to_fit();
+        // The array is held for the layer's life, and a one-token `xformOpOrder` would keep
+        // room for four (ppis patch, see PATCHED.md). Fewer than 16 spare bytes are not
+        // worth the copy: the allocator's smallest block holds 24.
+        if (out.capacity() - out.len()) * std::mem::size_of::<T>() >= 16 {
+            out.shrink_to_fit();
+        }
         Ok(out)
     }
 
