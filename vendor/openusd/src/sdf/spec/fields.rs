@@ -293,10 +293,7 @@ mod tests {
         assert_eq!(fields.remove("b"), Some(Value::Int(2)));
         assert_eq!(fields.remove("b"), None);
         let all: Vec<(String, Value)> = fields.into_iter().map(|(name, value)| (name.to_string(), value)).collect();
-        assert_eq!(
-            all,
-            [("a".into(), Value::Int(0)), ("default".into(), Value::Int(10)), ("c".into(), Value::Int(3))]
-        );
+        assert_eq!(all, [("a".into(), Value::Int(0)), ("default".into(), Value::Int(10)), ("c".into(), Value::Int(3))]);
     }
 
     #[test]
