@@ -959,7 +959,7 @@ fn resolve_variant_selections_in<'a>(
                 .get_field(&node.path, FieldKey::VariantSelection.as_str())
             {
                 if let Value::VariantSelectionMap(map) = value.into_owned() {
-                    for (set_name, selection) in map {
+                    for (set_name, selection) in *map {
                         // A set the seed or a stronger opinion already fixed
                         // ignores this value; skip before paying for
                         // evaluation.

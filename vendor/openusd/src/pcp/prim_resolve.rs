@@ -481,14 +481,14 @@ impl PrimIndex {
             let value = opinion?.value;
             match (merged.as_mut(), value.into_owned()) {
                 (None, Value::ValueBlock) => return Ok(None),
-                (None, Value::Dictionary(dict)) => merged = Some(dict),
+                (None, Value::Dictionary(dict)) => merged = Some(*dict),
                 (None, other) => return Ok(Some(other)),
                 (Some(_), Value::ValueBlock) => break,
-                (Some(strong), Value::Dictionary(weaker)) => dictionary_over(strong, weaker),
+                (Some(strong), Value::Dictionary(weaker)) => dictionary_over(strong, *weaker),
                 (Some(_), _) => {}
             }
         }
-        Ok(merged.map(Value::Dictionary))
+        Ok(merged.map(Value::from))
     }
 
     /// Resolves `timeSamples` across the composition graph, applying each
@@ -709,7 +709,7 @@ impl PrimIndex {
             match value.into_owned() {
                 Value::ValueBlock => break,
                 Value::Dictionary(dict) => {
-                    for (set_name, set_value) in dict {
+                    for (set_name, set_value) in *dict {
                         if blocked_sets.contains(&set_name) {
                             continue;
                         }
@@ -720,7 +720,7 @@ impl PrimIndex {
                             continue;
                         };
                         let composed = sets.entry(set_name.clone()).or_default();
-                        for (field, value) in fields {
+                        for (field, value) in *fields {
                             if composed.contains_key(&field) {
                                 continue;
                             }
@@ -755,10 +755,10 @@ impl PrimIndex {
             }
         }
 
-        let clips = Value::Dictionary(
+        let clips = Value::from(
             sets.into_iter()
-                .map(|(name, fields)| (name, Value::Dictionary(fields)))
-                .collect(),
+                .map(|(name, fields)| (name, Value::from(fields)))
+                .collect::<HashMap<_, _>>(),
         );
         let order = self.clip_sets_order(stack)?;
 
@@ -920,7 +920,7 @@ fn dictionary_over(stronger: &mut HashMap<String, Value>, weaker: HashMap<String
             Entry::Occupied(mut entry) => {
                 if let (Value::Dictionary(strong_dict), Value::Dictionary(weak_dict)) = (entry.get_mut(), weaker_value)
                 {
-                    dictionary_over(strong_dict, weak_dict);
+                    dictionary_over(strong_dict, *weak_dict);
                 }
             }
             Entry::Vacant(entry) => {

@@ -58,8 +58,8 @@ pub fn read_expression_variables(data: &dyn sdf::AbstractData) -> Result<Cow<'_,
     let root = sdf::Path::abs_root();
     Ok(
         match data.try_field(&root, sdf::FieldKey::ExpressionVariables.as_str())? {
-            Some(Cow::Borrowed(sdf::Value::Dictionary(dict))) => Cow::Borrowed(dict),
-            Some(Cow::Owned(sdf::Value::Dictionary(dict))) => Cow::Owned(dict),
+            Some(Cow::Borrowed(sdf::Value::Dictionary(dict))) => Cow::Borrowed(&**dict),
+            Some(Cow::Owned(sdf::Value::Dictionary(dict))) => Cow::Owned(*dict),
             _ => Cow::Owned(HashMap::new()),
         },
     )

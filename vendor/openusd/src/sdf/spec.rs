@@ -43,6 +43,10 @@ use strum::{Display, EnumCount, FromRepr};
 use crate::sdf;
 use crate::tf;
 
+mod fields;
+
+pub use fields::{FieldName, Fields};
+
 /// An enum that specifies the type of an object.
 /// Objects are entities that have fields and are addressable by path.
 #[repr(u32)]
@@ -89,10 +93,8 @@ macro_rules! impl_spec_debug {
 pub struct SpecData {
     /// The type of this spec (prim, attribute, relationship, etc.).
     pub ty: sdf::SpecType,
-    /// The fields stored on this spec, in authored order.
-    /// Field names are tokens: the names Sdf registers are static text, so a spec's
-    /// fields allocate nothing for their names.
-    pub fields: Vec<(tf::Token, sdf::Value)>,
+    /// The fields stored on this spec, in authored order, kept compact (see [`Fields`]).
+    pub fields: Fields,
 }
 
 /// Errors raised by typed spec-level authoring helpers.
@@ -112,23 +114,16 @@ pub enum SpecError {
 impl SpecData {
     /// Creates a new empty spec record of the given type.
     pub fn new(ty: sdf::SpecType) -> Self {
-        Self { ty, fields: Vec::new() }
+        Self {
+            ty,
+            fields: Fields::default(),
+        }
     }
 
     /// Insert or replace a field. If the key already exists, its value is
     /// overwritten in place and its position is preserved.
     pub fn add(&mut self, key: impl AsRef<str>, value: impl Into<sdf::Value>) {
-        let key = key.as_ref();
-        let value = value.into();
-        if let Some(slot) = self.fields.iter_mut().find(|(k, _)| k == key) {
-            slot.1 = value;
-        } else {
-            // Grown one field at a time: a spec has a handful of fields, each as large
-            // as the largest `Value`, and the default first capacity of four would
-            // take more memory than the fields do.
-            self.fields.reserve_exact(1);
-            self.fields.push((field_name(key), value));
-        }
+        self.fields.set(key.as_ref(), value.into());
     }
 
     /// Adds a list-op field value, folding it into any existing list op of the
@@ -160,88 +155,30 @@ impl SpecData {
 
     /// Look up a field by name.
     pub fn get(&self, key: &str) -> Option<&sdf::Value> {
-        self.fields.iter().find(|(k, _)| k == key).map(|(_, v)| v)
+        self.fields.get(key)
     }
 
     /// Mutably look up a field by name. Useful for in-place edits to composite
     /// values (time-sample maps, list ops) without cloning.
     pub fn get_mut(&mut self, key: &str) -> Option<&mut sdf::Value> {
-        self.fields.iter_mut().find(|(k, _)| k == key).map(|(_, v)| v)
+        self.fields.get_mut(key)
     }
 
     /// Returns `true` if the spec has a field with the given name.
     pub fn contains(&self, key: &str) -> bool {
-        self.fields.iter().any(|(k, _)| k == key)
+        self.fields.get(key).is_some()
     }
 
     /// Remove a field by name, returning its value if present.
     pub fn remove(&mut self, key: &str) -> Option<sdf::Value> {
-        let idx = self.fields.iter().position(|(k, _)| k == key)?;
-        Some(self.fields.remove(idx).1)
+        self.fields.remove(key)
     }
 
     /// Merge fields from `other` into `self`, upserting each by name.
     pub fn extend_from(&mut self, other: SpecData) {
-        for (k, v) in other.fields {
-            match self.fields.iter_mut().find(|(key, _)| *key == k) {
-                Some(slot) => slot.1 = v,
-                None => {
-                    self.fields.reserve_exact(1);
-                    self.fields.push((k, v));
-                }
-            }
+        for (name, value) in other.fields {
+            self.fields.set_named(name, value);
         }
-    }
-}
-
-/// A field name as a token: the static text of the names Sdf registers (the fields
-/// nearly every spec authors), a shared copy of any other.
-fn field_name(key: &str) -> tf::Token {
-    const NAMES: &[&str] = &[
-        "specifier",
-        "typeName",
-        "default",
-        "variability",
-        "custom",
-        "primChildren",
-        "properties",
-        "timeSamples",
-        "active",
-        "kind",
-        "apiSchemas",
-        "references",
-        "payload",
-        "inherits",
-        "specializes",
-        "variantSets",
-        "variantSetChildren",
-        "variantSelection",
-        "variantChildren",
-        "interpolation",
-        "elementSize",
-        "targetPaths",
-        "targetChildren",
-        "connectionPaths",
-        "connectionChildren",
-        "instanceable",
-        "documentation",
-        "customData",
-        "colorSpace",
-        "hidden",
-        "comment",
-        "assetInfo",
-        "allowedTokens",
-        "displayName",
-        "displayGroup",
-        "permission",
-        "prefixSubstitutions",
-        "suffixSubstitutions",
-        "symmetricPeer",
-        "spline",
-    ];
-    match NAMES.iter().find(|n| **n == key) {
-        Some(name) => tf::Token::new(name),
-        None => tf::Token::from(key),
     }
 }
 
@@ -694,7 +631,7 @@ where
     pub fn set_expression_variables(&mut self, vars: HashMap<String, sdf::Value>) {
         self.set(
             sdf::FieldKey::ExpressionVariables.as_str(),
-            sdf::Value::Dictionary(vars),
+            sdf::Value::from(vars),
         );
     }
 

@@ -41,6 +41,14 @@ impl Entry {
         if let Some(index) = &mut self.index {
             index.insert(name.clone(), slot(at));
         }
+        // A prim's few properties are held for the layer's life in a list of exactly their
+        // number. Shrinking a doubled list once the layer is parsed (`shrink_to_fit`) leaves
+        // its tail as a hole in the heap that the import's later, differently sized blocks
+        // do not fill. Past the scan limit the list grows by doubling, as a prim of `n`
+        // properties would otherwise copy it `n` times.
+        if self.properties.len() < SCAN_LIMIT {
+            self.properties.reserve_exact(1);
+        }
         self.properties.push((name, spec));
         if self.index.is_none() && self.properties.len() > SCAN_LIMIT {
             let index = self.properties.iter().enumerate().map(|(at, (name, _))| (name.clone(), slot(at)));

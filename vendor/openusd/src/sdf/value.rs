@@ -23,8 +23,8 @@ use super::*;
 /// Type-safe extraction is supported via [`TryFrom<Value>`] implementations for common Rust
 /// types (e.g. `f32`, `String`, `gf::Vec3f`).
 ///
-/// The variants larger than a pointer pair and a word or two (matrices of three rows or
-/// more, list ops, asset paths, payloads) are boxed (ppis patch, see PATCHED.md): every
+/// The variants larger than three words (four-component double vectors and quaternions,
+/// matrices, dictionaries, list ops, asset paths, payloads) are boxed (ppis patch, see PATCHED.md): every
 /// field of every spec is a `Value`, and unboxed the enum was as large as a list op
 /// (about 160 bytes) whatever it held.
 #[derive(Debug, Clone, PartialEq, EnumIs, EnumTryAs, IntoStaticStr, derive_more::From)]
@@ -71,7 +71,7 @@ pub enum Value {
 
     Quath(gf::Quath),
     Quatf(gf::Quatf),
-    Quatd(gf::Quatd),
+    Quatd(Box<gf::Quatd>),
     QuathVec(Vec<gf::Quath>),
     QuatfVec(Vec<gf::Quatf>),
     QuatdVec(Vec<gf::Quatd>),
@@ -96,14 +96,14 @@ pub enum Value {
 
     Vec4h(gf::Vec4h),
     Vec4f(gf::Vec4f),
-    Vec4d(gf::Vec4d),
+    Vec4d(Box<gf::Vec4d>),
     Vec4i(gf::Vec4i),
     Vec4hVec(Vec<gf::Vec4h>),
     Vec4fVec(Vec<gf::Vec4f>),
     Vec4dVec(Vec<gf::Vec4d>),
     Vec4iVec(Vec<gf::Vec4i>),
 
-    Matrix2d(gf::Mat2d),
+    Matrix2d(Box<gf::Mat2d>),
     Matrix3d(Box<gf::Mat3d>),
     Matrix4d(Box<gf::Matrix4d>),
     Matrix2dVec(Vec<gf::Mat2d>),
@@ -114,7 +114,7 @@ pub enum Value {
     Permission(Permission),
     Variability(Variability),
 
-    Dictionary(HashMap<String, Value>),
+    Dictionary(Box<HashMap<String, Value>>),
 
     TokenListOp(Box<TokenListOp>),
     StringListOp(Box<StringListOp>),
@@ -130,7 +130,7 @@ pub enum Value {
     PathVec(Vec<Path>),
     /// Layer-level relocates: `(source, target)` path pairs for namespace remapping.
     Relocates(RelocateList),
-    VariantSelectionMap(HashMap<String, String>),
+    VariantSelectionMap(Box<HashMap<String, String>>),
     TimeSamples(TimeSampleMap),
 
     LayerOffsetVec(Vec<LayerOffset>),
@@ -155,8 +155,38 @@ pub enum Value {
 }
 
 // Every spec field holds a `Value`: its size is that of its largest unboxed variant (a
-// `HashMap`, 48 bytes) and the tag.
-const _: () = assert!(std::mem::size_of::<Value>() <= 56);
+// `Vec`, a `String`, a `Token` or three doubles, 24 bytes) and the tag.
+const _: () = assert!(std::mem::size_of::<Value>() <= 32);
+
+impl From<gf::Vec4d> for Value {
+    fn from(v: gf::Vec4d) -> Self {
+        Value::Vec4d(Box::new(v))
+    }
+}
+
+impl From<gf::Quatd> for Value {
+    fn from(v: gf::Quatd) -> Self {
+        Value::Quatd(Box::new(v))
+    }
+}
+
+impl From<gf::Mat2d> for Value {
+    fn from(v: gf::Mat2d) -> Self {
+        Value::Matrix2d(Box::new(v))
+    }
+}
+
+impl From<HashMap<String, Value>> for Value {
+    fn from(v: HashMap<String, Value>) -> Self {
+        Value::Dictionary(Box::new(v))
+    }
+}
+
+impl From<HashMap<String, String>> for Value {
+    fn from(v: HashMap<String, String>) -> Self {
+        Value::VariantSelectionMap(Box::new(v))
+    }
+}
 
 impl From<gf::Mat3d> for Value {
     fn from(v: gf::Mat3d) -> Self {
@@ -555,13 +585,13 @@ impl_try_from_value!(gf::Vec3d, try_as_vec_3d, "gf::Vec3d");
 impl_try_from_value!(gf::Vec3i, try_as_vec_3i, "gf::Vec3i");
 impl_try_from_value!(gf::Vec3h, try_as_vec_3h, "gf::Vec3h");
 impl_try_from_value!(gf::Vec4f, try_as_vec_4f, "gf::Vec4f");
-impl_try_from_value!(gf::Vec4d, try_as_vec_4d, "gf::Vec4d");
+impl_try_from_value!(gf::Vec4d, try_as_vec_4d, "gf::Vec4d", |b: Box<_>| *b);
 impl_try_from_value!(gf::Vec4i, try_as_vec_4i, "gf::Vec4i");
 impl_try_from_value!(gf::Vec4h, try_as_vec_4h, "gf::Vec4h");
 impl_try_from_value!(gf::Quatf, try_as_quatf, "gf::Quatf");
-impl_try_from_value!(gf::Quatd, try_as_quatd, "gf::Quatd");
+impl_try_from_value!(gf::Quatd, try_as_quatd, "gf::Quatd", |b: Box<_>| *b);
 impl_try_from_value!(gf::Quath, try_as_quath, "gf::Quath");
-impl_try_from_value!(gf::Mat2d, try_as_matrix_2d, "gf::Mat2d");
+impl_try_from_value!(gf::Mat2d, try_as_matrix_2d, "gf::Mat2d", |b: Box<_>| *b);
 impl_try_from_value!(gf::Mat3d, try_as_matrix_3d, "gf::Mat3d", |b: Box<_>| *b);
 impl_try_from_value!(gf::Matrix4d, try_as_matrix_4d, "gf::Matrix4d", |b: Box<_>| *b);
 
@@ -613,7 +643,7 @@ impl_try_from_value!([f32; 3], try_as_vec_3f, "gf::Vec3f", Into::into);
 impl_try_from_value!([f32; 4], try_as_vec_4f, "gf::Vec4f", Into::into);
 impl_try_from_value!([f64; 2], try_as_vec_2d, "gf::Vec2d", Into::into);
 impl_try_from_value!([f64; 3], try_as_vec_3d, "gf::Vec3d", Into::into);
-impl_try_from_value!([f64; 4], try_as_vec_4d, "gf::Vec4d", Into::into);
+impl_try_from_value!([f64; 4], try_as_vec_4d, "gf::Vec4d", |b: Box<gf::Vec4d>| (*b).into());
 
 // `gf` vector arrays as arrays of fixed-size arrays.
 impl_try_from_value!(Vec<[f32; 2]>, try_as_vec_2f_vec, "Vec2fVec", map_into);
@@ -689,7 +719,7 @@ impl Value {
         Self::Vec3d(gf::vec3d(x, y, z))
     }
     pub fn vec4d(x: f64, y: f64, z: f64, w: f64) -> Self {
-        Self::Vec4d(gf::vec4d(x, y, z, w))
+        Self::Vec4d(Box::new(gf::vec4d(x, y, z, w)))
     }
     pub fn vec2i(x: i32, y: i32) -> Self {
         Self::Vec2i(gf::vec2i(x, y))
@@ -713,7 +743,7 @@ impl Value {
         Self::Quatf(gf::quatf(w, x, y, z))
     }
     pub fn quatd(w: f64, x: f64, y: f64, z: f64) -> Self {
-        Self::Quatd(gf::quatd(w, x, y, z))
+        Self::Quatd(Box::new(gf::quatd(w, x, y, z)))
     }
     pub fn quath(w: f16, x: f16, y: f16, z: f16) -> Self {
         Self::Quath(gf::quath(w, x, y, z))
@@ -729,7 +759,11 @@ impl Value {
     /// the counterpart of [`Value::token`] for name lists such as
     /// `primChildren` and `allowedTokens`.
     pub fn token_vec(items: impl IntoIterator<Item = impl Into<Token>>) -> Self {
-        Self::TokenVec(items.into_iter().map(Into::into).collect())
+        let mut tokens: Vec<Token> = items.into_iter().map(Into::into).collect();
+        // A layer holds its token lists (a prim's properties and children) for its life,
+        // and a list collected in place keeps its source's spare room (ppis patch).
+        tokens.shrink_to_fit();
+        Self::TokenVec(tokens)
     }
 
     /// Borrows the inner string of a string-like scalar — `asset`, `string`,
@@ -926,11 +960,11 @@ fn vec3_as_f64(value: &Value) -> Option<[f64; 3]> {
 fn vec4_as_f64(value: &Value) -> Option<[f64; 4]> {
     Some(match value {
         Value::Vec4f(v) => [v.x as f64, v.y as f64, v.z as f64, v.w as f64],
-        Value::Vec4d(v) => (*v).into(),
+        Value::Vec4d(v) => (**v).into(),
         Value::Vec4h(v) => [f64::from(v.x), f64::from(v.y), f64::from(v.z), f64::from(v.w)],
         Value::Vec4i(v) => [v.x as f64, v.y as f64, v.z as f64, v.w as f64],
         Value::Quatf(q) => (*q).into(),
-        Value::Quatd(q) => (*q).into(),
+        Value::Quatd(q) => (**q).into(),
         Value::Quath(q) => [f64::from(q.w), f64::from(q.x), f64::from(q.y), f64::from(q.z)],
         _ => return None,
     })

@@ -84,7 +84,8 @@ impl ClipsAPI {
             .prim
             .stage()
             .field::<Value>(self.prim.path(), sdf::FieldKey::Clips)?
-            .and_then(Value::try_as_dictionary))
+            .and_then(Value::try_as_dictionary)
+            .map(|clips| *clips))
     }
 
     /// Replace the entire `clips` dictionary (C++ `UsdClipsAPI::SetClips`).
@@ -93,7 +94,7 @@ impl ClipsAPI {
     pub fn set_clips(&self, clips: sdf::Dictionary) -> Result<(), StageAuthoringError> {
         self.prim
             .clone()
-            .set_metadata(sdf::FieldKey::Clips.as_str(), Value::Dictionary(clips))?;
+            .set_metadata(sdf::FieldKey::Clips.as_str(), Value::from(clips))?;
         Ok(())
     }
 
@@ -279,16 +280,16 @@ impl ClipsAPI {
             .update_metadata(sdf::FieldKey::Clips.as_str(), move |current| {
                 let mut sets = match current {
                     Some(Value::Dictionary(d)) => d,
-                    _ => HashMap::new(),
+                    _ => Box::default(),
                 };
                 match sets
                     .entry(clip_set)
-                    .or_insert_with(|| Value::Dictionary(HashMap::new()))
+                    .or_insert_with(|| Value::Dictionary(Box::default()))
                 {
                     Value::Dictionary(set) => {
                         set.insert(key, value);
                     }
-                    other => *other = Value::Dictionary(HashMap::from([(key, value)])),
+                    other => *other = Value::from(HashMap::from([(key, value)])),
                 }
                 Value::Dictionary(sets)
             })?;
@@ -352,7 +353,7 @@ mod tests {
     #[test]
     fn reads_remaining_fields_and_missing_edges() -> anyhow::Result<()> {
         let stage = Stage::builder().in_memory("anon.usda")?;
-        let set = Value::Dictionary(
+        let set = Value::from(
             [
                 (
                     keys::TIMES.to_string(),
@@ -370,7 +371,7 @@ mod tests {
         );
         stage.define_prim(sdf::path("/Anim")?)?.set_metadata(
             "clips",
-            Value::Dictionary([("default".to_string(), set)].into_iter().collect()),
+            Value::from(HashMap::from([("default".to_string(), set)])),
         )?;
         let clips = ClipsAPI::new(&stage.prim(sdf::path("/Anim")?));
 
@@ -466,7 +467,7 @@ mod tests {
         let clips = ClipsAPI::new(&stage.prim(sdf::path("/Anim")?));
         assert!(clips.clips()?.is_none());
 
-        let set = Value::Dictionary([(keys::PRIM_PATH.to_string(), Value::String("/Geo".into()))].into());
+        let set = Value::from(HashMap::from([(keys::PRIM_PATH.to_string(), Value::String("/Geo".into()))]));
         clips.set_clips(sdf::Dictionary::from([("default".to_string(), set)]))?;
 
         assert_eq!(clips.clip_set_names()?, vec!["default".to_string()]);

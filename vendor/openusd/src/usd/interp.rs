@@ -141,7 +141,7 @@ fn lerp_value(a: &Value, b: &Value, t: f64) -> Option<Value> {
         (V::Double(x), V::Double(y)) => V::Double(gf::lerp(*x, *y, t)),
         (V::TimeCode(x), V::TimeCode(y)) => V::TimeCode(gf::lerp(x.0, y.0, t).into()),
 
-        (V::Matrix2d(x), V::Matrix2d(y)) => V::Matrix2d(x.lerp(*y, t)),
+        (V::Matrix2d(x), V::Matrix2d(y)) => V::Matrix2d(Box::new(x.lerp(**y, t))),
         (V::Matrix3d(x), V::Matrix3d(y)) => V::Matrix3d(Box::new(x.lerp(**y, t))),
         (V::Matrix4d(x), V::Matrix4d(y)) => V::Matrix4d(Box::new(x.lerp(**y, t))),
 
@@ -153,11 +153,11 @@ fn lerp_value(a: &Value, b: &Value, t: f64) -> Option<Value> {
         (V::Vec3d(x), V::Vec3d(y)) => V::Vec3d(x.lerp(*y, t)),
         (V::Vec4h(x), V::Vec4h(y)) => V::Vec4h(x.lerp(*y, t32)),
         (V::Vec4f(x), V::Vec4f(y)) => V::Vec4f(x.lerp(*y, t32)),
-        (V::Vec4d(x), V::Vec4d(y)) => V::Vec4d(x.lerp(*y, t)),
+        (V::Vec4d(x), V::Vec4d(y)) => V::Vec4d(Box::new(x.lerp(**y, t))),
 
         (V::Quath(x), V::Quath(y)) => V::Quath(x.slerp(*y, t)),
         (V::Quatf(x), V::Quatf(y)) => V::Quatf(x.slerp(*y, t)),
-        (V::Quatd(x), V::Quatd(y)) => V::Quatd(x.slerp(*y, t)),
+        (V::Quatd(x), V::Quatd(y)) => V::Quatd(Box::new(x.slerp(**y, t))),
 
         // Array (VtArray) variants. Per C++: bracketing samples must
         // agree on length, otherwise fall back to held.

@@ -849,7 +849,7 @@ mod tests {
     #[test]
     fn prim_custom_data() -> anyhow::Result<()> {
         let stage = stage()?;
-        let dict = sdf::Value::Dictionary([("note".to_string(), sdf::Value::String("hi".into()))].into());
+        let dict = sdf::Value::from(std::collections::HashMap::from([("note".to_string(), sdf::Value::String("hi".into()))]));
         stage
             .define_prim("/A")?
             .set_metadata(sdf::FieldKey::CustomData.as_str(), dict)?;
@@ -927,7 +927,7 @@ mod tests {
         dict.insert("hint".to_string(), sdf::Value::String("v".to_string()));
         stage
             .define_prim("/World")?
-            .set_metadata("customData", sdf::Value::Dictionary(dict))?;
+            .set_metadata("customData", sdf::Value::from(dict))?;
 
         let Some(sdf::Value::Dictionary(read)) = stage.field::<sdf::Value>("/World", "customData")? else {
             panic!("expected customData dictionary");
@@ -943,7 +943,7 @@ mod tests {
         dict.insert("a".to_string(), sdf::Value::Int(1));
         stage
             .define_prim("/World")?
-            .set_metadata("customData", sdf::Value::Dictionary(dict))?;
+            .set_metadata("customData", sdf::Value::from(dict))?;
 
         // The closure receives the local opinion and merges into it.
         stage.define_prim("/World")?.update_metadata("customData", |local| {

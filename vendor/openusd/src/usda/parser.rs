@@ -775,7 +775,7 @@ impl<'a> Parser<'a> {
             let value = match list_op {
                 Some(ref tok @ (Token::Prepend | Token::Append | Token::Delete | Token::Add)) => {
                     let key = tok.keyword_lexeme().unwrap().to_owned();
-                    sdf::Value::Dictionary(HashMap::from([(key, value)]))
+                    sdf::Value::from(HashMap::from([(key, value)]))
                 }
                 _ => value,
             };
@@ -876,7 +876,7 @@ impl<'a> Parser<'a> {
             Ok(())
         })?;
 
-        Ok(sdf::Value::Dictionary(dict))
+        Ok(sdf::Value::from(dict))
     }
 
     fn read_relationship(
@@ -1037,7 +1037,7 @@ impl<'a> Parser<'a> {
                         .into_iter()
                         .filter_map(|(k, v)| v.try_as_string().map(|s| (k, s.to_owned())))
                         .collect();
-                    spec.add(FieldKey::VariantSelection, sdf::Value::VariantSelectionMap(selections));
+                    spec.add(FieldKey::VariantSelection, sdf::Value::from(selections));
                 }
             }
             n if n == FieldKey::VariantSetNames.as_str() => {
@@ -1137,7 +1137,7 @@ impl<'a> Parser<'a> {
         } else {
             0.0
         };
-        Ok(sdf::Value::Dictionary(HashMap::from([
+        Ok(sdf::Value::from(HashMap::from([
             ("mode".to_owned(), sdf::Value::token(mode)),
             ("slope".to_owned(), sdf::Value::Double(slope)),
         ])))
@@ -1186,7 +1186,7 @@ impl<'a> Parser<'a> {
                         this.ensure_pun(':')?;
                     }
                     let vals = this.parse_tuple::<f64, 5>()?;
-                    loop_params = sdf::Value::Dictionary(HashMap::from([
+                    loop_params = sdf::Value::from(HashMap::from([
                         ("protoStart".to_owned(), sdf::Value::Double(vals[0])),
                         ("protoEnd".to_owned(), sdf::Value::Double(vals[1])),
                         ("numPreLoops".to_owned(), sdf::Value::Double(vals[2])),
@@ -1251,7 +1251,7 @@ impl<'a> Parser<'a> {
                         }
                     }
 
-                    knots.push(sdf::Value::Dictionary(HashMap::from([
+                    knots.push(sdf::Value::from(HashMap::from([
                         ("time".to_owned(), sdf::Value::Double(time)),
                         ("value".to_owned(), sdf::Value::Double(value)),
                         ("preValue".to_owned(), sdf::Value::Double(pre_value)),
@@ -1267,7 +1267,7 @@ impl<'a> Parser<'a> {
             Ok(())
         })?;
 
-        Ok(sdf::Value::Dictionary(HashMap::from([
+        Ok(sdf::Value::from(HashMap::from([
             (
                 "curveType".to_owned(),
                 sdf::Value::token(curve_type.unwrap_or_else(|| "bezier".to_owned())),
@@ -1276,7 +1276,7 @@ impl<'a> Parser<'a> {
             ("postExtrapolation".to_owned(), post_extrapolation),
             ("loopParameters".to_owned(), loop_params),
             ("knots".to_owned(), sdf::Value::ValueVec(knots)),
-            ("knotCustomData".to_owned(), sdf::Value::Dictionary(knot_custom_data)),
+            ("knotCustomData".to_owned(), sdf::Value::from(knot_custom_data)),
         ])))
     }
 
@@ -1434,7 +1434,7 @@ impl<'a> Parser<'a> {
                     let sdf::Value::Dictionary(dict) = this.parse_dictionary()? else {
                         unreachable!("parse_dictionary always returns Dictionary");
                     };
-                    custom_data = dict;
+                    custom_data = *dict;
                 }
                 unexpected => bail!("Unexpected token in layer offset: {unexpected:?}"),
             }
@@ -1556,13 +1556,13 @@ impl<'a> Parser<'a> {
             (Type::Double2, true) => sdf::Value::Vec2dVec(self.parse_gf_array::<f64, _, 2>()?),
             (Type::Double3, false) => sdf::Value::Vec3d(self.parse_gf::<f64, _, 3>()?),
             (Type::Double3, true) => sdf::Value::Vec3dVec(self.parse_gf_array::<f64, _, 3>()?),
-            (Type::Double4, false) => sdf::Value::Vec4d(self.parse_gf::<f64, _, 4>()?),
+            (Type::Double4, false) => sdf::Value::Vec4d(Box::new(self.parse_gf::<f64, _, 4>()?)),
             (Type::Double4, true) => sdf::Value::Vec4dVec(self.parse_gf_array::<f64, _, 4>()?),
 
             // Quaternion fields in USDA are (w, x, y, z) — same as gf::Quat* field order.
             (Type::Quath, false) => sdf::Value::Quath(self.parse_gf::<crate::gf::f16, _, 4>()?),
             (Type::Quatf, false) => sdf::Value::Quatf(self.parse_gf::<f32, _, 4>()?),
-            (Type::Quatd, false) => sdf::Value::Quatd(self.parse_gf::<f64, _, 4>()?),
+            (Type::Quatd, false) => sdf::Value::Quatd(Box::new(self.parse_gf::<f64, _, 4>()?)),
             (Type::Quath, true) => sdf::Value::QuathVec(self.parse_gf_array::<crate::gf::f16, _, 4>()?),
             (Type::Quatf, true) => sdf::Value::QuatfVec(self.parse_gf_array::<f32, _, 4>()?),
             (Type::Quatd, true) => sdf::Value::QuatdVec(self.parse_gf_array::<f64, _, 4>()?),
@@ -1574,7 +1574,7 @@ impl<'a> Parser<'a> {
                 Ok(this.name_token(text))
             })?),
 
-            (Type::Matrix2d, false) => sdf::Value::Matrix2d(gf::Mat2d(self.parse_matrix::<2, 4>()?)),
+            (Type::Matrix2d, false) => sdf::Value::Matrix2d(Box::new(gf::Mat2d(self.parse_matrix::<2, 4>()?))),
             (Type::Matrix3d, false) => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.parse_matrix::<3, 9>()?))),
             (Type::Matrix4d, false) => sdf::Value::Matrix4d(Box::new(gf::Matrix4d(self.parse_matrix::<4, 16>()?))),
             (Type::Matrix2d, true) => {
@@ -1863,6 +1863,12 @@ impl<'a> Parser<'a> {
             out.push(parse_element(this)?);
             Ok(())
         })?;
+        // The array is held for the layer's life, and a one-token `xformOpOrder` would keep
+        // room for four (ppis patch, see PATCHED.md). Fewer than 16 spare bytes are not
+        // worth the copy: the allocator's smallest block holds 24.
+        if (out.capacity() - out.len()) * std::mem::size_of::<T>() >= 16 {
+            out.shrink_to_fit();
+        }
         Ok(out)
     }
 

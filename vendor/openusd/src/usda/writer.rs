@@ -334,7 +334,7 @@ impl<W: Write> Emitter<'_, W> {
         if let Some(Value::ValueVec(knots)) = dict.get("knots") {
             for knot in knots {
                 if let Value::Dictionary(knot) = knot {
-                    self.write_knot(knot, knot_custom)?;
+                    self.write_knot(knot, knot_custom.map(|custom| &**custom))?;
                 }
             }
         }
@@ -1544,7 +1544,7 @@ mod tests {
         dict.insert("ns:colon:key".to_string(), Value::Int(2));
         dict.insert("key with space".to_string(), Value::Int(3));
         dict.insert("1leading-digit".to_string(), Value::Int(4));
-        root_spec.add(FieldKey::CustomLayerData, Value::Dictionary(dict));
+        root_spec.add(FieldKey::CustomLayerData, Value::from(dict));
 
         let text = TextWriter::write_to_string(&data as &dyn AbstractData).unwrap();
         let parsed = Parser::new(&text)

@@ -125,7 +125,7 @@ where
         // deduplicated arrays and are resolved on demand. A property spec goes to
         // its owner's entry.
         let specs = mem::take(&mut file.specs);
-        let is_property = |index: usize| file.property_names[index] != reader::NO_PROPERTY;
+        let is_property = |index: usize| file.paths[index].is_property();
         let owners = specs.iter().filter(|spec| !is_property(spec.path_index)).count();
         let mut data: sdf::PathMap<Entry> = sdf::PathMap::with_capacity_and_hasher(owners, Default::default());
 
@@ -134,13 +134,13 @@ where
                 .ok()
                 .filter(|&i| i != NO_FIELDSET)
                 .context("corrupt file: fieldset index out of range")?;
-            let entry = data.entry(file.paths[spec.path_index].clone()).or_default();
+            let entry = data.entry(file.node(spec.path_index).clone()).or_default();
             let new = Spec {
                 ty: spec.spec_type,
                 fieldset,
                 authored: None,
             };
-            match file.property_names[spec.path_index] {
+            match file.paths[spec.path_index].name {
                 reader::NO_PROPERTY => entry.spec = Some(new),
                 name => entry.properties.push((name, new)),
             }
@@ -656,7 +656,7 @@ mod tests {
             .unwrap();
 
         // USDC bytes are `[x, y, z, w]`; reader returns `(w, x, y, z)`.
-        assert_eq!(quat, gf::quatd(2.4, 5.3, 6.3, 5.2));
+        assert_eq!(*quat, gf::quatd(2.4, 5.3, 6.3, 5.2));
 
         let quat = data
             .get_field(&sdf::path("/World.quatdArr")?, "default")?

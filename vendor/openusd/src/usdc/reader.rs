@@ -45,15 +45,16 @@ pub struct CrateFile<R> {
     pub fields: Vec<Field>,
     /// A vector of groups of fields, invalid-index terminated.
     pub fieldsets: Vec<Option<usize>>,
-    /// All unique paths, but a prim's property: its owner's path, the property's name
-    /// being in [`property_names`](Self::property_names). Use [`path`](Self::path).
-    pub paths: Vec<sdf::Path>,
-    /// ppis patch: for each of [`paths`](Self::paths), the token of the property name
-    /// appended to it, or [`NO_PROPERTY`]. A property's path node is made only when a value
-    /// names it ([`path`](Self::path)): the layer keys property specs by owner and name
-    /// (`CrateData`), and on a stage of simple prims the properties' nodes were a third of
-    /// the layer's memory.
-    pub property_names: Vec<u32>,
+    /// ppis patch: every unique path of the PATHS section, by its index there, as a node
+    /// of [`nodes`](Self::nodes) and, for a prim's property, the token of its name. A
+    /// property's path node is made only when a value names it ([`path`](Self::path)): the
+    /// layer keys property specs by owner and name (`CrateData`), and a slot of 8 bytes per
+    /// path instead of a node handle and a name (20) keeps a simple prim's six paths in 48
+    /// bytes for the layer's life.
+    pub paths: Vec<PathSlot>,
+    /// ppis patch: the path nodes that [`paths`](Self::paths) name (the first is the empty
+    /// path, which a slot the file never fills names).
+    pub nodes: Vec<sdf::Path>,
     // All specs.
     pub specs: Vec<Spec>,
     /// ppis patch: how many values enclose the one being read (see [`MAX_VALUE_DEPTH`]).
@@ -65,8 +66,31 @@ pub struct CrateFile<R> {
 /// nesting than this is refused as corrupt instead of overflowing the stack.
 pub const MAX_VALUE_DEPTH: usize = 128;
 
-/// [`CrateFile::property_names`] of a path that is not a prim's property.
+/// [`PathSlot::name`] of a path that is not a prim's property.
 pub const NO_PROPERTY: u32 = u32::MAX;
+
+/// ppis patch: one path of the PATHS section: a node of [`CrateFile::nodes`] and, for a
+/// prim's property, the token of the name appended to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PathSlot {
+    /// The index of the path, or of the property's owner, in [`CrateFile::nodes`].
+    pub node: u32,
+    /// The token of the property's name, or [`NO_PROPERTY`].
+    pub name: u32,
+}
+
+// One per path of the file, held for the layer's life.
+const _: () = assert!(std::mem::size_of::<PathSlot>() == 8);
+
+impl PathSlot {
+    /// The slot of the empty path.
+    const EMPTY: PathSlot = PathSlot { node: 0, name: NO_PROPERTY };
+
+    /// Whether the slot is a prim's property, kept by owner and name.
+    pub fn is_property(&self) -> bool {
+        self.name != NO_PROPERTY
+    }
+}
 
 impl<R> CrateFile<R> {
     /// Returns file's version extracted from bootstrap header.
@@ -93,7 +117,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             fields: Vec::new(),
             fieldsets: Vec::new(),
             paths: Vec::new(),
-            property_names: Vec::new(),
+            nodes: Vec::new(),
             specs: Vec::new(),
             value_depth: 0,
         };
@@ -387,8 +411,8 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         if let Some(i) = element_token_indexes.iter().find(|i| i.unsigned_abs() as usize >= self.tokens.len()) {
             bail!("corrupt file: path element token {i} of {} tokens", self.tokens.len());
         }
-        self.paths = vec![sdf::Path::default(); path_count];
-        self.property_names = vec![NO_PROPERTY; path_count];
+        self.paths = vec![PathSlot::EMPTY; path_count];
+        self.nodes = vec![sdf::Path::default()];
 
         self.build_compressed_paths(&path_indexes, &element_token_indexes, &jumps)?;
 
@@ -419,12 +443,13 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             return Ok(());
         }
 
-        let mut pending = vec![(0usize, sdf::Path::default())];
+        // Each pending subtree carries its parent's path and, once known, the parent's node.
+        let mut pending = vec![(0usize, sdf::Path::default(), None)];
         // ppis patch: a valid jump table visits each entry once; a corrupt one may point past
         // the end or make subtrees overlap, which would take exponential time.
         let mut visits = 0usize;
 
-        while let Some((mut current_index, mut parent_path)) = pending.pop() {
+        while let Some((mut current_index, mut parent_path, mut parent_node)) = pending.pop() {
             loop {
                 let index = current_index;
                 current_index += 1;
@@ -436,7 +461,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
                 if parent_path.is_empty() {
                     parent_path = sdf::Path::new("/")?;
-                    self.paths[index] = parent_path.clone();
+                    self.paths[index] = self.add_node(parent_path.clone())?;
                 } else {
                     let token_index = element_token_indexes[index];
                     let is_prim_property_path = token_index < 0;
@@ -444,18 +469,24 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     let element_token = self.tokens[token_index].as_str();
 
                     let slot = path_indexes[index] as usize;
-                    self.property_names[slot] = NO_PROPERTY;
                     self.paths[slot] = if is_prim_property_path && parent_path.owns_property(element_token) {
-                        self.property_names[slot] = token_index as u32;
-                        parent_path.clone()
+                        let node = match parent_node {
+                            Some(node) => node,
+                            None => {
+                                let added = self.add_node(parent_path.clone())?.node;
+                                parent_node = Some(added);
+                                added
+                            }
+                        };
+                        PathSlot { node, name: token_index as u32 }
                     } else if is_prim_property_path {
-                        parent_path.append_property(element_token)?
+                        self.add_node(parent_path.append_property(element_token)?)?
                     } else if element_token.starts_with('{') {
                         // Variant segments are appended directly without a separator
                         // to produce canonical paths like /Prim{set=sel}.
-                        parent_path.append_variant_segment(element_token)
+                        self.add_node(parent_path.append_variant_segment(element_token))?
                     } else {
-                        parent_path.append_path(element_token)?
+                        self.add_node(parent_path.append_path(element_token)?)?
                     };
                 }
 
@@ -466,12 +497,14 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     if has_sibling {
                         let sibling_index = index + jumps[index] as usize;
                         // Siblings share this node's parent; defer the subtree.
-                        pending.push((sibling_index, parent_path.clone()));
+                        pending.push((sibling_index, parent_path.clone(), parent_node));
                     }
 
                     // Descend into the child (the next sequential entry) under
                     // this node's path.
-                    parent_path = self.path(path_indexes[index] as usize)?;
+                    let slot = path_indexes[index] as usize;
+                    parent_path = self.path(slot)?;
+                    parent_node = Some(self.paths[slot]).filter(|slot| !slot.is_property()).map(|slot| slot.node);
                 }
 
                 if !has_child && !has_sibling {
@@ -480,7 +513,15 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
         }
 
+        self.nodes.shrink_to_fit();
         Ok(())
+    }
+
+    /// The slot of a new node holding `path`.
+    fn add_node(&mut self, path: sdf::Path) -> Result<PathSlot> {
+        let node = u32::try_from(self.nodes.len()).context("corrupt file: more than 2^32 paths")?;
+        self.nodes.push(path);
+        Ok(PathSlot { node, name: NO_PROPERTY })
     }
 
     fn read_specs(&mut self) -> Result<()> {
@@ -768,13 +809,20 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     }
 
     /// The path at `index` of the PATHS section (ppis patch: a property's node is made
-    /// here, from its owner and name; see [`property_names`](Self::property_names)).
+    /// here, from its owner and name; see [`paths`](Self::paths)).
     pub fn path(&self, index: usize) -> Result<sdf::Path> {
-        let owner = self.paths.get(index).with_context(|| format!("corrupt file: path index {index} out of range"))?;
-        match self.property_names.get(index).copied().unwrap_or(NO_PROPERTY) {
-            NO_PROPERTY => Ok(owner.clone()),
-            name => owner.append_property(&self.tokens[name as usize]),
+        let slot = self.paths.get(index).with_context(|| format!("corrupt file: path index {index} out of range"))?;
+        let node = &self.nodes[slot.node as usize];
+        match slot.name {
+            NO_PROPERTY => Ok(node.clone()),
+            name => node.append_property(&self.tokens[name as usize]),
         }
+    }
+
+    /// The node of the path at `index`, or of its owner if it is a prim's property (an
+    /// index the caller has checked, as [`validate`](Self::validate) does for specs).
+    pub fn node(&self, index: usize) -> &sdf::Path {
+        &self.nodes[self.paths[index].node as usize]
     }
 
     /// Reads a count-prefixed vector of POD values.
@@ -1101,7 +1149,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
             Type::Vec4d if value.is_inlined() => {
                 let [x, y, z, w] = to_vec::<f64, 4>(self.unpack_value(value)?);
-                sdf::Value::Vec4d(gf::vec4d(x, y, z, w))
+                sdf::Value::Vec4d(Box::new(gf::vec4d(x, y, z, w)))
             }
             Type::Vec4i if value.is_inlined() => {
                 let [x, y, z, w] = to_vec::<i32, 4>(self.unpack_value(value)?);
@@ -1121,7 +1169,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
             Type::Vec4h => sdf::Value::Vec4h(self.unpack_value::<gf::Vec4h>(value)?),
             Type::Vec4f => sdf::Value::Vec4f(self.unpack_value::<gf::Vec4f>(value)?),
-            Type::Vec4d => sdf::Value::Vec4d(self.unpack_value::<gf::Vec4d>(value)?),
+            Type::Vec4d => sdf::Value::Vec4d(Box::new(self.unpack_value::<gf::Vec4d>(value)?)),
             Type::Vec4i => sdf::Value::Vec4i(self.unpack_value::<gf::Vec4i>(value)?),
 
             //
@@ -1147,7 +1195,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             ),
 
             Type::Matrix2d if value.is_inlined() => {
-                sdf::Value::Matrix2d(gf::Mat2d(to_mat_diag::<2, 4>(self.unpack_value(value)?)))
+                sdf::Value::Matrix2d(Box::new(gf::Mat2d(to_mat_diag::<2, 4>(self.unpack_value(value)?))))
             }
             Type::Matrix3d if value.is_inlined() => {
                 sdf::Value::Matrix3d(Box::new(gf::Mat3d(to_mat_diag::<3, 9>(self.unpack_value(value)?))))
@@ -1156,7 +1204,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 sdf::Value::Matrix4d(Box::new(gf::Matrix4d(to_mat_diag::<4, 16>(self.unpack_value(value)?))))
             }
 
-            Type::Matrix2d => sdf::Value::Matrix2d(gf::Mat2d(self.unpack_value::<[f64; 4]>(value)?)),
+            Type::Matrix2d => sdf::Value::Matrix2d(Box::new(gf::Mat2d(self.unpack_value::<[f64; 4]>(value)?))),
             Type::Matrix3d => sdf::Value::Matrix3d(Box::new(gf::Mat3d(self.unpack_value::<[f64; 9]>(value)?))),
             Type::Matrix4d => sdf::Value::Matrix4d(Box::new(gf::Matrix4d(self.unpack_value::<[f64; 16]>(value)?))),
 
@@ -1354,7 +1402,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                     map.insert(key, value);
                 }
 
-                sdf::Value::VariantSelectionMap(map)
+                sdf::Value::from(map)
             }
 
             Type::TimeSamples => {
@@ -1403,14 +1451,14 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
 
             // Empty dictionary.
-            Type::Dictionary if value.is_inlined() => sdf::Value::Dictionary(HashMap::default()),
+            Type::Dictionary if value.is_inlined() => sdf::Value::Dictionary(Box::default()),
             Type::Dictionary => {
                 ensure!(!value.is_compressed(), "Dictionary {ty} can't be compressed");
                 ensure!(!value.is_array(), "Dictionary {ty} can't be inlined");
 
                 self.set_position(value.payload())?;
 
-                sdf::Value::Dictionary(self.read_custom_data()?)
+                sdf::Value::from(self.read_custom_data()?)
             }
 
             Type::ValueBlock => sdf::Value::ValueBlock,

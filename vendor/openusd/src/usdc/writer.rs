@@ -516,7 +516,7 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
 
             Value::Vec2d(a) => self.write_pod_out(Type::Vec2d, a),
             Value::Vec3d(a) => self.write_pod_out(Type::Vec3d, a),
-            Value::Vec4d(a) => self.write_pod_out(Type::Vec4d, a),
+            Value::Vec4d(a) => self.write_pod_out(Type::Vec4d, &**a),
             Value::Quatd(a) => {
                 let pixar = [a.x, a.y, a.z, a.w];
                 self.write_pod_out(Type::Quatd, &pixar)
@@ -526,7 +526,7 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
             Value::Vec3i(a) => self.write_pod_out(Type::Vec3i, a),
             Value::Vec4i(a) => self.write_pod_out(Type::Vec4i, a),
 
-            Value::Matrix2d(a) => self.write_pod_out(Type::Matrix2d, a),
+            Value::Matrix2d(a) => self.write_pod_out(Type::Matrix2d, &**a),
             Value::Matrix3d(a) => self.write_pod_out(Type::Matrix3d, &**a),
             Value::Matrix4d(a) => self.write_pod_out(Type::Matrix4d, &**a),
 

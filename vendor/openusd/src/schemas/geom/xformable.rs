@@ -304,7 +304,7 @@ fn value_to_vec3_f64(v: &sdf::Value) -> Option<[f64; 3]> {
 
 fn value_to_quat_wxyz(v: &sdf::Value) -> Option<[f64; 4]> {
     match v {
-        sdf::Value::Quatd(q) => Some(<[f64; 4]>::from(*q)),
+        sdf::Value::Quatd(q) => Some(<[f64; 4]>::from(**q)),
         sdf::Value::Quatf(q) => Some([q.w as f64, q.x as f64, q.y as f64, q.z as f64]),
         sdf::Value::Quath(q) => Some([
             q.w.to_f32() as f64,
