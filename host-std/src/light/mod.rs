@@ -5,6 +5,7 @@
 
 pub mod baselines;
 mod distant_in_env;
+mod latlong_x4;
 pub use distant_in_env::move_distant_lights;
 pub mod environment;
 pub mod image_file;

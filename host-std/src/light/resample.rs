@@ -8,9 +8,9 @@
 //! for its points, x along u, y along v of the square.
 
 use crate::light::image_file::RgbImage;
+use crate::light::latlong_x4::LatLongLookup;
 use rayon::prelude::*;
-use sampler_core::glam::{Vec2, Vec3};
-use sampler_core::mapping::square_to_sphere;
+use sampler_core::glam::{Vec3, Vec4};
 use std::f64::consts::PI;
 
 /// Continuous lat-long coordinates (u, v) ∈ \[0,1)×\[0,1\] of a local direction (f64: an f32
@@ -141,18 +141,24 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
         let l = lum(t);
         if l > threshold && threshold > 0.0 { t.map(|c| (c as f64 * threshold / l) as f32) } else { t }
     };
-    let lookup = |s: f64, t: f64| {
-        let (i, j) = direction_to_latlong(square_to_sphere(Vec2::new(s as f32, t as f32)), image.width, image.height);
-        clamped(image.texels[j * image.width + i])
+    let pixels = LatLongLookup::new(image.width, image.height);
+    // The source texels at four points of the square (coordinates in f64, read as f32).
+    let lookup4 = |s: [f64; 4], t: [f64; 4]| {
+        let found = pixels.pixels_x4(Vec4::from_array(s.map(|s| s as f32)), Vec4::from_array(t.map(|t| t as f32)));
+        found.map(|(i, j)| clamped(image.texels[j * image.width + i]))
     };
+    // The mean of k × k stratified points of texel (x, y), row by row, four at a time.
     let average = |x: usize, y: usize, k: usize| -> [f64; 3] {
         let mut acc = [0.0f64; 3];
-        for sy in 0..k {
-            for sx in 0..k {
-                let t =
-                    lookup(((x * k + sx) as f64 + 0.5) / (n * k) as f64, ((y * k + sy) as f64 + 0.5) / (n * k) as f64);
+        let at = |i: usize| (i as f64 + 0.5) / (n * k) as f64;
+        let points = k * k;
+        for first in (0..points).step_by(4) {
+            let q = |l: usize| (first + l).min(points - 1);
+            let found =
+                lookup4(std::array::from_fn(|l| at(x * k + q(l) % k)), std::array::from_fn(|l| at(y * k + q(l) / k)));
+            for f in &found[..(points - first).min(4)] {
                 for c in 0..3 {
-                    acc[c] += t[c] as f64;
+                    acc[c] += f[c] as f64;
                 }
             }
         }
@@ -164,10 +170,17 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     let band = BAND_ROWS.min(n);
     out.par_chunks_mut(n * band).enumerate().for_each(|(b, rows)| {
         let y0 = b * band;
-        let corner: Vec<f64> = (0..=band)
-            .flat_map(|j| (0..=n).map(move |i| (i, y0 + j)))
-            .map(|(i, j)| lum(lookup(i as f64 / n as f64, j as f64 / n as f64)))
-            .collect();
+        let width = n + 1;
+        let count = (band + 1) * width;
+        let mut corner: Vec<f64> = Vec::with_capacity(count + 3);
+        for first in (0..count).step_by(4) {
+            let q = |l: usize| ((first + l).min(count - 1) % width, y0 + (first + l).min(count - 1) / width);
+            let found = lookup4(
+                std::array::from_fn(|l| q(l).0 as f64 / n as f64),
+                std::array::from_fn(|l| q(l).1 as f64 / n as f64),
+            );
+            corner.extend(found.iter().take(count - first).map(|&t| lum(t)));
+        }
         for (k, texel) in rows.iter_mut().enumerate() {
             let (x, y) = (k % n, y0 + k / n);
             let mean = average(x, y, ss);
