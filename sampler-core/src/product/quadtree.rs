@@ -205,7 +205,12 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
         for c in 0..4 {
-            if bounds[c + 1] > bounds[c] {
+            if bounds[c + 1] == bounds[c] + 1 && !self.probe_leaves && !self.bilinear {
+                // A leaf of one sample (most leaves) without the call.
+                (b[c], p[c]) = self.sample_leaf(first + c, l[c], bounds[c]);
+                sum_b += b[c];
+                filled += 1;
+            } else if bounds[c + 1] > bounds[c] {
                 (b[c], p[c]) = self.node(first + c, cell.child(c), l[c], bounds[c], bounds[c + 1]);
                 sum_b += b[c];
                 filled += 1;
@@ -265,6 +270,16 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         (b, product)
     }
 
+    /// [`leaf`](Self::leaf) of the one sample `keys[at]`, with neither probed nor bilinear leaves.
+    #[inline(always)]
+    fn sample_leaf(&mut self, index: usize, env: f32, at: usize) -> (f32, f32) {
+        let sum: f32 = core::iter::once(self.values[(self.keys[at] & 0xFFFF) as usize]).sum();
+        let b = sum / 1.0;
+        let product = b * env;
+        set(&mut self.nodes[index], 0, product);
+        (b, product)
+    }
+
     /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
     /// sorted by the next two Morton bits' digit, so three binary searches find them in a long
     /// run, and counting each digit in a short one (most of the tree's runs, where a scan costs
@@ -294,9 +309,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     fn push_children(&mut self, index: usize, cell: Cell) -> usize {
         let Cell { level: depth, x, y } = cell;
         let first = self.nodes.len();
-        for _ in 0..4 {
-            let _ = self.nodes.push(Node::default());
-        }
+        let _ = self.nodes.extend_from_slice(&[Node::default(); 4]);
         if self.bilinear {
             let w = self.corners[index];
             let inv = 1.0 / (1u64 << depth) as f32;
