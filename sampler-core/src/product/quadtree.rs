@@ -149,7 +149,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             let _ = self.corners.push(w);
         }
         let root_env = self.env.cell_relative(Cell::ROOT);
-        let (_, total) = self.node(0, Cell::ROOT, root_env, 0, self.keys.len());
+        let (_, total) = self.node(0, Cell::ROOT, 0, root_env, 0, self.keys.len());
         if self.refine_share > 0.0 && total > 0.0 && total.is_finite() {
             self.refine(0, Cell::ROOT, root_env, self.refine_share * total);
         }
@@ -203,8 +203,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     /// Fills node `index` covering `cell` and samples `lo..hi` (non-empty); returns its (B̃
     /// mean, product mean). Fields are written in place: building a `Node` on the stack and
     /// copying it back costs a failed store-forward per node. `env` is the environment's
-    /// relative mean over the cell (fetched by the parent).
-    fn node(&mut self, index: usize, cell: Cell, env: f32, lo: usize, hi: usize) -> (f32, f32) {
+    /// relative mean over the cell (fetched by the parent), `code` the cell's Morton index
+    /// within its level (carried down: a child's is 4·code + c; its high bits may be lost below
+    /// the levels a 32-bit `usize` holds, where the map has no level to look up).
+    #[allow(clippy::too_many_arguments)]
+    fn node(&mut self, index: usize, cell: Cell, code: usize, env: f32, lo: usize, hi: usize) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || cell.level >= self.max_depth || !room {
             return self.leaf(index, cell, env, lo, hi);
@@ -213,7 +216,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let bounds = self.split(cell.level, lo, hi);
         // The environment over the four children: one 2×2 block of the pyramid (or the texel
         // containing them, below the finest level).
-        let l = if cell.level < self.env.finest_level() { self.env.children_relative(cell) } else { [env; 4] };
+        let l = if cell.level < self.env.finest_level() {
+            self.env.children_relative_at(cell.level, code)
+        } else {
+            [env; 4]
+        };
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
@@ -224,7 +231,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
                 sum_b += b[c];
                 filled += 1;
             } else if bounds[c + 1] > bounds[c] {
-                (b[c], p[c]) = self.node(first + c, cell.child(c), l[c], bounds[c], bounds[c + 1]);
+                (b[c], p[c]) = self.node(first + c, cell.child(c), (code << 2) | c, l[c], bounds[c], bounds[c + 1]);
                 sum_b += b[c];
                 filled += 1;
             }
