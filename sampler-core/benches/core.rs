@@ -220,9 +220,44 @@ fn two_level_points(c: &mut Criterion) {
     }
 }
 
+/// Build + 16 warps of the quadtree product from fewer BRDF samples (K = 256 is "two
+/// products"), 1024² map: what a K per lobe width would cost (docs/perf.md, "Building a product
+/// sampler"; error at equal time against K in docs/tuning.md).
+fn quadtree_k(c: &mut Criterion) {
+    let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
+        ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
+        ("ggx a=0.01", Box::new(RoughConductor::new(0.01, Vec3::ONE))),
+        ("ggx a=0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
+        ("ggx a=0.3", Box::new(RoughConductor::new(0.3, Vec3::ONE))),
+        ("carpaint", Box::new(CarPaint::default())),
+    ];
+    let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
+    let points = shading_point_set();
+    let map = sunny_map(10);
+    let env = EnvHierarchy::new(map.level, &map.pyramid, &map.rgb).unwrap();
+    let mut g = c.benchmark_group("quadtree K 1024x1024");
+    for (name, brdf) in &brdfs {
+        for k in [32usize, 64, 128] {
+            let params = ProductParams { brdf_samples: k, ..ProductParams::default() };
+            let mut i = 0u64;
+            g.bench_function(BenchmarkId::new(*name, format!("K={k}")), |b| {
+                let mut pts = [DVec2::ZERO; 16];
+                b.iter(|| {
+                    i += 1;
+                    let (frame, wo) = &points[(i % 100) as usize];
+                    let s = arena.build(&env, brdf.as_ref(), frame, *wo, &params, i).unwrap();
+                    sobol02(i, 0, &mut pts);
+                    black_box(pts.iter().filter_map(|u| s.sample(*u)).map(|d| d.pdf).sum::<f32>())
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().measurement_time(Duration::from_secs(2)).warm_up_time(Duration::from_millis(500)).sample_size(30);
-    targets = mapping, shading_points, two_level_points
+    targets = mapping, shading_points, two_level_points, quadtree_k
 }
 criterion_main!(benches);

@@ -1,6 +1,9 @@
 //! Runs many shading-point builds in a loop, for profilers (`perf record`, callgrind).
-//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations] [mis]`
-//! (`mis`: the product-MIS preset `ProductParams::for_mis`, probed and refined leaves).
+//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations] [mis|points] [K]`
+//! (brdf: lambert, phong, carpaint, ggx — α 0.1 — or ggxA for GGX α = A)
+//! (`mis`: the product-MIS preset `ProductParams::for_mis`, probed and refined leaves; `points`:
+//! only the shading points, build + 16 warps each, without the stages after them, for a CPU-time
+//! measure of the whole process such as `perf stat -e task-clock`).
 
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
@@ -15,8 +18,12 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("ggx", String::as_str);
     let iters: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(50_000);
-    let params =
-        if args.get(3).is_some_and(|a| a == "mis") { ProductParams::for_mis(256) } else { ProductParams::default() };
+    let k: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(256);
+    let params = if args.get(3).is_some_and(|a| a == "mis") {
+        ProductParams::for_mis(k)
+    } else {
+        ProductParams { brdf_samples: k, ..ProductParams::default() }
+    };
     let brdf = brdf_named(which);
     let level = 10;
     let n = 1usize << level;
@@ -43,6 +50,10 @@ fn main() {
         }
     }
     let dt = t.elapsed().as_secs_f64();
+    if args.get(3).is_some_and(|a| a == "points") {
+        println!("{which}: {:.2} µs per shading point ({acc:.3e})", dt / iters as f64 * 1e6);
+        return;
+    }
     // Stages, each over the same shading points.
     let mut frames = Vec::new();
     let mut rng = Pcg32::new(1, 1);
@@ -90,8 +101,11 @@ fn main() {
     );
 }
 
-/// The BRDF the first argument names (GGX α = 0.1 by default).
+/// The BRDF the first argument names (GGX α = 0.1 by default; `ggx0.3`: GGX α = 0.3).
 fn brdf_named(which: &str) -> Box<dyn Brdf> {
+    if let Some(alpha) = which.strip_prefix("ggx").and_then(|a| a.parse().ok()) {
+        return Box::new(RoughConductor::new(alpha, Vec3::ONE));
+    }
     match which {
         "lambert" => Box::new(Lambert::new(Vec3::splat(0.5))),
         "phong" => Box::new(Phong::new(Vec3::splat(0.1), Vec3::splat(0.8), 1e3)),

@@ -48,7 +48,7 @@ impl CarPaint {
     /// Sampling weights of (coat, flake, base). The coat gets a share well above its energy
     /// (at least 1/4 of the samples when present): it is needle-sharp, so under a bright light
     /// it dominates a tiny cone that the other lobes would never find.
-    fn lobe_weights(&self, wo: Vec3) -> [f32; 3] {
+    pub(super) fn lobe_weights(&self, wo: Vec3) -> [f32; 3] {
         let transmit = 1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z);
         let flake = transmit * luminance(self.flake);
         let base = transmit * luminance(self.base);
@@ -187,33 +187,9 @@ impl Brdf for CarPaint {
         if wo.z <= 0.0 || total.is_nan() || total <= 0.0 {
             return 0;
         }
-        // Per view, once: stretched views, G1(wo)/(4 cosθo) of both lobes, the coat's
-        // transmission towards the viewer and the cumulative lobe probabilities.
-        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
-        let (wc, wf) = (c.stretch(wo), f.stretch(wo));
-        let (gc, gf) = (c.g1(wo) / (4.0 * wo.z), f.g1(wo) / (4.0 * wo.z));
-        let transmit_o = 1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z);
-        let (p0, p1) = (w[0] / total, (w[0] + w[1]) / total);
-        let (flake, base) = (luminance(self.flake), luminance(self.base) * FRAC_1_PI);
-        for (p, o) in u.iter().zip(out.iter_mut()) {
-            let wi = if p.x < p0 {
-                reflect(wo, c.sample_visible_stretched(wc, Vec2::new(p.x / p0, p.y)))
-            } else if p.x < p1 {
-                reflect(wo, f.sample_visible_stretched(wf, Vec2::new((p.x - p0) / (p1 - p0), p.y)))
-            } else {
-                square_to_cosine_hemisphere(Vec2::new(((p.x - p1) / (1.0 - p1)).min(1.0 - f32::EPSILON / 2.0), p.y))
-            };
-            let value = match half_vector(wo, wi) {
-                Some(h) if wi.z > 0.0 => {
-                    let coat = self.coat * gc * fresnel_schlick(self.coat_f0, wo.dot(h)) * c.d(h) * c.g1(wi);
-                    let transmit = transmit_o * (1.0 - self.coat * fresnel_schlick(self.coat_f0, wi.z));
-                    coat + transmit * (flake * gf * f.d(h) * f.g1(wi) + base * wi.z)
-                }
-                _ => 0.0,
-            };
-            *o = BrdfDraw { wi, value };
-        }
-        u.len().min(out.len())
+        let n = u.len().min(out.len());
+        self.sample_batch_x4(wo, w, &u[..n], &mut out[..n]);
+        n
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

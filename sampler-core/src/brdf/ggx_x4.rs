@@ -21,29 +21,29 @@ pub(crate) struct Dir4 {
 
 impl Dir4 {
     /// Lanes from up to four directions (missing ones +z).
-    fn gather(v: &[Vec3]) -> Self {
+    pub(super) fn gather(v: &[Vec3]) -> Self {
         let at = |k: usize| v.get(k).copied().unwrap_or(Vec3::Z);
         let (a, b, c, d) = (at(0), at(1), at(2), at(3));
         Self { x: Vec4::new(a.x, b.x, c.x, d.x), y: Vec4::new(a.y, b.y, c.y, d.y), z: Vec4::new(a.z, b.z, c.z, d.z) }
     }
 
-    fn lane(&self, k: usize) -> Vec3 {
+    pub(super) fn lane(&self, k: usize) -> Vec3 {
         Vec3::new(self.x[k], self.y[k], self.z[k])
     }
 
     /// `a · self` per lane, as `Vec3::dot` orders it.
-    fn dot(&self, a: Vec3) -> Vec4 {
+    pub(super) fn dot(&self, a: Vec3) -> Vec4 {
         Vec4::splat(a.x) * self.x + Vec4::splat(a.y) * self.y + Vec4::splat(a.z) * self.z
     }
 
-    fn length_squared(&self) -> Vec4 {
+    pub(super) fn length_squared(&self) -> Vec4 {
         self.x * self.x + self.y * self.y + self.z * self.z
     }
 }
 
 impl Ggx {
     /// [`Ggx::sample_visible_stretched`] for four points.
-    fn sample_visible_stretched_x4(&self, w: Vec3, ux: Vec4, uy: Vec4) -> Dir4 {
+    pub(super) fn sample_visible_stretched_x4(&self, w: Vec3, ux: Vec4, uy: Vec4) -> Dir4 {
         let one = Vec4::ONE;
         let a = Vec4::splat(self.alpha());
         let (sin_phi, cos_phi) = sin_cos_2pi_x4(ux);
@@ -66,7 +66,7 @@ impl Ggx {
     }
 
     /// [`Ggx::d`] for four unit microfacet normals.
-    fn d_x4(&self, m: &Dir4) -> Vec4 {
+    pub(super) fn d_x4(&self, m: &Dir4) -> Vec4 {
         let a2 = Vec4::splat(self.alpha() * self.alpha());
         let k = a2 * m.z * m.z + (m.x * m.x + m.y * m.y);
         let d = a2 / (Vec4::splat(PI) * k * k);
@@ -74,7 +74,7 @@ impl Ggx {
     }
 
     /// [`Ggx::g1`] for four directions.
-    fn g1_x4(&self, v: &Dir4) -> Vec4 {
+    pub(super) fn g1_x4(&self, v: &Dir4) -> Vec4 {
         let tan2 = (v.x * v.x + v.y * v.y) / (v.z * v.z);
         let a2 = Vec4::splat(self.alpha() * self.alpha());
         let g = Vec4::splat(2.0) / (Vec4::ONE + sqrt4(Vec4::ONE + a2 * tan2));

@@ -6,6 +6,7 @@
 //! reflected and nothing is sampled.
 
 mod carpaint;
+mod carpaint_x4;
 mod conductor;
 mod ggx_x4;
 mod lambert;

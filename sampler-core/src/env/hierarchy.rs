@@ -132,7 +132,15 @@ impl<'a> EnvHierarchy<'a> {
     #[inline]
     #[must_use]
     pub fn children_relative(&self, node: Cell) -> [f32; 4] {
-        let base = level_offset(node.level + 1) + 4 * node.morton();
+        self.children_relative_at(node.level, node.morton())
+    }
+
+    /// [`children_relative`](Self::children_relative) of the node of `level` whose Morton
+    /// index within its level is `morton`, for callers that carry it down a descent.
+    #[inline]
+    #[must_use]
+    pub fn children_relative_at(&self, level: u32, morton: usize) -> [f32; 4] {
+        let base = level_offset(level + 1) + 4 * morton;
         let q = &self.pyramid[base..base + 4];
         let s = self.inv_mean;
         [q[0] * s, q[1] * s, q[2] * s, q[3] * s]

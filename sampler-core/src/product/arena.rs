@@ -34,7 +34,7 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     keys: Vec<u64, K>,
     nodes: Vec<Node, NODES>,
     /// Per node, the probability that the warp reaches it (see `path_probabilities`).
-    paths: Vec<f64, NODES>,
+    paths: [f64; NODES],
     /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
     corners: Vec<Corners, CORNERS>,
     /// What the last build made (`None` before the first).
@@ -72,7 +72,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             values: [0.0; K],
             keys: Vec::new(),
             nodes: Vec::new(),
-            paths: Vec::new(),
+            paths: [0.0; NODES],
             corners: Vec::new(),
             built: None,
         }
@@ -136,7 +136,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             corners: &mut self.corners,
         };
         builder.build();
-        path_probabilities(&self.nodes, &mut self.paths);
+        path_probabilities(&self.nodes, &mut self.paths[..self.nodes.len()]);
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
@@ -166,7 +166,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         Some(ProductSampler {
             env,
             nodes: &self.nodes,
-            paths: &self.paths,
+            paths: &self.paths[..self.nodes.len()],
             corners: &self.corners,
             defensive,
             brdf_samples,
@@ -179,9 +179,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
 /// it, multiplied in the warp's order (so bit for bit what a descent would multiply). Computed
 /// once per build, top-down (children always follow their parent in `nodes`), so that the warp
 /// and the density read it at the leaf instead of dividing at every level.
-fn path_probabilities<const N: usize>(nodes: &[Node], paths: &mut Vec<f64, N>) {
-    paths.clear();
-    let _ = paths.resize(nodes.len(), 0.0);
+fn path_probabilities(nodes: &[Node], paths: &mut [f64]) {
     if let Some(root) = paths.first_mut() {
         *root = 1.0;
     }
@@ -191,9 +189,20 @@ fn path_probabilities<const N: usize>(nodes: &[Node], paths: &mut Vec<f64, N>) {
         }
         let first = n.child as usize;
         let c = &nodes[first..first + 4];
-        let mass = [c[0].product, c[1].product, c[2].product, c[3].product];
-        for k in 0..4 {
-            paths[first + k] = paths[i] * branch_probability(mass, k);
+        let m = [c[0].product, c[1].product, c[2].product, c[3].product].map(f64::from);
+        // `branch_probability` for the four children, each column's share computed once.
+        let total = m[0] + m[1] + m[2] + m[3];
+        let parent = paths[i];
+        for dx in 0..2 {
+            let column = m[dx] + m[dx + 2];
+            let (top, bottom) = if total <= 0.0 || column <= 0.0 {
+                (0.0, 0.0)
+            } else {
+                let share = column / total;
+                (share * (m[dx] / column), share * (m[dx + 2] / column))
+            };
+            paths[first + dx] = parent * top;
+            paths[first + dx + 2] = parent * bottom;
         }
     }
 }
@@ -210,4 +219,40 @@ pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
         return 0.0;
     }
     (column / total) * (m[dx + 2 * dy] / column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each node's path probability is the product of `branch_probability` down to it, bit for
+    /// bit, including children of a parent whose column has no mass.
+    #[test]
+    fn paths_are_the_products_of_the_branch_probabilities() {
+        let node = |child: u32, product: f32| Node { child, product };
+        let nodes = [
+            node(1, 1.0),
+            node(5, 0.3),
+            node(0, 0.0),
+            node(0, 0.7),
+            node(0, 1e-7),
+            node(0, 0.1),
+            node(0, 0.0),
+            node(0, 3.0),
+            node(0, 0.0),
+        ];
+        // Every node's entry is written: none keeps the NaN it starts with.
+        let mut paths = [f64::NAN; 9];
+        path_probabilities(&nodes, &mut paths);
+        assert!(paths.iter().all(|p| !p.is_nan()));
+        let mass = |first: usize| [0, 1, 2, 3].map(|k| nodes[first + k].product);
+        assert_eq!(paths[0], 1.0);
+        for k in 0..4 {
+            assert_eq!(paths[1 + k].to_bits(), (1.0 * branch_probability(mass(1), k)).to_bits());
+            let want = paths[1] * branch_probability(mass(5), k);
+            assert_eq!(paths[5 + k].to_bits(), want.to_bits(), "child {k}");
+        }
+        assert_eq!(paths[6], 0.0);
+        assert_eq!(paths[8], 0.0);
+    }
 }

@@ -76,15 +76,28 @@ pub fn morton(x: u32, y: u32) -> u64 {
     spread(x) | (spread(y) << 1)
 }
 
+/// The bits of a 24-bit value spread to the even bits, a byte at a time by table (a third
+/// of the shifts and masks of spreading the whole word).
 #[inline]
 fn spread(v: u32) -> u64 {
-    let mut x = v as u64 & 0xFFFF_FFFF;
-    x = (x | (x << 16)) & 0x0000_FFFF_0000_FFFF;
-    x = (x | (x << 8)) & 0x00FF_00FF_00FF_00FF;
-    x = (x | (x << 4)) & 0x0F0F_0F0F_0F0F_0F0F;
-    x = (x | (x << 2)) & 0x3333_3333_3333_3333;
-    (x | (x << 1)) & 0x5555_5555_5555_5555
+    let byte = |k: u32| u64::from(SPREAD_BYTE[((v >> (8 * k)) & 0xFF) as usize]) << (16 * k);
+    byte(0) | byte(1) | byte(2)
 }
+
+/// Each byte's bits spread to the even bits of 16.
+const SPREAD_BYTE: [u16; 256] = {
+    let mut table = [0u16; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut bit = 0;
+        while bit < 8 {
+            table[b] |= (((b >> bit) & 1) << (2 * bit)) as u16;
+            bit += 1;
+        }
+        b += 1;
+    }
+    table
+};
 
 /// Sort key: Morton code in the high 48 bits, sample index in the low 16.
 #[inline]
@@ -136,7 +149,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             let _ = self.corners.push(w);
         }
         let root_env = self.env.cell_relative(Cell::ROOT);
-        let (_, total) = self.node(0, Cell::ROOT, root_env, 0, self.keys.len());
+        let (_, total) = self.node(0, Cell::ROOT, 0, root_env, 0, self.keys.len());
         if self.refine_share > 0.0 && total > 0.0 && total.is_finite() {
             self.refine(0, Cell::ROOT, root_env, self.refine_share * total);
         }
@@ -190,8 +203,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     /// Fills node `index` covering `cell` and samples `lo..hi` (non-empty); returns its (B̃
     /// mean, product mean). Fields are written in place: building a `Node` on the stack and
     /// copying it back costs a failed store-forward per node. `env` is the environment's
-    /// relative mean over the cell (fetched by the parent).
-    fn node(&mut self, index: usize, cell: Cell, env: f32, lo: usize, hi: usize) -> (f32, f32) {
+    /// relative mean over the cell (fetched by the parent), `code` the cell's Morton index
+    /// within its level (carried down: a child's is 4·code + c; its high bits may be lost below
+    /// the levels a 32-bit `usize` holds, where the map has no level to look up).
+    #[allow(clippy::too_many_arguments)]
+    fn node(&mut self, index: usize, cell: Cell, code: usize, env: f32, lo: usize, hi: usize) -> (f32, f32) {
         let room = self.nodes.len() + 4 <= NODES;
         if hi - lo == 1 || cell.level >= self.max_depth || !room {
             return self.leaf(index, cell, env, lo, hi);
@@ -200,13 +216,22 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let bounds = self.split(cell.level, lo, hi);
         // The environment over the four children: one 2×2 block of the pyramid (or the texel
         // containing them, below the finest level).
-        let l = if cell.level < self.env.finest_level() { self.env.children_relative(cell) } else { [env; 4] };
+        let l = if cell.level < self.env.finest_level() {
+            self.env.children_relative_at(cell.level, code)
+        } else {
+            [env; 4]
+        };
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
         for c in 0..4 {
-            if bounds[c + 1] > bounds[c] {
-                (b[c], p[c]) = self.node(first + c, cell.child(c), l[c], bounds[c], bounds[c + 1]);
+            if bounds[c + 1] == bounds[c] + 1 && !self.probe_leaves && !self.bilinear {
+                // A leaf of one sample (most leaves) without the call.
+                (b[c], p[c]) = self.sample_leaf(first + c, l[c], bounds[c]);
+                sum_b += b[c];
+                filled += 1;
+            } else if bounds[c + 1] > bounds[c] {
+                (b[c], p[c]) = self.node(first + c, cell.child(c), (code << 2) | c, l[c], bounds[c], bounds[c + 1]);
                 sum_b += b[c];
                 filled += 1;
             }
@@ -265,6 +290,16 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         (b, product)
     }
 
+    /// [`leaf`](Self::leaf) of the one sample `keys[at]`, with neither probed nor bilinear leaves.
+    #[inline(always)]
+    fn sample_leaf(&mut self, index: usize, env: f32, at: usize) -> (f32, f32) {
+        let sum: f32 = core::iter::once(self.values[(self.keys[at] & 0xFFFF) as usize]).sum();
+        let b = sum / 1.0;
+        let product = b * env;
+        set(&mut self.nodes[index], 0, product);
+        (b, product)
+    }
+
     /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
     /// sorted by the next two Morton bits' digit, so three binary searches find them in a long
     /// run, and counting each digit in a short one (most of the tree's runs, where a scan costs
@@ -294,9 +329,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     fn push_children(&mut self, index: usize, cell: Cell) -> usize {
         let Cell { level: depth, x, y } = cell;
         let first = self.nodes.len();
-        for _ in 0..4 {
-            let _ = self.nodes.push(Node::default());
-        }
+        let _ = self.nodes.extend_from_slice(&[Node::default(); 4]);
         if self.bilinear {
             let w = self.corners[index];
             let inv = 1.0 / (1u64 << depth) as f32;
@@ -355,6 +388,12 @@ mod tests {
         assert_eq!(digit(k, 0), 1); // right, bottom
         assert_eq!(digit(k, 1), 3); // 0.75 = 0.11b, 0.25 = 0.01b
         assert_eq!(morton(top, top) >> 46, 3);
+        // Every bit of both coordinates lands where interleaving puts it.
+        for bit in 0..COORD_BITS {
+            assert_eq!(morton(1 << bit, 0), 1 << (2 * bit));
+            assert_eq!(morton(0, 1 << bit), 1 << (2 * bit + 1));
+        }
+        assert_eq!(morton(0xFF_FFFF, 0xFF_FFFF), (1 << 48) - 1);
     }
 
     #[test]
