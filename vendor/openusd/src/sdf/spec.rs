@@ -43,9 +43,10 @@ use strum::{Display, EnumCount, FromRepr};
 use crate::sdf;
 use crate::tf;
 
+mod field_table;
 mod fields;
 
-pub use fields::{FieldName, Fields};
+pub use fields::{FieldName, FieldTable, Fields};
 
 /// An enum that specifies the type of an object.
 /// Objects are entities that have fields and are addressable by path.

@@ -50,7 +50,8 @@ pub(super) enum Kind {
 
 pub(super) struct Node {
     pub(super) parent: Option<Path>,
-    pub(super) seg: Box<str>,
+    /// Shared, so that a prim's name in its parent's `primChildren` can be this text.
+    pub(super) seg: Arc<str>,
     pub(super) kind: Kind,
     /// Prim names along the chain (`Path::prim_element_count`).
     pub(super) prims: u32,
@@ -225,7 +226,10 @@ impl Path {
             let separator = usize::from(kind == Kind::Prim && up.kind == Kind::Prim);
             Arc::new(Node {
                 parent: Some(self.clone()),
-                seg: pieces.concat().into_boxed_str(),
+                seg: match pieces {
+                    [one] => Arc::from(*one),
+                    _ => Arc::from(pieces.concat()),
+                },
                 kind,
                 prims: up.prims + u32::from(kind == Kind::Prim),
                 elems: up.elems + u32::from(matches!(kind, Kind::Prim | Kind::Variant)),
