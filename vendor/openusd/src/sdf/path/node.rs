@@ -109,6 +109,26 @@ fn leaf(kind: Kind, text: &str) -> Path {
     }
 }
 
+/// The concatenated `pieces` (`seg_len` bytes) in one allocation: a property node's
+/// segment is `.` and its name, and a property path is made for nearly every query.
+fn shared_text(pieces: &[&str], seg_len: usize) -> Arc<str> {
+    const ON_STACK: usize = 64;
+    match pieces {
+        [one] => Arc::from(*one),
+        _ if seg_len <= ON_STACK => {
+            let mut bytes = [0u8; ON_STACK];
+            let mut at = 0;
+            for piece in pieces {
+                bytes[at..at + piece.len()].copy_from_slice(piece.as_bytes());
+                at += piece.len();
+            }
+            // Concatenated UTF-8 texts are UTF-8.
+            Arc::from(std::str::from_utf8(&bytes[..at]).expect("pieces are UTF-8"))
+        }
+        _ => Arc::from(pieces.concat()),
+    }
+}
+
 /// The hash of a child node from its parent's: a multiply-rotate over the segment's
 /// bytes, finished by Murmur3's mixer. It is computed for every path made (the intern
 /// table and every path-keyed map use it), on segments of a few bytes, where SipHash's
@@ -226,10 +246,7 @@ impl Path {
             let separator = usize::from(kind == Kind::Prim && up.kind == Kind::Prim);
             Arc::new(Node {
                 parent: Some(self.clone()),
-                seg: match pieces {
-                    [one] => Arc::from(*one),
-                    _ => Arc::from(pieces.concat()),
-                },
+                seg: shared_text(pieces, seg_len),
                 kind,
                 prims: up.prims + u32::from(kind == Kind::Prim),
                 elems: up.elems + u32::from(matches!(kind, Kind::Prim | Kind::Variant)),
