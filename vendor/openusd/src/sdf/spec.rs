@@ -46,7 +46,8 @@ use crate::tf;
 mod field_table;
 mod fields;
 
-pub use fields::{FieldName, FieldTable, Fields};
+pub use field_table::FieldTable;
+pub use fields::{FieldName, Fields};
 
 /// An enum that specifies the type of an object.
 /// Objects are entities that have fields and are addressable by path.

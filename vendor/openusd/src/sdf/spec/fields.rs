@@ -9,14 +9,13 @@
 //!
 //! The allocation is shared: the specs of a layer's many similar prims author the same
 //! fields (every sphere's `specifier`, `typeName` and `properties`, every `xformOpOrder`),
-//! and a reader that builds a layer hands each spec's finished fields to a [`FieldTable`],
-//! which gives back the list an earlier spec holds when it is the same. A shared list is
-//! copied when one of its specs is edited, so no other spec sees the edit.
+//! and a reader that builds a layer hands each spec's finished fields to a
+//! [`FieldTable`](super::FieldTable), which gives back the list an earlier spec holds when
+//! it is the same. A shared list is copied when one of its specs is edited, so no other
+//! spec sees the edit.
 
 use std::fmt;
 use std::sync::Arc;
-
-pub use super::field_table::FieldTable;
 
 use crate::sdf::{ChildrenKey, FieldKey, Value};
 
@@ -179,7 +178,7 @@ impl Fields {
         self.0.as_deref().unwrap_or_default()
     }
 
-    /// The list itself, for [`FieldTable`] to share.
+    /// The list itself, for [`FieldTable`](super::FieldTable) to share.
     pub(super) fn shared(&mut self) -> Option<&mut Arc<[Field]>> {
         self.0.as_mut()
     }
