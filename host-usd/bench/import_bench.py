@@ -2,7 +2,8 @@
 """Import speed of `ppis info` against Pixar's library (usd-core).
 
 Generates stages of N spheres and of N simple meshes (a quad each) under one Xform,
-each prim with its own translate, in usda and usdc (exported by Pixar's Sdf), plus
+each prim with its own translate (kinds: `spheres`; `meshes`, every quad the same
+points; `quads`, every quad its own points), in usda and usdc (exported by Pixar's Sdf), plus
 chains of nested Xforms,
 into a folder (default: a temporary one); then times, for each file, `ppis info FILE`
 (the whole process, wall clock, and its peak RSS) and Pixar's `Usd.Stage.Open` plus a
@@ -11,6 +12,7 @@ one Python process, the pxr import excluded). Prints a Markdown table.
 
     python3 host-usd/bench/import_bench.py [--ppis target/release/ppis] [--dir DIR]
         [--counts 10,1000,10000,100000] [--depths 250,500,1000,2000]
+        [--kinds spheres,meshes,quads] [--formats usda,usdc]
 
 Bytes per prim is the peak RSS above the 10-prim file's of the same kind, divided by
 the prim count.
@@ -48,7 +50,11 @@ def usda_text(kind, n):
         if kind == "spheres":
             out.append(f'def Sphere "S{i}"\n{{\ndouble radius = 0.4\n' + xf.format(at) + "}\n")
         else:
-            out.append(f'def Mesh "M{i}"\n{{\npoint3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]\n'
+            # "meshes" share one quad's points (a layer may hold them once); "quads" each
+            # have their own, as scanned or modelled meshes do.
+            x = i if kind == "quads" else 0
+            points = f"({x}, 0, 0), ({x + 1}, 0, 0), ({x + 1}, 1, 0), ({x}, 1, 0)"
+            out.append(f'def Mesh "M{i}"\n{{\npoint3f[] points = [{points}]\n'
                        "int[] faceVertexCounts = [4]\nint[] faceVertexIndices = [0, 1, 2, 3]\n"
                        + xf.format(at) + "}\n")
     out.append("}\n")
@@ -83,12 +89,13 @@ def main():
     ap.add_argument("--counts", default="10,1000,10000,100000")
     ap.add_argument("--depths", default="250,500,1000,2000")
     ap.add_argument("--formats", default="usda,usdc")
+    ap.add_argument("--kinds", default="spheres,meshes,quads")
     a = ap.parse_args()
     folder = a.dir or tempfile.mkdtemp(prefix="ppis-import-bench-")
     os.makedirs(folder, exist_ok=True)
     cases = []
     for fmt in a.formats.split(","):
-        for kind in ("spheres", "meshes"):
+        for kind in a.kinds.split(","):
             cases += [(kind, int(n), fmt) for n in a.counts.split(",")]
         cases += [("deep", int(d), fmt) for d in a.depths.split(",")]
     print("| file | prims | size | ppis s | Pixar s | ratio | ppis peak MB | bytes/prim |")

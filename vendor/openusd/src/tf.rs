@@ -86,6 +86,13 @@ impl From<String> for Token {
     }
 }
 
+/// A token holding text that is shared already, without copying it.
+impl From<Arc<str>> for Token {
+    fn from(text: Arc<str>) -> Self {
+        Token(Repr::Shared(text))
+    }
+}
+
 impl From<&String> for Token {
     fn from(text: &String) -> Self {
         Token(Repr::Shared(Arc::from(text.as_str())))

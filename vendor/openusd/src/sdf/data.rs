@@ -11,7 +11,7 @@ use std::{
 use anyhow::Result;
 
 use crate::sdf::spec_table::SpecTable;
-use crate::sdf::{Path, PathMap, SpecData, SpecType, Value};
+use crate::sdf::{FieldTable, Path, PathMap, SpecData, SpecType, Value};
 use crate::tf;
 
 /// The scene-description storage interface, mirroring C++ `SdfAbstractData`.
@@ -206,6 +206,13 @@ impl Data {
         make: impl FnOnce() -> SpecData,
     ) -> Result<&mut SpecData> {
         self.specs.property_or_insert_with(owner, name, make)
+    }
+
+    /// Shares the fields of the spec at `path` and of its properties' specs with the
+    /// equal ones of specs handed to `table` before (see [`FieldTable`]): a reader calls
+    /// it as it finishes each prim.
+    pub fn share_fields(&mut self, path: &Path, table: &mut FieldTable) {
+        self.specs.share_fields(path, table);
     }
 
     /// Remove the spec record at `path` and return it, if any.

@@ -11,6 +11,7 @@ pub use hasher::{BuildPathHasher, PathHasher, PathMap, PathSet};
 use std::{cmp, fmt, result, str::FromStr};
 
 use anyhow::{bail, ensure, Result};
+use crate::tf;
 
 #[inline]
 pub fn path(str: impl AsRef<str>) -> Result<Path> {
@@ -575,6 +576,13 @@ impl Path {
     /// trimmed. Empty when `self` is the absolute root.
     pub fn ancestors_below_root(&self) -> impl Iterator<Item = Path> {
         self.ancestors().take_while(|p| !p.is_abs_root())
+    }
+
+    /// A prim path's name as a token holding the path's own text (no copy), or `None`
+    /// for other paths: a layer names each prim twice, by its path and in its parent's
+    /// `primChildren`, and both can hold one text.
+    pub fn prim_name_token(&self) -> Option<tf::Token> {
+        (self.kind() == Kind::Prim).then(|| tf::Token::from(self.node.seg.clone()))
     }
 
     /// Returns the final component name, or `None` for the pseudo-root and empty paths.

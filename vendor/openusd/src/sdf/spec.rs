@@ -43,8 +43,10 @@ use strum::{Display, EnumCount, FromRepr};
 use crate::sdf;
 use crate::tf;
 
+mod field_table;
 mod fields;
 
+pub use field_table::FieldTable;
 pub use fields::{FieldName, Fields};
 
 /// An enum that specifies the type of an object.

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use crate::sdf::{Path, PathMap, SpecData};
+use crate::sdf::{FieldTable, Path, PathMap, SpecData};
 use crate::tf;
 
 /// The specs at one path: its own, if any, and those of the properties it owns.
@@ -194,6 +194,15 @@ impl SpecTable {
     }
 
     /// Every spec with its path, in no particular order; a property's path is made here.
+    /// Hands the fields of `path`'s own spec and of its properties' specs to `table`
+    /// (see [`FieldTable`]).
+    pub(crate) fn share_fields(&mut self, path: &Path, table: &mut FieldTable) {
+        let Some(entry) = self.entries.get_mut(path) else { return };
+        for spec in entry.spec.iter_mut().chain(entry.properties.iter_mut().map(|(_, spec)| spec)) {
+            table.share(&mut spec.fields);
+        }
+    }
+
     pub(crate) fn iter(&self) -> impl Iterator<Item = (Path, &SpecData)> {
         self.entries.iter().flat_map(|(path, entry)| {
             let own = entry.spec.as_ref().map(|spec| (path.clone(), spec));

@@ -40,6 +40,9 @@ pub struct Parser<'a> {
     depth: usize,
     /// The token of each property name met so far (ppis patch, see [`Parser::name_token`]).
     names: HashMap<&'a str, tf::Token>,
+    /// The distinct field lists of the specs read so far (ppis patch, see
+    /// [`sdf::FieldTable`]): each finished prim's specs share the equal lists of earlier ones.
+    fields: sdf::FieldTable,
 }
 
 /// A path for an error message: long ones keep their start and end.
@@ -80,6 +83,7 @@ impl<'a> Parser<'a> {
             last_span: None,
             depth: 0,
             names: HashMap::new(),
+            fields: sdf::FieldTable::default(),
         }
     }
 
@@ -276,6 +280,8 @@ impl<'a> Parser<'a> {
         }
         data.insert_spec(current_path.clone(), pseudo_root_spec);
         data.shrink_to_fit();
+        // The lists only the table holds now are no spec's: let them go with the table.
+        self.fields = sdf::FieldTable::default();
         Ok(data)
     }
 
@@ -356,7 +362,7 @@ impl<'a> Parser<'a> {
     fn read_prim(
         &mut self,
         current_path: &sdf::Path,
-        parent_children: &mut Vec<String>,
+        parent_children: &mut Vec<tf::Token>,
         data: &mut sdf::Data,
     ) -> Result<()> {
         let mut spec = sdf::SpecData::new(sdf::SpecType::Prim);
@@ -384,8 +390,8 @@ impl<'a> Parser<'a> {
         // path whose parent is itself, and instancing's ancestor walk recursed until the
         // stack overflowed (see PATCHED.md).
         ensure!(sdf::Path::is_valid_identifier(name), "Invalid prim name \"{name}\": not an identifier");
-        parent_children.push(name.to_string());
         let prim_path = current_path.append_path(name)?;
+        parent_children.push(prim_path.prim_name_token().unwrap_or_else(|| tf::Token::from(name)));
 
         let mut properties = Vec::new();
 
@@ -410,7 +416,8 @@ impl<'a> Parser<'a> {
         if !variant_sets.is_empty() {
             spec.add(ChildrenKey::VariantSetChildren, sdf::Value::token_vec(variant_sets));
         }
-        data.insert_spec(prim_path, spec);
+        data.insert_spec(prim_path.clone(), spec);
+        data.share_fields(&prim_path, &mut self.fields);
 
         Ok(())
     }
@@ -425,7 +432,7 @@ impl<'a> Parser<'a> {
         path: &sdf::Path,
         owner_spec: &mut sdf::SpecData,
         data: &mut sdf::Data,
-    ) -> Result<(Vec<String>, Vec<tf::Token>, Vec<String>)> {
+    ) -> Result<(Vec<tf::Token>, Vec<tf::Token>, Vec<String>)> {
         ensure!(
             path.prim_element_count() <= MAX_NAMESPACE_DEPTH,
             "{}: namespace deeper than {MAX_NAMESPACE_DEPTH} levels",
@@ -544,7 +551,8 @@ impl<'a> Parser<'a> {
             if !variant_sets.is_empty() {
                 variant_spec.add(ChildrenKey::VariantSetChildren, sdf::Value::token_vec(variant_sets));
             }
-            data.insert_spec(variant_path, variant_spec);
+            data.insert_spec(variant_path.clone(), variant_spec);
+            data.share_fields(&variant_path, &mut this.fields);
             Ok(())
         })?;
 

@@ -50,7 +50,8 @@ pub(super) enum Kind {
 
 pub(super) struct Node {
     pub(super) parent: Option<Path>,
-    pub(super) seg: Box<str>,
+    /// Shared, so that a prim's name in its parent's `primChildren` can be this text.
+    pub(super) seg: Arc<str>,
     pub(super) kind: Kind,
     /// Prim names along the chain (`Path::prim_element_count`).
     pub(super) prims: u32,
@@ -105,6 +106,26 @@ fn leaf(kind: Kind, text: &str) -> Path {
             interned: false,
             text: TextCell::new(),
         }),
+    }
+}
+
+/// The concatenated `pieces` (`seg_len` bytes) in one allocation: a property node's
+/// segment is `.` and its name, and a property path is made for nearly every query.
+fn shared_text(pieces: &[&str], seg_len: usize) -> Arc<str> {
+    const ON_STACK: usize = 64;
+    match pieces {
+        [one] => Arc::from(*one),
+        _ if seg_len <= ON_STACK => {
+            let mut bytes = [0u8; ON_STACK];
+            let mut at = 0;
+            for piece in pieces {
+                bytes[at..at + piece.len()].copy_from_slice(piece.as_bytes());
+                at += piece.len();
+            }
+            // Concatenated UTF-8 texts are UTF-8.
+            Arc::from(std::str::from_utf8(&bytes[..at]).expect("pieces are UTF-8"))
+        }
+        _ => Arc::from(pieces.concat()),
     }
 }
 
@@ -225,7 +246,7 @@ impl Path {
             let separator = usize::from(kind == Kind::Prim && up.kind == Kind::Prim);
             Arc::new(Node {
                 parent: Some(self.clone()),
-                seg: pieces.concat().into_boxed_str(),
+                seg: shared_text(pieces, seg_len),
                 kind,
                 prims: up.prims + u32::from(kind == Kind::Prim),
                 elems: up.elems + u32::from(matches!(kind, Kind::Prim | Kind::Variant)),

@@ -6,8 +6,16 @@
 //! A field is its [`FieldName`] (16 bytes) and its [`Value`] (32), and a spec's fields are
 //! one allocation of exactly their number: a spec authors its fields once, when it is
 //! parsed, and a growable vector would hold spare slots and a capacity word for its life.
+//!
+//! The allocation is shared: the specs of a layer's many similar prims author the same
+//! fields (every sphere's `specifier`, `typeName` and `properties`, every `xformOpOrder`),
+//! and a reader that builds a layer hands each spec's finished fields to a
+//! [`FieldTable`](super::FieldTable), which gives back the list an earlier spec holds when
+//! it is the same. A shared list is copied when one of its specs is edited, so no other
+//! spec sees the edit.
 
 use std::fmt;
+use std::sync::Arc;
 
 use crate::sdf::{ChildrenKey, FieldKey, Value};
 
@@ -141,43 +149,54 @@ impl fmt::Display for FieldName {
 }
 
 #[derive(Clone)]
-struct Field {
-    name: FieldName,
-    value: Value,
+pub(super) struct Field {
+    pub(super) name: FieldName,
+    pub(super) value: Value,
 }
 
-/// A spec's fields in authored order, names unique.
+/// A spec's fields in authored order, names unique; no allocation when there are none.
 #[derive(Clone, Default)]
-pub struct Fields(Box<[Field]>);
+pub struct Fields(Option<Arc<[Field]>>);
 
 impl Fields {
     /// The number of fields.
     pub fn len(&self) -> usize {
-        self.0.len()
+        self.slice().len()
     }
 
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
+        self.slice().is_empty()
     }
 
     /// The names and values in authored order.
     pub fn iter(&self) -> Iter<'_> {
-        Iter(self.0.iter())
+        Iter(self.slice().iter())
+    }
+
+    pub(super) fn slice(&self) -> &[Field] {
+        self.0.as_deref().unwrap_or_default()
+    }
+
+    /// The list itself, for [`FieldTable`](super::FieldTable) to share.
+    pub(super) fn shared(&mut self) -> Option<&mut Arc<[Field]>> {
+        self.0.as_mut()
     }
 
     fn position(&self, key: &str) -> Option<usize> {
-        self.0.iter().position(|field| field.name.as_str() == key)
+        self.slice().iter().position(|field| field.name.as_str() == key)
     }
 
     /// The value of the field named `key`.
     pub fn get(&self, key: &str) -> Option<&Value> {
-        self.position(key).map(|at| &self.0[at].value)
+        self.position(key).map(|at| &self.slice()[at].value)
     }
 
-    /// The value of the field named `key`, to edit in place.
+    /// The value of the field named `key`, to edit in place (a shared list is copied first).
     pub fn get_mut(&mut self, key: &str) -> Option<&mut Value> {
-        self.position(key).map(|at| &mut self.0[at].value)
+        let at = self.position(key)?;
+        let fields = self.0.as_mut()?;
+        Some(&mut Arc::make_mut(fields)[at].value)
     }
 
     /// Sets the field named `key`: in place if it is authored, else after the others.
@@ -196,21 +215,51 @@ impl Fields {
         }
     }
 
-    /// Appends a field not yet authored, keeping the allocation exactly as long as the list.
+    /// Appends a field not yet authored, in one allocation of exactly the new length.
     fn push(&mut self, name: FieldName, value: Value) {
-        let mut fields = std::mem::take(&mut self.0).into_vec();
-        fields.reserve_exact(1);
-        fields.push(Field { name, value });
-        self.0 = fields.into_boxed_slice();
+        let field = std::iter::once(Field { name, value });
+        self.0 = Some(match self.0.take() {
+            None => field.collect(),
+            Some(mut fields) => match Arc::get_mut(&mut fields) {
+                Some(own) => own.iter_mut().map(take_field).chain(field).collect(),
+                None => fields.iter().cloned().chain(field).collect(),
+            },
+        });
     }
 
     /// Removes the field named `key`, returning its value; the others keep their order.
     pub fn remove(&mut self, key: &str) -> Option<Value> {
         let at = self.position(key)?;
-        let mut fields = std::mem::take(&mut self.0).into_vec();
-        let field = fields.remove(at);
-        self.0 = fields.into_boxed_slice();
-        Some(field.value)
+        let mut fields = into_vec(self.0.take()?);
+        let removed = fields.remove(at);
+        if !fields.is_empty() {
+            self.0 = Some(fields.into());
+        }
+        Some(removed.value)
+    }
+
+    /// Whether `self` and `other` hold the same list (not merely equal fields).
+    pub fn is_shared_with(&self, other: &Fields) -> bool {
+        match (&self.0, &other.0) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
+}
+
+/// The fields, moved out of a list only one spec holds or cloned from a shared one.
+fn into_vec(mut fields: Arc<[Field]>) -> Vec<Field> {
+    match Arc::get_mut(&mut fields) {
+        Some(own) => own.iter_mut().map(take_field).collect(),
+        None => fields.to_vec(),
+    }
+}
+
+/// The field, moved out of a list only one spec holds; an empty placeholder is left.
+fn take_field(field: &mut Field) -> Field {
+    Field {
+        name: std::mem::replace(&mut field.name, FieldName(Repr::Registered(0))),
+        value: std::mem::replace(&mut field.value, Value::None),
     }
 }
 
@@ -225,7 +274,7 @@ impl<'a> IntoIterator for &'a Fields {
     type IntoIter = Iter<'a>;
 
     fn into_iter(self) -> Iter<'a> {
-        Iter(self.0.iter())
+        self.iter()
     }
 }
 
@@ -260,7 +309,7 @@ impl IntoIterator for Fields {
     type IntoIter = IntoIter;
 
     fn into_iter(self) -> IntoIter {
-        IntoIter(self.0.into_vec().into_iter())
+        IntoIter(self.0.map(into_vec).unwrap_or_default().into_iter())
     }
 }
 

@@ -1,0 +1,243 @@
+//! One copy of each distinct field list of a layer (ppis patch, see PATCHED.md).
+//!
+//! A reader hands every spec's finished [`Fields`] to the layer's [`FieldTable`]; a list
+//! equal to one an earlier spec holds is replaced by that spec's, so a layer of many
+//! similar prims holds each prim's common fields once, as a usdc file stores its field
+//! sets once. Lists are equal when their names are and their values are bit for bit:
+//! `0.0` and `-0.0` are kept apart, as every NaN is from every other. Only lists of plain
+//! values (numbers, vectors, matrices, tokens, strings, their arrays and the spec enums)
+//! are shared; a list holding anything else (a dictionary, a list op, time samples) is
+//! left as it is.
+
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::mem::Discriminant;
+use std::sync::Arc;
+
+use bytemuck::{bytes_of, cast_slice};
+
+use super::fields::{Field, Fields};
+use crate::sdf::Value;
+use crate::tf::Token;
+
+/// The distinct field lists a reader has finished so far. It lives while its layer is
+/// read: a list held only by the table afterwards would be held for nothing.
+/// Its hash is aHash, keyed at random per table as the standard map's SipHash is (a
+/// file cannot be made of lists that collide), at a fraction of SipHash's cost for the
+/// many short writes a list makes.
+#[derive(Default)]
+pub struct FieldTable {
+    lists: HashMap<Key, (), ahash::RandomState>,
+}
+
+impl FieldTable {
+    /// Replaces `fields` by the equal list the table holds, or makes the table hold it.
+    pub fn share(&mut self, fields: &mut Fields) {
+        let Some(list) = fields.shared() else { return };
+        if !list.iter().all(|field| bits(&field.value).is_some()) {
+            return;
+        }
+        match self.lists.entry(Key(list.clone())) {
+            std::collections::hash_map::Entry::Occupied(held) => *list = held.key().0.clone(),
+            std::collections::hash_map::Entry::Vacant(new) => {
+                new.insert(());
+            }
+        }
+    }
+
+    /// The number of distinct lists held.
+    pub fn len(&self) -> usize {
+        self.lists.len()
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.lists.is_empty()
+    }
+}
+
+/// A field list whose every value has [`bits`].
+struct Key(Arc<[Field]>);
+
+impl Hash for Key {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_usize(self.0.len());
+        for field in self.0.iter() {
+            field.name.as_str().hash(state);
+            bits(&field.value).hash(state);
+        }
+    }
+}
+
+impl PartialEq for Key {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.len() == other.0.len()
+            && self.0.iter().zip(other.0.iter()).all(|(a, b)| a.name.as_str() == b.name.as_str() && bits(&a.value) == bits(&b.value))
+    }
+}
+
+impl Eq for Key {}
+
+/// A value as its variant and the bits it holds, compared exactly.
+type Bits<'a> = (Discriminant<Value>, Content<'a>);
+
+#[derive(Hash, PartialEq, Eq)]
+enum Content<'a> {
+    Bytes(&'a [u8]),
+    Bools(&'a [bool]),
+    Small(u64),
+    Text(&'a str),
+    Tokens(&'a [Token]),
+    Strings(&'a [String]),
+}
+
+/// The bits of a plain value; `None` for values the table does not share.
+fn bits(value: &Value) -> Option<Bits<'_>> {
+    use Content::{Bools, Bytes, Small, Strings, Text, Tokens};
+    let content = match value {
+        Value::Bool(v) => Bools(std::slice::from_ref(v)),
+        Value::BoolVec(v) => Bools(v),
+        Value::Uchar(v) => Bytes(bytes_of(v)),
+        Value::UcharVec(v) => Bytes(v),
+        Value::Int(v) => Bytes(bytes_of(v)),
+        Value::IntVec(v) => Bytes(cast_slice(v)),
+        Value::Uint(v) => Bytes(bytes_of(v)),
+        Value::UintVec(v) => Bytes(cast_slice(v)),
+        Value::Int64(v) => Bytes(bytes_of(v)),
+        Value::Int64Vec(v) => Bytes(cast_slice(v)),
+        Value::Uint64(v) => Bytes(bytes_of(v)),
+        Value::Uint64Vec(v) => Bytes(cast_slice(v)),
+        Value::Half(v) => Bytes(bytes_of(v)),
+        Value::HalfVec(v) => Bytes(cast_slice(v)),
+        Value::Float(v) => Bytes(bytes_of(v)),
+        Value::FloatVec(v) => Bytes(cast_slice(v)),
+        Value::Double(v) => Bytes(bytes_of(v)),
+        Value::DoubleVec(v) => Bytes(cast_slice(v)),
+        Value::String(v) => Text(v),
+        Value::StringVec(v) => Strings(v),
+        Value::Token(v) => Text(v.as_str()),
+        Value::TokenVec(v) => Tokens(v),
+        Value::Specifier(v) => Small(*v as u64),
+        Value::Permission(v) => Small(*v as u64),
+        Value::Variability(v) => Small(*v as u64),
+        _ => Bytes(vector_bits(value)?),
+    };
+    Some((std::mem::discriminant(value), content))
+}
+
+/// The bits of a vector, quaternion or matrix value, or of an array of them.
+fn vector_bits(value: &Value) -> Option<&[u8]> {
+    Some(match value {
+        Value::Quath(v) => bytes_of(v),
+        Value::Quatf(v) => bytes_of(v),
+        Value::Quatd(v) => bytes_of(&**v),
+        Value::QuathVec(v) => cast_slice(v),
+        Value::QuatfVec(v) => cast_slice(v),
+        Value::QuatdVec(v) => cast_slice(v),
+        Value::Vec2h(v) => bytes_of(v),
+        Value::Vec2f(v) => bytes_of(v),
+        Value::Vec2d(v) => bytes_of(v),
+        Value::Vec2i(v) => bytes_of(v),
+        Value::Vec2hVec(v) => cast_slice(v),
+        Value::Vec2fVec(v) => cast_slice(v),
+        Value::Vec2dVec(v) => cast_slice(v),
+        Value::Vec2iVec(v) => cast_slice(v),
+        Value::Vec3h(v) => bytes_of(v),
+        Value::Vec3f(v) => bytes_of(v),
+        Value::Vec3d(v) => bytes_of(v),
+        Value::Vec3i(v) => bytes_of(v),
+        Value::Vec3hVec(v) => cast_slice(v),
+        Value::Vec3fVec(v) => cast_slice(v),
+        Value::Vec3dVec(v) => cast_slice(v),
+        Value::Vec3iVec(v) => cast_slice(v),
+        Value::Vec4h(v) => bytes_of(v),
+        Value::Vec4f(v) => bytes_of(v),
+        Value::Vec4d(v) => bytes_of(&**v),
+        Value::Vec4i(v) => bytes_of(v),
+        Value::Vec4hVec(v) => cast_slice(v),
+        Value::Vec4fVec(v) => cast_slice(v),
+        Value::Vec4dVec(v) => cast_slice(v),
+        Value::Vec4iVec(v) => cast_slice(v),
+        Value::Matrix2d(v) => bytes_of(&**v),
+        Value::Matrix3d(v) => bytes_of(&**v),
+        Value::Matrix4d(v) => bytes_of(&**v),
+        Value::Matrix2dVec(v) => cast_slice(v),
+        Value::Matrix3dVec(v) => cast_slice(v),
+        Value::Matrix4dVec(v) => cast_slice(v),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sdf::{Specifier, Variability};
+
+    fn fields(pairs: &[(&str, Value)]) -> Fields {
+        let mut fields = Fields::default();
+        for (name, value) in pairs {
+            fields.set(name, value.clone());
+        }
+        fields
+    }
+
+    #[test]
+    fn equal_lists_are_one_list() {
+        let mut table = FieldTable::default();
+        let make = || {
+            fields(&[
+                ("specifier", Value::Specifier(Specifier::Def)),
+                ("typeName", Value::Token(Token::new("Sphere"))),
+                ("properties", Value::TokenVec(vec![Token::from("radius"), Token::new("xformOpOrder")])),
+                ("variability", Value::Variability(Variability::Uniform)),
+                ("default", Value::Vec3fVec(vec![crate::gf::vec3f(1.0, 2.0, 3.0)])),
+            ])
+        };
+        let (mut a, mut b) = (make(), make());
+        table.share(&mut a);
+        table.share(&mut b);
+        assert!(a.is_shared_with(&b));
+        assert_eq!(table.len(), 1);
+    }
+
+    #[test]
+    fn lists_that_differ_in_a_bit_a_variant_or_a_name_stay_apart() {
+        let mut table = FieldTable::default();
+        let mut lists = [
+            fields(&[("default", Value::Double(0.0))]),
+            fields(&[("default", Value::Double(-0.0))]),
+            fields(&[("default", Value::Float(0.0))]),
+            fields(&[("default", Value::Int64(0))]),
+            fields(&[("default", Value::Uint64(0))]),
+            fields(&[("comment", Value::Double(0.0))]),
+            fields(&[("default", Value::Token(Token::new("a")))]),
+            fields(&[("default", Value::String("a".into()))]),
+            fields(&[("default", Value::Double(0.0)), ("custom", Value::Bool(false))]),
+        ];
+        for list in &mut lists {
+            table.share(list);
+        }
+        assert_eq!(table.len(), lists.len());
+    }
+
+    #[test]
+    fn lists_of_other_values_are_not_shared_and_edits_copy() {
+        let mut table = FieldTable::default();
+        let dictionary = || fields(&[("customData", Value::Dictionary(Default::default()))]);
+        let (mut a, mut b) = (dictionary(), dictionary());
+        table.share(&mut a);
+        table.share(&mut b);
+        assert!(!a.is_shared_with(&b) && table.is_empty());
+
+        let (mut c, mut d) = (fields(&[("default", Value::Int(1))]), fields(&[("default", Value::Int(1))]));
+        table.share(&mut c);
+        table.share(&mut d);
+        d.set("default", Value::Int(2));
+        d.set("custom", Value::Bool(true));
+        assert_eq!(c.get("default"), Some(&Value::Int(1)));
+        assert_eq!(c.len(), 1);
+        assert_eq!(d.get("default"), Some(&Value::Int(2)));
+        assert_eq!(d.remove("default"), Some(Value::Int(2)));
+        assert_eq!(c.get("default"), Some(&Value::Int(1)));
+    }
+}
