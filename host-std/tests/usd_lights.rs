@@ -104,3 +104,24 @@ fn usd_light_twins_render_like_their_json_originals() {
 fn usd_twin_of_every_light_under_an_environment_renders_like_its_json_original() {
     twin_renders_like_its_original("lights_env");
 }
+
+/// ShapingAPI reaches the renderer's lights (`lights_shaping.usda`): the RectLight facing down
+/// with a 30° cone lights the floor straight below it and not a point 45° off its axis, the
+/// point light aimed along +X lights along +X and not along −X, and the shaped lights' power
+/// is the unshaped one's times the integral of their falloff (less).
+#[test]
+fn shaped_usd_lights_render_their_cone() {
+    use sampler_core::glam::{Vec2, Vec3};
+    use sampler_core::light::SceneLight;
+    let file = root().join("host-usd/tests/fixtures/lights_shaping.usda");
+    let converted = usd::load(&file, &usd::Options::default()).unwrap();
+    let lights = &converted.scene.lights;
+    let rect = lights.iter().find_map(|l| if let SceneLight::Rect(r) = l { Some(*r) } else { None }).unwrap();
+    let point = lights.iter().find_map(|l| if let SceneLight::Point(p) = l { Some(*p) } else { None }).unwrap();
+    let lit = |l: &dyn Light, p: Vec3| l.sample(p, Vec2::splat(0.5)).is_some_and(|s| s.radiance.max_element() > 0.0);
+    assert!(lit(&rect, Vec3::ZERO) && !lit(&rect, Vec3::new(3.0, 0.0, 0.0)));
+    assert!(lit(&point, Vec3::new(5.0, 3.0, 0.0)) && !lit(&point, Vec3::new(-1.0, 3.0, 0.0)));
+    assert!(lit(&point, Vec3::new(5.0, 4.5, 0.0)) && !lit(&point, Vec3::new(3.0, 4.5, 0.0)), "40° cone");
+    let unshaped = sampler_core::light::RectLight::new(Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::splat(10.0)).unwrap();
+    assert!(rect.power(1.0).x < 0.5 * unshaped.power(1.0).x, "{} against {}", rect.power(1.0), unshaped.power(1.0));
+}

@@ -86,6 +86,8 @@ pub struct UsdLight {
     pub prim_type: String,
     /// What it emits, where.
     pub emitter: Emitter,
+    /// Its ShapingAPI cone and focus (points, spheres, rectangles and disks).
+    pub shaping: Option<crate::shaping::LightShaping>,
 }
 
 /// A light input: `inputs:<name>`, or the pre-21.02 `<name>`.
@@ -147,18 +149,24 @@ impl Emission {
     }
 }
 
+/// The light kinds whose ShapingAPI cone and focus are rendered.
+pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
+
 /// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
-/// cone, focus and IES profile, light filters, the diffuse and specular multipliers, shadow
-/// controls, and (for `type_name`) a RectLight's texture and a CylinderLight's `treatAsLine`.
+/// cone and focus on kinds other than [`SHAPED_KINDS`] and its IES profile, light filters, the
+/// diffuse and specular multipliers, shadow controls, and (for `type_name`) a CylinderLight's
+/// `treatAsLine`.
 pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
     let mut notes = Vec::new();
     let authored =
         |name: &str| -> Result<Option<f64>, String> { Ok(input(stage, prim, name)?.and_then(|v| v.scalar())) };
-    if authored("shaping:cone:angle")?.is_some_and(|a| a < 90.0) {
-        notes.push("ShapingAPI cone angle not rendered (the light emits over its whole hemisphere)".into());
-    }
-    if authored("shaping:focus")?.is_some_and(|f| f > 0.0) {
-        notes.push("ShapingAPI focus not rendered".into());
+    if !SHAPED_KINDS.contains(&type_name) {
+        if authored("shaping:cone:angle")?.is_some_and(|a| a < 180.0) {
+            notes.push(format!("ShapingAPI cone angle not rendered on a {type_name}"));
+        }
+        if authored("shaping:focus")?.is_some_and(|f| f > 0.0) {
+            notes.push(format!("ShapingAPI focus not rendered on a {type_name}"));
+        }
     }
     if let Some(Value::Asset { authored, .. }) = input(stage, prim, "shaping:ies:file")?
         && !authored.is_empty()
@@ -176,14 +184,14 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     if stage.value(prim, "inputs:shadow:enable")?.and_then(|v| v.scalar()) == Some(0.0) {
         notes.push("ShadowAPI shadow:enable = false not honoured (the light casts shadows)".into());
     }
+    if type_name == "CylinderLight" && stage.value(prim, "treatAsLine")?.and_then(|v| v.scalar()) == Some(1.0) {
+        notes.push("treatAsLine ignored (rendered as the cylinder)".into());
+    }
     if type_name == "RectLight"
         && let Some(Value::Asset { authored, .. }) = input(stage, prim, "texture:file")?
         && !authored.is_empty()
     {
         notes.push(format!("texture:file {authored} not rendered (the rectangle emits its colour)"));
-    }
-    if type_name == "CylinderLight" && stage.value(prim, "treatAsLine")?.and_then(|v| v.scalar()) == Some(1.0) {
-        notes.push("treatAsLine ignored (rendered as the cylinder)".into());
     }
     Ok(notes)
 }

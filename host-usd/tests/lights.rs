@@ -3,7 +3,8 @@
 //! 2^exposure · color · blackbody, divided by the area with `normalize`); pre-21.02 names are
 //! read; dark, invisible and partly supported lights are notes; a NaN or negative input is an
 //! error naming the prim; the blackbody colour agrees with Pixar's (divided by its 6500 K
-//! colour, which the schema makes white) within 1% from 3000 K up and 5% below.
+//! colour, which the schema makes white) within 1% from 3000 K up and 5% below. ShapingAPI is
+//! read about each light's axis.
 
 use glam::Vec3;
 use host_usd::lights::{Emitter, UsdLight};
@@ -103,7 +104,6 @@ fn dark_hidden_and_partly_rendered_lights_are_notes() {
         ("/World/Dark", "emits nothing"),
         ("/World/NoSize", "radius 0"),
         ("/World/Hidden", "invisible"),
-        ("/World/Spot", "cone angle"),
         ("/World/Spot", "non-uniform scale"),
         ("/World/Portal", "PortalLight not rendered"),
     ] {
@@ -113,9 +113,37 @@ fn dark_hidden_and_partly_rendered_lights_are_notes() {
     for path in ["/World/Dark", "/World/NoSize", "/World/Hidden", "/World/Portal"] {
         assert!(s.lights.iter().all(|l| l.path != path), "{path} is not rendered");
     }
-    // The spot still renders, as a sphere.
+    // The spot renders as a sphere shaped by its cone.
     assert!(matches!(light(&s, "/World/Spot").emitter, Emitter::Sphere { .. }));
+    assert_eq!(light(&s, "/World/Spot").shaping.map(|x| x.cone_angle_deg), Some(30.0));
     assert_eq!(s.lights.len(), 10, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
+}
+
+/// ShapingAPI (`lights_shaping.usda`): each input read, the axis the world image of the light's
+/// −Z, the cone falling back to 90° where ShapingAPI is applied and to none where it is not, a
+/// shaping that changes nothing dropped, and a kind that does not render it noted.
+#[test]
+fn shaping_inputs_are_read_about_the_lights_axis() {
+    let s = host_usd::load(&fixture("lights_shaping.usda")).unwrap();
+    let shaping = |path: &str| light(&s, path).shaping;
+    let spot = shaping("/World/Spot").expect("the RectLight is shaped");
+    assert!(close(spot.axis, -Vec3::Y), "{:?}", spot.axis);
+    assert_eq!((spot.cone_angle_deg, spot.cone_softness, spot.focus), (30.0, 0.5, 2.0));
+    assert!(close(spot.focus_tint, Vec3::new(0.1, 0.2, 0.3)));
+    let point = shaping("/World/PointSpot").expect("the point light is shaped");
+    assert!(matches!(light(&s, "/World/PointSpot").emitter, Emitter::Point { .. }));
+    assert!(close(point.axis, Vec3::X) && point.cone_angle_deg == 40.0, "{point:?}");
+    let disk = shaping("/World/FocusDisk").unwrap();
+    assert_eq!((disk.cone_angle_deg, disk.focus, disk.focus_tint), (90.0, 4.0, Vec3::ZERO));
+    let unapplied = shaping("/World/Unapplied").unwrap();
+    assert_eq!((unapplied.cone_angle_deg, unapplied.focus), (180.0, 2.0));
+    assert_eq!(shaping("/World/Plain"), None);
+    assert_eq!(shaping("/World/ShapedSun"), None);
+    let notes = notes_of(&s, "/World/ShapedSun");
+    assert!(notes.iter().any(|n| n.contains("cone angle not rendered on a DistantLight")), "{notes:?}");
+    for path in ["/World/Spot", "/World/PointSpot", "/World/FocusDisk", "/World/Unapplied", "/World/Plain"] {
+        assert!(notes_of(&s, path).is_empty(), "{path}: {:?}", notes_of(&s, path));
+    }
 }
 
 #[test]

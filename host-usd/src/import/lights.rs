@@ -1,12 +1,13 @@
 //! UsdLux lights into the scene, each under its world transform (the up-axis conversion
 //! included): DistantLight, SphereLight (a point with `treatAsPoint`), RectLight, DiskLight,
 //! CylinderLight (its side tessellated into emitting triangles) and meshes with MeshLightAPI.
-//! A light that emits nothing (zero intensity, colour or size) is a note, as the schema makes
+//! Spheres (points too), rectangles and disks carry their ShapingAPI cone and focus. A light that emits nothing (zero intensity, colour or size) is a note, as the schema makes
 //! it dark; a value that cannot be a light (not finite, negative) is an error naming the prim.
 
 use super::Importer;
 use crate::lights::{self, Emission, Emitter, UsdLight};
 use crate::shapes;
+use crate::shaping::{self, LightShaping};
 use crate::stage::PrimPath;
 use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -25,8 +26,14 @@ impl Importer<'_> {
             self.skip(prim, format!("invisible {type_name}: not rendered"));
             return Ok(());
         }
-        let stage = self.stage;
-        let m = self.conversion * self.worlds.world(stage, prim)?;
+        let m = self.conversion * self.worlds.world(self.stage, prim)?;
+        self.light_at(prim, type_name, &m, &prim.to_string())
+    }
+
+    /// The light `prim` under the renderer-frame transform `m`, named `label` (its path, or
+    /// for a PointInstancer's instance the path and the instance).
+    pub(super) fn light_at(&mut self, prim: &PrimPath, type_name: &str, m: &DMat4, label: &str) -> Result<(), String> {
+        let (stage, m) = (self.stage, *m);
         let fallback = if type_name == "DistantLight" { 50000.0 } else { 1.0 };
         let emission = Emission::read(stage, prim, fallback)?;
         lights::unrendered(stage, prim, type_name)?.into_iter().for_each(|n| self.skip(prim, n));
@@ -51,15 +58,27 @@ impl Importer<'_> {
             "CylinderLight" => cylinder(size("radius", 0.5)?, size("length", 1.0)?, &m, &emission),
             _ => return Err(format!("{type_name} is not a light kind read here")),
         };
-        self.add_light(prim, type_name, built);
+        let shaping = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read(stage, prim, &m)? } else { None };
+        self.add_light(prim, label, type_name, built, shaping);
         Ok(())
     }
 
     /// A gprim with MeshLightAPI: its triangles emit (front faces, both sides when
     /// `doubleSided`); it is not also a surface, and its material is not rendered.
     pub(super) fn mesh_light(&mut self, prim: &PrimPath, type_name: &str) -> Result<(), String> {
-        let stage = self.stage;
-        let m = self.conversion * self.worlds.world(stage, prim)?;
+        let m = self.conversion * self.worlds.world(self.stage, prim)?;
+        self.mesh_light_at(prim, type_name, &m, &prim.to_string())
+    }
+
+    /// The mesh light `prim` under the renderer-frame transform `m`, named `label`.
+    pub(super) fn mesh_light_at(
+        &mut self,
+        prim: &PrimPath,
+        type_name: &str,
+        m: &DMat4,
+        label: &str,
+    ) -> Result<(), String> {
+        let (stage, m) = (self.stage, *m);
         let emission = Emission::read(stage, prim, 1.0)?;
         lights::unrendered(stage, prim, type_name)?.into_iter().for_each(|n| self.skip(prim, n));
         if stage.bound_material(prim)?.is_some() {
@@ -72,11 +91,18 @@ impl Importer<'_> {
         };
         let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        self.add_light(prim, type_name, built);
+        self.add_light(prim, label, type_name, built, None);
         Ok(())
     }
 
-    fn add_light(&mut self, prim: &PrimPath, type_name: &str, built: Built) {
+    fn add_light(
+        &mut self,
+        prim: &PrimPath,
+        label: &str,
+        type_name: &str,
+        built: Built,
+        shaping: Option<LightShaping>,
+    ) {
         let emitter = match built {
             Ok(e) if dark(&e) => Err("emits nothing (intensity or color 0): not rendered".to_string()),
             other => other,
@@ -86,7 +112,9 @@ impl Importer<'_> {
                 for p in extent(&emitter) {
                     self.grow(p);
                 }
-                self.scene.lights.push(UsdLight { path: prim.to_string(), prim_type: type_name.into(), emitter });
+                let path = label.to_string();
+                let prim_type = type_name.into();
+                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping });
             }
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }
