@@ -4,7 +4,8 @@
 //! read; dark, invisible and partly supported lights are notes; a NaN or negative input is an
 //! error naming the prim; the blackbody colour agrees with Pixar's (divided by its 6500 K
 //! colour, which the schema makes white) within 1% from 3000 K up and 5% below. ShapingAPI is
-//! read about each light's axis.
+//! read about each light's axis, and lights inside PointInstancer prototypes and instanceable
+//! references come once per instance.
 
 use glam::Vec3;
 use host_usd::lights::{Emitter, UsdLight};
@@ -144,6 +145,30 @@ fn shaping_inputs_are_read_about_the_lights_axis() {
     for path in ["/World/Spot", "/World/PointSpot", "/World/FocusDisk", "/World/Unapplied", "/World/Plain"] {
         assert!(notes_of(&s, path).is_empty(), "{path}: {:?}", notes_of(&s, path));
     }
+}
+
+/// Lights inside a PointInstancer's prototype and under instanceable references
+/// (`lights_instanced.usda`): one light per visible instance, at the instance's transform.
+#[test]
+fn instanced_lights_take_each_instances_transform() {
+    let s = host_usd::load(&fixture("lights_instanced.usda")).unwrap();
+    let bulb = |i: usize| light(&s, &format!("/World/Lamps/Protos/Lamp/Bulb[/World/Lamps:{i}]"));
+    let Emitter::Sphere { center, radius, .. } = bulb(0).emitter else { panic!() };
+    assert!(close(center, Vec3::new(0.0, 1.0, 0.0)) && (radius - 0.1).abs() < 1e-6, "{center} {radius}");
+    // Scaled ×2 and moved to x = 5.
+    let Emitter::Sphere { center, radius, .. } = bulb(1).emitter else { panic!() };
+    assert!(close(center, Vec3::new(5.0, 2.0, 0.0)) && (radius - 0.2).abs() < 1e-6, "{center} {radius}");
+    let panel = |i: usize| light(&s, &format!("/World/Lamps/Protos/Lamp/Panel[/World/Lamps:{i}]"));
+    let Emitter::Triangles { positions, .. } = &panel(1).emitter else { panic!() };
+    assert!(positions.iter().any(|p| close(*p, Vec3::new(7.0, 0.0, 2.0))), "{positions:?}");
+    assert!(matches!(panel(0).emitter, Emitter::Triangles { .. }));
+    // Instance id 12 is invisible.
+    assert!(s.lights.iter().all(|l| !l.path.ends_with(":2]")), "{:?}", s.lights);
+    for (path, x) in [("/World/A/Panel", -4.0), ("/World/B/Panel", 4.0)] {
+        let Emitter::Rect { p0, e1, e2, .. } = light(&s, path).emitter else { panic!() };
+        assert!(close(p0 + 0.5 * (e1 + e2), Vec3::new(x, 2.0, 0.0)), "{path}: {p0}");
+    }
+    assert_eq!(s.lights.len(), 6, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
 }
 
 #[test]

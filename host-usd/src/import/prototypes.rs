@@ -11,8 +11,8 @@ use crate::instancer;
 use crate::stage::{PrimPath, Stage, Step};
 use glam::DMat4;
 
-/// A renderable gprim under a prototype root: its path, type and transform relative to
-/// the root's parent.
+/// A renderable gprim or a light under a prototype root: its path, type and transform relative
+/// to the root's parent.
 type Part = (PrimPath, String, DMat4);
 
 /// The prototype roots known so far, what lies under each, and the instancers not yet
@@ -99,7 +99,7 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Keeps a visible gprim under prototype roots for their instancers.
+    /// Keeps a visible gprim or light under prototype roots for their instancers.
     pub(super) fn prototype_gprim(&mut self, prim: &PrimPath, type_name: &str) -> Result<(), String> {
         let stage = self.stage;
         for i in 0..self.prototypes.roots.len() {
@@ -151,12 +151,24 @@ impl Importer<'_> {
             list.iter().try_for_each(|(p, t, rel)| {
                 let m = self.conversion * *world * inst.transform * *rel;
                 let label = format!("{p}[{prim}:{}]", inst.index);
-                self.gprim(p, t, &label, &m).map_err(fail(p))
+                self.prototype_part(p, t, &label, &m).map_err(fail(p))
             })
         });
         self.prototypes.parts = parts;
         expanded?;
         self.scene.counts.instances += instances.len();
         Ok(())
+    }
+
+    /// One prim kept under a prototype root, for one instance at `m`: a light, a mesh light
+    /// (MeshLightAPI) or a gprim.
+    fn prototype_part(&mut self, prim: &PrimPath, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
+        if crate::lights::KINDS.contains(&type_name) {
+            return self.light_at(prim, type_name, m, label);
+        }
+        if self.stage.applied_schemas(prim)?.iter().any(|s| s == "MeshLightAPI") {
+            return self.mesh_light_at(prim, type_name, m, label);
+        }
+        self.gprim(prim, type_name, label, m)
     }
 }
