@@ -88,6 +88,26 @@ pub struct UsdLight {
     pub emitter: Emitter,
     /// Its ShapingAPI cone and focus (points, spheres, rectangles and disks).
     pub shaping: Option<crate::shaping::LightShaping>,
+    /// A RectLight's `texture:file`, placed on the rectangle.
+    pub texture: Option<RectTexture>,
+}
+
+/// A RectLight's texture and where it lies. The schema puts the image's first texel (its
+/// top-left corner) at the rectangle's local (+X, +Y) corner and its last one at (−X, −Y):
+/// seen from the front (from the emitting side, local −Z, with +Y up) the image is upright
+/// and unmirrored. Image column fractions run along `across`, rows (top to bottom) along `down`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RectTexture {
+    /// The resolved asset path (inside a package: `pkg.usdz[tex/a.png]`).
+    pub name: String,
+    /// The encoded image.
+    pub bytes: Vec<u8>,
+    /// Where the image's top-left corner lies: the world image of local (+w/2, +h/2, 0).
+    pub corner: Vec3,
+    /// From that corner across the image's top row: the world image of (−w, 0, 0).
+    pub across: Vec3,
+    /// From that corner down the image's first column: the world image of (0, −h, 0).
+    pub down: Vec3,
 }
 
 /// A light input: `inputs:<name>`, or the pre-21.02 `<name>`.
@@ -155,7 +175,7 @@ pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
 /// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
 /// cone and focus on kinds other than [`SHAPED_KINDS`] and its IES profile, light filters, the
 /// diffuse and specular multipliers, shadow controls, and (for `type_name`) a CylinderLight's
-/// `treatAsLine`.
+/// `treatAsLine`. A RectLight's texture renders (`RectTexture`).
 pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
     let mut notes = Vec::new();
     let authored =
@@ -186,12 +206,6 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     }
     if type_name == "CylinderLight" && stage.value(prim, "treatAsLine")?.and_then(|v| v.scalar()) == Some(1.0) {
         notes.push("treatAsLine ignored (rendered as the cylinder)".into());
-    }
-    if type_name == "RectLight"
-        && let Some(Value::Asset { authored, .. }) = input(stage, prim, "texture:file")?
-        && !authored.is_empty()
-    {
-        notes.push(format!("texture:file {authored} not rendered (the rectangle emits its colour)"));
     }
     Ok(notes)
 }

@@ -198,6 +198,7 @@ fn a_light_that_cannot_exist_is_an_error_naming_the_prim() {
         ("def RectLight \"L\" { color3f inputs:color = (1, -1, 1) }", "inputs:color"),
         ("def DiskLight \"L\" { float inputs:radius = -1 }", "inputs:radius"),
         ("def DistantLight \"L\" { float inputs:intensity = -5 }", "negative"),
+        ("def RectLight \"L\" { asset inputs:texture:file = @gone.png@ }", "texture:file gone.png not found"),
     ] {
         let file = dir.path().join("bad.usda");
         std::fs::write(&file, format!("#usda 1.0\n{body}\n")).unwrap();

@@ -1,9 +1,11 @@
 //! A USD stage's UsdLux lights (host-usd's [`host_usd::lights::UsdLight`], radiometry already
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
 //! light per face with an area; a ShapingAPI cone and focus shape a point, sphere, rectangle or
-//! disk. A light the core cannot build is a note naming its prim.
+//! disk; a RectLight's `texture:file` cuts it into one rectangle per texel ([`super::rect_texture`]).
+//! A light the core cannot build is a note naming its prim.
 
 use crate::scene::mesh_light::push_triangle_lights;
+use crate::scene::rect_texture;
 use host_usd::lights::{Emitter, UsdLight};
 use host_usd::shaping::LightShaping;
 use sampler_core::light::{
@@ -14,6 +16,23 @@ use sampler_core::light::{
 pub(crate) fn convert(lights: &[UsdLight], notes: &mut Vec<String>) -> Vec<SceneLight> {
     let mut out = Vec::new();
     for l in lights {
+        if let (Some(t), Emitter::Rect { e1, e2, radiance, .. }) = (&l.texture, &l.emitter) {
+            match rect_texture::decode(t) {
+                Ok(image) => {
+                    let pushed = core_shaping(l.shaping.as_ref())
+                        .and_then(|s| rect_texture::push_cells(t, &image, e1.cross(*e2), *radiance, s, &mut out));
+                    match pushed {
+                        Ok(0) => notes.push(format!("{}: its texture {} is black: not rendered", l.path, t.name)),
+                        Ok(_) => {}
+                        Err(e) => notes.push(format!("{}: {} not rendered ({e})", l.path, l.prim_type)),
+                    }
+                    continue;
+                }
+                Err(e) => {
+                    notes.push(format!("{}: texture:file not used ({e}); the rectangle emits its colour", l.path))
+                }
+            }
+        }
         if let Err(e) = push(&l.emitter, l.shaping.as_ref(), &mut out) {
             notes.push(format!("{}: {} not rendered ({e})", l.path, l.prim_type));
         }
@@ -65,7 +84,8 @@ pub fn describe(l: &UsdLight) -> String {
             s.focus_tint.to_array()
         )
     });
-    format!("{}{shaped}", emitter_line(l))
+    let textured = l.texture.as_ref().map_or(String::new(), |t| format!("; textured by {}", t.name));
+    format!("{}{shaped}{textured}", emitter_line(l))
 }
 
 fn emitter_line(l: &UsdLight) -> String {

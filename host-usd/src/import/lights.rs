@@ -5,10 +5,10 @@
 //! it dark; a value that cannot be a light (not finite, negative) is an error naming the prim.
 
 use super::Importer;
-use crate::lights::{self, Emission, Emitter, UsdLight};
+use crate::lights::{self, Emission, Emitter, RectTexture, UsdLight};
 use crate::shapes;
 use crate::shaping::{self, LightShaping};
-use crate::stage::PrimPath;
+use crate::stage::{PrimPath, Stage, Value};
 use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::f64::consts::PI;
@@ -41,6 +41,7 @@ impl Importer<'_> {
             let v = lights::scalar(stage, prim, name, fallback)?;
             if v < 0.0 { Err(format!("inputs:{name} is negative ({v})")) } else { Ok(v) }
         };
+        let mut texture = None;
         let built = match type_name {
             "DistantLight" => distant(lights::scalar(stage, prim, "angle", 0.53)?, &m, &emission)?,
             "SphereLight" => {
@@ -49,7 +50,11 @@ impl Importer<'_> {
                 note.into_iter().for_each(|n| self.skip(prim, n));
                 built
             }
-            "RectLight" => rect(size("width", 1.0)?, size("height", 1.0)?, &m, &emission),
+            "RectLight" => {
+                let (width, height) = (size("width", 1.0)?, size("height", 1.0)?);
+                texture = rect_texture(stage, prim, width, height, &m)?;
+                rect(width, height, &m, &emission)
+            }
             "DiskLight" => {
                 let (built, note) = disk(size("radius", 0.5)?, &m, &emission);
                 note.into_iter().for_each(|n| self.skip(prim, n));
@@ -60,6 +65,9 @@ impl Importer<'_> {
         };
         let shaping = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read(stage, prim, &m)? } else { None };
         self.add_light(prim, label, type_name, built, shaping);
+        if let Some(light) = self.scene.lights.last_mut().filter(|l| l.path == label) {
+            light.texture = texture;
+        }
         Ok(())
     }
 
@@ -114,7 +122,7 @@ impl Importer<'_> {
                 }
                 let path = label.to_string();
                 let prim_type = type_name.into();
-                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping });
+                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture: None });
             }
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }
@@ -197,6 +205,29 @@ fn sphere(r: f64, point: bool, m: &DMat4, emission: &Emission) -> (Built, Option
         return (Err("of radius 0 emits nothing: not rendered".into()), note);
     }
     (Ok(Emitter::Sphere { center, radius: radius as f32, radiance }), note)
+}
+
+/// A RectLight's `texture:file` under `m`, read from its (resolved) asset; `None` when none
+/// is authored, an error naming the file when it cannot be found or read.
+fn rect_texture(
+    stage: &Stage,
+    prim: &PrimPath,
+    width: f64,
+    height: f64,
+    m: &DMat4,
+) -> Result<Option<RectTexture>, String> {
+    let Some(Value::Asset { authored, resolved }) = lights::input(stage, prim, "texture:file")? else {
+        return Ok(None);
+    };
+    if authored.is_empty() {
+        return Ok(None);
+    }
+    let name = resolved.ok_or_else(|| format!("texture:file {authored} not found"))?;
+    let bytes = stage.read_asset(&name).map_err(|e| format!("texture:file {name}: {e}"))?;
+    let corner = m.transform_point3(DVec3::new(0.5 * width, 0.5 * height, 0.0)).as_vec3();
+    let across = m.transform_vector3(DVec3::new(-width, 0.0, 0.0)).as_vec3();
+    let down = m.transform_vector3(DVec3::new(0.0, -height, 0.0)).as_vec3();
+    Ok(Some(RectTexture { name, bytes, corner, across, down }))
 }
 
 /// RectLight: `width` along local X, `height` along local Y, centred, emitting towards the
