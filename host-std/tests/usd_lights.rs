@@ -200,3 +200,29 @@ fn a_textured_rect_light_emits_its_image() {
         assert!((mean[c] - quad[c]).abs() <= 4.0 * se[c] + 1e-3 * quad[c], "channel {c}: {mean} ± {se} against {quad}");
     }
 }
+
+/// `ppis info` lists every light feature the render leaves out (`lights_unrendered.usda`), and
+/// `ppis render` says so in its one warning summary.
+#[test]
+fn unrendered_light_features_are_listed_and_warned() {
+    let file = root().join("host-usd/tests/fixtures/lights_unrendered.usda");
+    let ppis = || std::process::Command::new(env!("CARGO_BIN_EXE_ppis"));
+    let info = ppis().arg("info").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    let needles = ["IES profile", "light filters", "light linking", "shadow linking", "PortalLight", "portals ignored"];
+    for needle in needles {
+        assert!(text.contains(needle), "ppis info does not list {needle:?}: {text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.exr");
+    let args = ["--width", "8", "--height", "8", "--spp", "1", "--method", "mis", "-o"];
+    let render = ppis().arg("render").arg(&file).args(args).arg(&out).output().unwrap();
+    let stderr = String::from_utf8_lossy(&render.stderr);
+    assert!(render.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("ppis: warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("not rendered as authored"), "{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "ppis render does not warn of {needle:?}: {stderr}");
+    }
+}

@@ -169,6 +169,16 @@ impl Emission {
     }
 }
 
+/// The light authors its collection `name` (LightAPI's `lightLink` or `shadowLink`) to leave
+/// some prims out: includes or excludes, or `includeRoot` off.
+fn linked(stage: &Stage, prim: &PrimPath, name: &str) -> Result<bool, String> {
+    let base = format!("collection:{name}");
+    let listed = !stage.targets(prim, &format!("{base}:includes"))?.is_empty()
+        || !stage.targets(prim, &format!("{base}:excludes"))?.is_empty();
+    let root_off = stage.value(prim, &format!("{base}:includeRoot"))?.and_then(|v| v.scalar()) == Some(0.0);
+    Ok(listed || root_off)
+}
+
 /// The light kinds whose ShapingAPI cone and focus are rendered.
 pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
 
@@ -195,6 +205,11 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     }
     if !stage.targets(prim, "light:filters")?.is_empty() {
         notes.push("light filters not rendered".into());
+    }
+    for (collection, what) in [("lightLink", "light linking"), ("shadowLink", "shadow linking")] {
+        if linked(stage, prim, collection)? {
+            notes.push(format!("{what} (collection:{collection}) not honoured: the light reaches every prim"));
+        }
     }
     for (name, what) in [("diffuse", "diffuse multiplier"), ("specular", "specular multiplier")] {
         if authored(name)?.is_some_and(|v| v != 1.0) {

@@ -171,6 +171,27 @@ fn instanced_lights_take_each_instances_transform() {
     assert_eq!(s.lights.len(), 6, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
 }
 
+/// What is not rendered (`lights_unrendered.usda`) is a note each: an IES profile, a light
+/// filter, light and shadow linking, a PortalLight, a PluginLight and a dome's portals.
+#[test]
+fn what_is_not_rendered_is_a_note_each() {
+    let s = host_usd::load(&fixture("lights_unrendered.usda")).unwrap();
+    for (path, needle) in [
+        ("/World/Lamp", "IES profile profile.ies not rendered"),
+        ("/World/Lamp", "light filters not rendered"),
+        ("/World/Lamp", "light linking (collection:lightLink) not honoured"),
+        ("/World/Lamp", "shadow linking (collection:shadowLink) not honoured"),
+        ("/World/Window", "PortalLight not rendered"),
+        ("/World/Plugin", "PluginLight not rendered"),
+        ("/World/Sky", "portals ignored"),
+    ] {
+        let notes = notes_of(&s, path);
+        assert!(notes.iter().any(|n| n.contains(needle)), "{path}: {needle:?} not in {notes:?}");
+    }
+    // The lamp itself renders.
+    assert!(matches!(light(&s, "/World/Lamp").emitter, Emitter::Sphere { .. }));
+}
+
 #[test]
 fn a_dome_takes_its_colour_temperature() {
     let dir = tempfile::tempdir().unwrap();
