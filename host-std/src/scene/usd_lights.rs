@@ -1,7 +1,7 @@
 //! A USD stage's UsdLux lights (host-usd's [`host_usd::lights::UsdLight`], radiometry already
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
 //! light per face with an area; a ShapingAPI cone and focus shape a point, sphere, rectangle or
-//! disk; a RectLight's `texture:file` cuts it into one rectangle per texel ([`super::rect_texture`]).
+//! disk; a RectLight's `texture:file` cuts it into one rectangle per texel (`scene/rect_texture.rs`).
 //! A light the core cannot build is a note naming its prim.
 
 use crate::scene::mesh_light::push_triangle_lights;
