@@ -97,7 +97,7 @@ impl Light for DiskLight {
         }
         let d = square_to_uniform_disk_concentric(u) * self.radius;
         let q = self.center + self.frame.s * d.x + self.frame.t * d.y;
-        area_sample(p, q, self.frame.n, self.area(), &self.emission)
+        area_sample(p, q, self.frame.n, self.area(), |d| self.emission.towards(d))
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {

@@ -128,7 +128,7 @@ impl Emission {
     #[inline]
     #[must_use]
     pub fn towards(&self, dir: Vec3) -> Vec3 {
-        self.radiance * self.shaping.factor(-dir)
+        if self.shaping.is_none() { self.radiance } else { self.radiance * self.shaping.factor(-dir) }
     }
 }
 
@@ -190,15 +190,15 @@ fn emitted(emission: &Emission, cos_front: f32, dir: Vec3) -> Option<Vec3> {
 }
 
 /// The sample of a point `q` drawn uniformly on an area `area` of normal `normal` emitting
-/// `emission`, seen from `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
+/// `radiance(dir)` along the direction `dir` from `p`, seen from `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
 #[inline]
-fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, emission: &Emission) -> Option<LightSample> {
+fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, radiance: impl Fn(Vec3) -> Vec3) -> Option<LightSample> {
     let v = q - p;
     let distance = v.length();
     let dir = v / distance;
     let pdf = area_to_solid_angle(distance, dir.dot(normal), area);
     let ok = pdf > 0.0 && pdf.is_finite();
-    ok.then(|| LightSample { dir, distance, radiance: emission.towards(dir), pdf, delta: false })
+    ok.then(|| LightSample { dir, distance, radiance: radiance(dir), pdf, delta: false })
 }
 
 /// The density with respect to solid angle of a point drawn uniformly on an area `area`, seen

@@ -125,7 +125,7 @@ impl Light for RectLight {
             let radiance = self.emission.towards(dir);
             return Some(LightSample { dir, distance: distance as f32, radiance, pdf, delta: false });
         }
-        area_sample(p, self.p0 + u.x * self.e1 + u.y * self.e2, self.normal, self.area, &self.emission)
+        area_sample(p, self.p0 + u.x * self.e1 + u.y * self.e2, self.normal, self.area, |d| self.emission.towards(d))
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {

@@ -22,6 +22,8 @@ pub struct Shaping {
     start: f32,
     focus: f32,
     tint: Vec3,
+    /// Some direction's emission changes (kept so that unshaped lights test one flag).
+    active: bool,
 }
 
 /// Simpson intervals per smooth piece of the factor in [`Shaping::integral`].
@@ -29,7 +31,7 @@ const SIMPSON_STEPS: usize = 64;
 
 impl Shaping {
     /// No shaping: every direction keeps the full emission.
-    pub const NONE: Self = Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE };
+    pub const NONE: Self = Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE, active: false };
 
     /// The emission about the world `axis` (any length) cut off beyond `cone_angle` radians
     /// (≥ π: no cutoff), softened over the fraction `softness` of the cone (clamped to [0, 1]),
@@ -41,13 +43,15 @@ impl Shaping {
         }
         let cutoff = cone_angle.clamp(0.0, PI);
         let start = cutoff * (1.0 - softness.clamp(0.0, 1.0));
-        Ok(Self { axis: unit(axis)?, cutoff, start, focus: focus.max(0.0), tint: checked_rgb(focus_tint)? })
+        let (focus, tint) = (focus.max(0.0), checked_rgb(focus_tint)?);
+        let active = cutoff < PI || (focus > 0.0 && tint != Vec3::ONE);
+        Ok(Self { axis: unit(axis)?, cutoff, start, focus, tint, active })
     }
 
     /// The shaping changes no direction's emission.
     #[must_use]
     pub fn is_none(&self) -> bool {
-        self.cutoff >= PI && (self.focus == 0.0 || self.tint == Vec3::ONE)
+        !self.active
     }
 
     /// The unit axis.

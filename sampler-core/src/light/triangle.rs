@@ -139,7 +139,7 @@ impl Light for TriangleLight {
         // Uniform barycentrics by the square-root warp.
         let su = libm::sqrtf(u.x);
         let q = self.v[0] + (u.y * su) * (self.v[1] - self.v[0]) + (su * (1.0 - u.y)) * (self.v[2] - self.v[0]);
-        area_sample(p, q, self.normal, self.area, &self.emission)
+        area_sample(p, q, self.normal, self.area, |_| radiance)
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
