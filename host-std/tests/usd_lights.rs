@@ -104,3 +104,125 @@ fn usd_light_twins_render_like_their_json_originals() {
 fn usd_twin_of_every_light_under_an_environment_renders_like_its_json_original() {
     twin_renders_like_its_original("lights_env");
 }
+
+/// ShapingAPI reaches the renderer's lights (`lights_shaping.usda`): the RectLight facing down
+/// with a 30° cone lights the floor straight below it and not a point 45° off its axis, the
+/// point light aimed along +X lights along +X and not along −X, and the shaped lights' power
+/// is the unshaped one's times the integral of their falloff (less).
+#[test]
+fn shaped_usd_lights_render_their_cone() {
+    use sampler_core::glam::{Vec2, Vec3};
+    use sampler_core::light::SceneLight;
+    let file = root().join("host-usd/tests/fixtures/lights_shaping.usda");
+    let converted = usd::load(&file, &usd::Options::default()).unwrap();
+    let lights = &converted.scene.lights;
+    let rect = lights.iter().find_map(|l| if let SceneLight::Rect(r) = l { Some(*r) } else { None }).unwrap();
+    let point = lights.iter().find_map(|l| if let SceneLight::Point(p) = l { Some(*p) } else { None }).unwrap();
+    let lit = |l: &dyn Light, p: Vec3| l.sample(p, Vec2::splat(0.5)).is_some_and(|s| s.radiance.max_element() > 0.0);
+    assert!(lit(&rect, Vec3::ZERO) && !lit(&rect, Vec3::new(3.0, 0.0, 0.0)));
+    assert!(lit(&point, Vec3::new(5.0, 3.0, 0.0)) && !lit(&point, Vec3::new(-1.0, 3.0, 0.0)));
+    assert!(lit(&point, Vec3::new(5.0, 4.5, 0.0)) && !lit(&point, Vec3::new(3.0, 4.5, 0.0)), "40° cone");
+    let unshaped = sampler_core::light::RectLight::new(Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::splat(10.0)).unwrap();
+    assert!(rect.power(1.0).x < 0.5 * unshaped.power(1.0).x, "{} against {}", rect.power(1.0), unshaped.power(1.0));
+}
+
+/// A RectLight's `texture:file` (`lights_textured.usda`, a 4 × 2 image on a 2 × 1 rectangle
+/// facing down, its first texel at the local (+X, +Y) corner): one emitting cell per texel but
+/// the black one, each where the schema puts it with the light's radiance times its texel; and
+/// the irradiance the cells deliver, picked by power and sampled by solid angle, matches
+/// quadrature over the rectangle of the texture looked up at each point (every channel).
+#[test]
+fn a_textured_rect_light_emits_its_image() {
+    use host_std::light::image_file;
+    use sampler_core::glam::{Vec2, Vec3};
+    use sampler_core::light::{PowerSelector, SceneLight};
+    use sampler_core::rng::Pcg32;
+    let fixtures = root().join("host-usd/tests/fixtures");
+    let converted = usd::load(&fixtures.join("lights_textured.usda"), &usd::Options::default()).unwrap();
+    assert!(converted.notes.is_empty(), "{:?}", converted.notes);
+    assert!(converted.files.iter().any(|f| f.ends_with("light_texture.png")), "{:?}", converted.files);
+    let lights = &converted.scene.lights;
+    assert_eq!(lights.len(), 7, "one cell per texel, the black one left out");
+    let image = image_file::load(&fixtures.join("light_texture.png")).unwrap();
+    // The image at a point of the rectangle: columns run from x = +1 to −1, rows from z = −½ to +½.
+    let texel = |q: Vec3| {
+        let col = (((1.0 - q.x) / 2.0 * 4.0) as usize).min(3);
+        let row = (((q.z + 0.5) * 2.0) as usize).min(1);
+        Vec3::from_array(image.texels[row * 4 + col]) * 3.0
+    };
+    // The red texel's cell: x in [0.5, 1], z in [−0.5, 0], facing down.
+    let red = lights
+        .iter()
+        .find_map(|l| match l {
+            SceneLight::Rect(r) if r.power(1.0).y == 0.0 && r.power(1.0).x > 0.0 => Some(*r),
+            _ => None,
+        })
+        .unwrap();
+    let Some(sampler_core::light::LightSurface::Rect { p0, e1, e2 }) = SceneLight::Rect(red).surface() else {
+        panic!()
+    };
+    let centre = p0 + 0.5 * (e1 + e2);
+    assert!((centre - Vec3::new(0.75, 2.0, -0.25)).length() < 1e-5 && red.normal().y < -0.999, "{centre}");
+    // Irradiance at a point below, by light sampling against quadrature.
+    let (p, n) = (Vec3::new(0.3, 0.0, 0.1), Vec3::Y);
+    let weights: Vec<f32> = lights.iter().map(|l| l.power(1.0).element_sum()).collect();
+    let mut cdf = vec![0.0; weights.len() + 1];
+    let selector = PowerSelector::build(&weights, &mut cdf).unwrap();
+    let mut rng = Pcg32::new(7, 1);
+    let count = 200_000;
+    let (mut sum, mut sum2) = (Vec3::ZERO.as_dvec3(), Vec3::ZERO.as_dvec3());
+    for _ in 0..count {
+        let picked = selector.pick(rng.next_f64());
+        let u = Vec2::new(picked.u_remapped as f32, rng.next_f32());
+        let v = lights[picked.index].sample(p, u).map_or(Vec3::ZERO.as_dvec3(), |s| {
+            (s.radiance * n.dot(s.dir).max(0.0)).as_dvec3() / (s.pdf as f64 * picked.pmf)
+        });
+        sum += v;
+        sum2 += v * v;
+    }
+    let mean = sum / count as f64;
+    let se = ((sum2 / count as f64 - mean * mean).max(Vec3::ZERO.as_dvec3()) / count as f64).powf(0.5);
+    let steps = (400, 200);
+    let mut quad = Vec3::ZERO.as_dvec3();
+    for j in 0..steps.1 {
+        for i in 0..steps.0 {
+            let q = Vec3::new(
+                -1.0 + 2.0 * (i as f32 + 0.5) / steps.0 as f32,
+                2.0,
+                -0.5 + (j as f32 + 0.5) / steps.1 as f32,
+            );
+            let d = q - p;
+            let g = (n.dot(d) * d.y) as f64 / (d.length_squared() as f64).powi(2);
+            quad += texel(q).as_dvec3() * g * (2.0 / (steps.0 * steps.1) as f64);
+        }
+    }
+    for c in 0..3 {
+        assert!((mean[c] - quad[c]).abs() <= 4.0 * se[c] + 1e-3 * quad[c], "channel {c}: {mean} ± {se} against {quad}");
+    }
+}
+
+/// `ppis info` lists every light feature the render leaves out (`lights_unrendered.usda`), and
+/// `ppis render` says so in its one warning summary.
+#[test]
+fn unrendered_light_features_are_listed_and_warned() {
+    let file = root().join("host-usd/tests/fixtures/lights_unrendered.usda");
+    let ppis = || std::process::Command::new(env!("CARGO_BIN_EXE_ppis"));
+    let info = ppis().arg("info").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    let needles = ["IES profile", "light filters", "light linking", "shadow linking", "PortalLight", "portals ignored"];
+    for needle in needles {
+        assert!(text.contains(needle), "ppis info does not list {needle:?}: {text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.exr");
+    let args = ["--width", "8", "--height", "8", "--spp", "1", "--method", "mis", "-o"];
+    let render = ppis().arg("render").arg(&file).args(args).arg(&out).output().unwrap();
+    let stderr = String::from_utf8_lossy(&render.stderr);
+    assert!(render.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("ppis: warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("not rendered as authored"), "{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "ppis render does not warn of {needle:?}: {stderr}");
+    }
+}

@@ -20,6 +20,7 @@ pub mod primvar;
 pub mod render_settings;
 pub mod scene;
 pub mod shapes;
+pub mod shaping;
 pub mod stage;
 pub mod xform;
 pub mod xform_ops;

@@ -86,6 +86,28 @@ pub struct UsdLight {
     pub prim_type: String,
     /// What it emits, where.
     pub emitter: Emitter,
+    /// Its ShapingAPI cone and focus (points, spheres, rectangles and disks).
+    pub shaping: Option<crate::shaping::LightShaping>,
+    /// A RectLight's `texture:file`, placed on the rectangle.
+    pub texture: Option<RectTexture>,
+}
+
+/// A RectLight's texture and where it lies. The schema puts the image's first texel (its
+/// top-left corner) at the rectangle's local (+X, +Y) corner and its last one at (−X, −Y):
+/// seen from the front (from the emitting side, local −Z, with +Y up) the image is upright
+/// and unmirrored. Image column fractions run along `across`, rows (top to bottom) along `down`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RectTexture {
+    /// The resolved asset path (inside a package: `pkg.usdz[tex/a.png]`).
+    pub name: String,
+    /// The encoded image.
+    pub bytes: Vec<u8>,
+    /// Where the image's top-left corner lies: the world image of local (+w/2, +h/2, 0).
+    pub corner: Vec3,
+    /// From that corner across the image's top row: the world image of (−w, 0, 0).
+    pub across: Vec3,
+    /// From that corner down the image's first column: the world image of (0, −h, 0).
+    pub down: Vec3,
 }
 
 /// A light input: `inputs:<name>`, or the pre-21.02 `<name>`.
@@ -147,18 +169,34 @@ impl Emission {
     }
 }
 
+/// The light authors its collection `name` (LightAPI's `lightLink` or `shadowLink`) to leave
+/// some prims out: includes or excludes, or `includeRoot` off.
+fn linked(stage: &Stage, prim: &PrimPath, name: &str) -> Result<bool, String> {
+    let base = format!("collection:{name}");
+    let listed = !stage.targets(prim, &format!("{base}:includes"))?.is_empty()
+        || !stage.targets(prim, &format!("{base}:excludes"))?.is_empty();
+    let root_off = stage.value(prim, &format!("{base}:includeRoot"))?.and_then(|v| v.scalar()) == Some(0.0);
+    Ok(listed || root_off)
+}
+
+/// The light kinds whose ShapingAPI cone and focus are rendered.
+pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
+
 /// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
-/// cone, focus and IES profile, light filters, the diffuse and specular multipliers, shadow
-/// controls, and (for `type_name`) a RectLight's texture and a CylinderLight's `treatAsLine`.
+/// cone and focus on kinds other than [`SHAPED_KINDS`] and its IES profile, light filters, the
+/// diffuse and specular multipliers, shadow controls, and (for `type_name`) a CylinderLight's
+/// `treatAsLine`. A RectLight's texture renders (`RectTexture`).
 pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
     let mut notes = Vec::new();
     let authored =
         |name: &str| -> Result<Option<f64>, String> { Ok(input(stage, prim, name)?.and_then(|v| v.scalar())) };
-    if authored("shaping:cone:angle")?.is_some_and(|a| a < 90.0) {
-        notes.push("ShapingAPI cone angle not rendered (the light emits over its whole hemisphere)".into());
-    }
-    if authored("shaping:focus")?.is_some_and(|f| f > 0.0) {
-        notes.push("ShapingAPI focus not rendered".into());
+    if !SHAPED_KINDS.contains(&type_name) {
+        if authored("shaping:cone:angle")?.is_some_and(|a| a < 180.0) {
+            notes.push(format!("ShapingAPI cone angle not rendered on a {type_name}"));
+        }
+        if authored("shaping:focus")?.is_some_and(|f| f > 0.0) {
+            notes.push(format!("ShapingAPI focus not rendered on a {type_name}"));
+        }
     }
     if let Some(Value::Asset { authored, .. }) = input(stage, prim, "shaping:ies:file")?
         && !authored.is_empty()
@@ -168,6 +206,11 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     if !stage.targets(prim, "light:filters")?.is_empty() {
         notes.push("light filters not rendered".into());
     }
+    for (collection, what) in [("lightLink", "light linking"), ("shadowLink", "shadow linking")] {
+        if linked(stage, prim, collection)? {
+            notes.push(format!("{what} (collection:{collection}) not honoured: the light reaches every prim"));
+        }
+    }
     for (name, what) in [("diffuse", "diffuse multiplier"), ("specular", "specular multiplier")] {
         if authored(name)?.is_some_and(|v| v != 1.0) {
             notes.push(format!("inputs:{name} ({what}) not rendered; the light is physical"));
@@ -175,12 +218,6 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     }
     if stage.value(prim, "inputs:shadow:enable")?.and_then(|v| v.scalar()) == Some(0.0) {
         notes.push("ShadowAPI shadow:enable = false not honoured (the light casts shadows)".into());
-    }
-    if type_name == "RectLight"
-        && let Some(Value::Asset { authored, .. }) = input(stage, prim, "texture:file")?
-        && !authored.is_empty()
-    {
-        notes.push(format!("texture:file {authored} not rendered (the rectangle emits its colour)"));
     }
     if type_name == "CylinderLight" && stage.value(prim, "treatAsLine")?.and_then(|v| v.scalar()) == Some(1.0) {
         notes.push("treatAsLine ignored (rendered as the cylinder)".into());

@@ -3,7 +3,9 @@
 //! 2^exposure · color · blackbody, divided by the area with `normalize`); pre-21.02 names are
 //! read; dark, invisible and partly supported lights are notes; a NaN or negative input is an
 //! error naming the prim; the blackbody colour agrees with Pixar's (divided by its 6500 K
-//! colour, which the schema makes white) within 1% from 3000 K up and 5% below.
+//! colour, which the schema makes white) within 1% from 3000 K up and 5% below. ShapingAPI is
+//! read about each light's axis, and lights inside PointInstancer prototypes and instanceable
+//! references come once per instance.
 
 use glam::Vec3;
 use host_usd::lights::{Emitter, UsdLight};
@@ -103,7 +105,6 @@ fn dark_hidden_and_partly_rendered_lights_are_notes() {
         ("/World/Dark", "emits nothing"),
         ("/World/NoSize", "radius 0"),
         ("/World/Hidden", "invisible"),
-        ("/World/Spot", "cone angle"),
         ("/World/Spot", "non-uniform scale"),
         ("/World/Portal", "PortalLight not rendered"),
     ] {
@@ -113,9 +114,82 @@ fn dark_hidden_and_partly_rendered_lights_are_notes() {
     for path in ["/World/Dark", "/World/NoSize", "/World/Hidden", "/World/Portal"] {
         assert!(s.lights.iter().all(|l| l.path != path), "{path} is not rendered");
     }
-    // The spot still renders, as a sphere.
+    // The spot renders as a sphere shaped by its cone.
     assert!(matches!(light(&s, "/World/Spot").emitter, Emitter::Sphere { .. }));
+    assert_eq!(light(&s, "/World/Spot").shaping.map(|x| x.cone_angle_deg), Some(30.0));
     assert_eq!(s.lights.len(), 10, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
+}
+
+/// ShapingAPI (`lights_shaping.usda`): each input read, the axis the world image of the light's
+/// −Z, the cone falling back to 90° where ShapingAPI is applied and to none where it is not, a
+/// shaping that changes nothing dropped, and a kind that does not render it noted.
+#[test]
+fn shaping_inputs_are_read_about_the_lights_axis() {
+    let s = host_usd::load(&fixture("lights_shaping.usda")).unwrap();
+    let shaping = |path: &str| light(&s, path).shaping;
+    let spot = shaping("/World/Spot").expect("the RectLight is shaped");
+    assert!(close(spot.axis, -Vec3::Y), "{:?}", spot.axis);
+    assert_eq!((spot.cone_angle_deg, spot.cone_softness, spot.focus), (30.0, 0.5, 2.0));
+    assert!(close(spot.focus_tint, Vec3::new(0.1, 0.2, 0.3)));
+    let point = shaping("/World/PointSpot").expect("the point light is shaped");
+    assert!(matches!(light(&s, "/World/PointSpot").emitter, Emitter::Point { .. }));
+    assert!(close(point.axis, Vec3::X) && point.cone_angle_deg == 40.0, "{point:?}");
+    let disk = shaping("/World/FocusDisk").unwrap();
+    assert_eq!((disk.cone_angle_deg, disk.focus, disk.focus_tint), (90.0, 4.0, Vec3::ZERO));
+    let unapplied = shaping("/World/Unapplied").unwrap();
+    assert_eq!((unapplied.cone_angle_deg, unapplied.focus), (180.0, 2.0));
+    assert_eq!(shaping("/World/Plain"), None);
+    assert_eq!(shaping("/World/ShapedSun"), None);
+    let notes = notes_of(&s, "/World/ShapedSun");
+    assert!(notes.iter().any(|n| n.contains("cone angle not rendered on a DistantLight")), "{notes:?}");
+    for path in ["/World/Spot", "/World/PointSpot", "/World/FocusDisk", "/World/Unapplied", "/World/Plain"] {
+        assert!(notes_of(&s, path).is_empty(), "{path}: {:?}", notes_of(&s, path));
+    }
+}
+
+/// Lights inside a PointInstancer's prototype and under instanceable references
+/// (`lights_instanced.usda`): one light per visible instance, at the instance's transform.
+#[test]
+fn instanced_lights_take_each_instances_transform() {
+    let s = host_usd::load(&fixture("lights_instanced.usda")).unwrap();
+    let bulb = |i: usize| light(&s, &format!("/World/Lamps/Protos/Lamp/Bulb[/World/Lamps:{i}]"));
+    let Emitter::Sphere { center, radius, .. } = bulb(0).emitter else { panic!() };
+    assert!(close(center, Vec3::new(0.0, 1.0, 0.0)) && (radius - 0.1).abs() < 1e-6, "{center} {radius}");
+    // Scaled ×2 and moved to x = 5.
+    let Emitter::Sphere { center, radius, .. } = bulb(1).emitter else { panic!() };
+    assert!(close(center, Vec3::new(5.0, 2.0, 0.0)) && (radius - 0.2).abs() < 1e-6, "{center} {radius}");
+    let panel = |i: usize| light(&s, &format!("/World/Lamps/Protos/Lamp/Panel[/World/Lamps:{i}]"));
+    let Emitter::Triangles { positions, .. } = &panel(1).emitter else { panic!() };
+    assert!(positions.iter().any(|p| close(*p, Vec3::new(7.0, 0.0, 2.0))), "{positions:?}");
+    assert!(matches!(panel(0).emitter, Emitter::Triangles { .. }));
+    // Instance id 12 is invisible.
+    assert!(s.lights.iter().all(|l| !l.path.ends_with(":2]")), "{:?}", s.lights);
+    for (path, x) in [("/World/A/Panel", -4.0), ("/World/B/Panel", 4.0)] {
+        let Emitter::Rect { p0, e1, e2, .. } = light(&s, path).emitter else { panic!() };
+        assert!(close(p0 + 0.5 * (e1 + e2), Vec3::new(x, 2.0, 0.0)), "{path}: {p0}");
+    }
+    assert_eq!(s.lights.len(), 6, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
+}
+
+/// What is not rendered (`lights_unrendered.usda`) is a note each: an IES profile, a light
+/// filter, light and shadow linking, a PortalLight, a PluginLight and a dome's portals.
+#[test]
+fn what_is_not_rendered_is_a_note_each() {
+    let s = host_usd::load(&fixture("lights_unrendered.usda")).unwrap();
+    for (path, needle) in [
+        ("/World/Lamp", "IES profile profile.ies not rendered"),
+        ("/World/Lamp", "light filters not rendered"),
+        ("/World/Lamp", "light linking (collection:lightLink) not honoured"),
+        ("/World/Lamp", "shadow linking (collection:shadowLink) not honoured"),
+        ("/World/Window", "PortalLight not rendered"),
+        ("/World/Plugin", "PluginLight not rendered"),
+        ("/World/Sky", "portals ignored"),
+    ] {
+        let notes = notes_of(&s, path);
+        assert!(notes.iter().any(|n| n.contains(needle)), "{path}: {needle:?} not in {notes:?}");
+    }
+    // The lamp itself renders.
+    assert!(matches!(light(&s, "/World/Lamp").emitter, Emitter::Sphere { .. }));
 }
 
 #[test]
@@ -145,6 +219,7 @@ fn a_light_that_cannot_exist_is_an_error_naming_the_prim() {
         ("def RectLight \"L\" { color3f inputs:color = (1, -1, 1) }", "inputs:color"),
         ("def DiskLight \"L\" { float inputs:radius = -1 }", "inputs:radius"),
         ("def DistantLight \"L\" { float inputs:intensity = -5 }", "negative"),
+        ("def RectLight \"L\" { asset inputs:texture:file = @gone.png@ }", "texture:file gone.png not found"),
     ] {
         let file = dir.path().join("bad.usda");
         std::fs::write(&file, format!("#usda 1.0\n{body}\n")).unwrap();

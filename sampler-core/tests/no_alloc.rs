@@ -119,16 +119,17 @@ fn ten_thousand_shading_points_allocate_nothing() {
     assert_eq!(count, 0, "the core allocated {count} times");
 }
 
-/// Every light's sampling, density and ray query, picking a light by power, and the lights'
-/// estimator (a light sample and a BRDF sample under the balance heuristic), at 10 000 shading
+/// Every light's sampling, density and ray query (shaped lights among them), picking a light by
+/// power, and the lights' estimator (a light sample and a BRDF sample under the balance heuristic), at 10 000 shading
 /// points.
 #[test]
 fn light_sampling_allocates_nothing() {
     use sampler_core::light::*;
     let l = Vec3::new(1.0, 2.0, 3.0);
+    let spot = Shaping::new(Vec3::NEG_Z, 1.0, 0.3, 2.0, Vec3::splat(0.1)).unwrap();
     let lights: [SceneLight; 8] = [
-        PointLight::new(Vec3::new(0.0, 0.0, 3.0), l).unwrap().into(),
-        SphereLight::new(Vec3::new(1.0, 0.0, 2.0), 0.5, l).unwrap().with_two_sided(true).into(),
+        PointLight::new(Vec3::new(0.0, 0.0, 3.0), l).unwrap().with_shaping(spot).into(),
+        SphereLight::new(Vec3::new(1.0, 0.0, 2.0), 0.5, l).unwrap().with_two_sided(true).with_shaping(spot).into(),
         RectLight::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::X * 2.0, Vec3::Y * 2.0, l)
             .unwrap()
             .with_two_sided(true)

@@ -9,6 +9,8 @@ pub mod mesh;
 mod mesh_light;
 mod model;
 pub mod ply;
+#[cfg(feature = "usd")]
+mod rect_texture;
 pub mod texture;
 #[cfg(feature = "usd")]
 pub mod usd;

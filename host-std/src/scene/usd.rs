@@ -89,7 +89,8 @@ fn image_size(usd: &UsdScene, cam: &host_usd::Camera, size: (Option<u32>, Option
 fn files_read(usd: &UsdScene) -> Vec<PathBuf> {
     let textures = usd.materials.iter().flat_map(|m| &m.textures).filter_map(|t| t.source.resolved.as_deref());
     let dome = usd.dome.iter().filter_map(|d| d.texture.as_ref().map(|(name, _)| name.as_str()));
-    let mut files: Vec<PathBuf> = (usd.layers.iter().map(String::as_str).chain(textures).chain(dome))
+    let lights = usd.lights.iter().filter_map(|l| l.texture.as_ref().map(|t| t.name.as_str()));
+    let mut files: Vec<PathBuf> = (usd.layers.iter().map(String::as_str).chain(textures).chain(dome).chain(lights))
         .map(|id| PathBuf::from(id.split_once('[').map_or(id, |(file, _)| file)))
         .filter(|p| p.is_file())
         .collect();
@@ -99,7 +100,7 @@ fn files_read(usd: &UsdScene) -> Vec<PathBuf> {
 }
 
 /// A texture's file name with a usable extension (`pkg.usdz[tex/a.png]` → `pkg.usdz/tex/a.png`).
-fn texture_name(resolved: &str) -> PathBuf {
+pub(crate) fn texture_name(resolved: &str) -> PathBuf {
     PathBuf::from(resolved.replace('[', "/").replace(']', ""))
 }
 

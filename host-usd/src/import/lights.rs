@@ -1,13 +1,14 @@
 //! UsdLux lights into the scene, each under its world transform (the up-axis conversion
 //! included): DistantLight, SphereLight (a point with `treatAsPoint`), RectLight, DiskLight,
 //! CylinderLight (its side tessellated into emitting triangles) and meshes with MeshLightAPI.
-//! A light that emits nothing (zero intensity, colour or size) is a note, as the schema makes
+//! Spheres (points too), rectangles and disks carry their ShapingAPI cone and focus. A light that emits nothing (zero intensity, colour or size) is a note, as the schema makes
 //! it dark; a value that cannot be a light (not finite, negative) is an error naming the prim.
 
 use super::Importer;
-use crate::lights::{self, Emission, Emitter, UsdLight};
+use crate::lights::{self, Emission, Emitter, RectTexture, UsdLight};
 use crate::shapes;
-use crate::stage::PrimPath;
+use crate::shaping::{self, LightShaping};
+use crate::stage::{PrimPath, Stage, Value};
 use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::f64::consts::PI;
@@ -25,8 +26,14 @@ impl Importer<'_> {
             self.skip(prim, format!("invisible {type_name}: not rendered"));
             return Ok(());
         }
-        let stage = self.stage;
-        let m = self.conversion * self.worlds.world(stage, prim)?;
+        let m = self.conversion * self.worlds.world(self.stage, prim)?;
+        self.light_at(prim, type_name, &m, &prim.to_string())
+    }
+
+    /// The light `prim` under the renderer-frame transform `m`, named `label` (its path, or
+    /// for a PointInstancer's instance the path and the instance).
+    pub(super) fn light_at(&mut self, prim: &PrimPath, type_name: &str, m: &DMat4, label: &str) -> Result<(), String> {
+        let (stage, m) = (self.stage, *m);
         let fallback = if type_name == "DistantLight" { 50000.0 } else { 1.0 };
         let emission = Emission::read(stage, prim, fallback)?;
         lights::unrendered(stage, prim, type_name)?.into_iter().for_each(|n| self.skip(prim, n));
@@ -34,6 +41,7 @@ impl Importer<'_> {
             let v = lights::scalar(stage, prim, name, fallback)?;
             if v < 0.0 { Err(format!("inputs:{name} is negative ({v})")) } else { Ok(v) }
         };
+        let mut texture = None;
         let built = match type_name {
             "DistantLight" => distant(lights::scalar(stage, prim, "angle", 0.53)?, &m, &emission)?,
             "SphereLight" => {
@@ -42,7 +50,11 @@ impl Importer<'_> {
                 note.into_iter().for_each(|n| self.skip(prim, n));
                 built
             }
-            "RectLight" => rect(size("width", 1.0)?, size("height", 1.0)?, &m, &emission),
+            "RectLight" => {
+                let (width, height) = (size("width", 1.0)?, size("height", 1.0)?);
+                texture = rect_texture(stage, prim, width, height, &m)?;
+                rect(width, height, &m, &emission)
+            }
             "DiskLight" => {
                 let (built, note) = disk(size("radius", 0.5)?, &m, &emission);
                 note.into_iter().for_each(|n| self.skip(prim, n));
@@ -51,15 +63,30 @@ impl Importer<'_> {
             "CylinderLight" => cylinder(size("radius", 0.5)?, size("length", 1.0)?, &m, &emission),
             _ => return Err(format!("{type_name} is not a light kind read here")),
         };
-        self.add_light(prim, type_name, built);
+        let shaping = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read(stage, prim, &m)? } else { None };
+        self.add_light(prim, label, type_name, built, shaping);
+        if let Some(light) = self.scene.lights.last_mut().filter(|l| l.path == label) {
+            light.texture = texture;
+        }
         Ok(())
     }
 
     /// A gprim with MeshLightAPI: its triangles emit (front faces, both sides when
     /// `doubleSided`); it is not also a surface, and its material is not rendered.
     pub(super) fn mesh_light(&mut self, prim: &PrimPath, type_name: &str) -> Result<(), String> {
-        let stage = self.stage;
-        let m = self.conversion * self.worlds.world(stage, prim)?;
+        let m = self.conversion * self.worlds.world(self.stage, prim)?;
+        self.mesh_light_at(prim, type_name, &m, &prim.to_string())
+    }
+
+    /// The mesh light `prim` under the renderer-frame transform `m`, named `label`.
+    pub(super) fn mesh_light_at(
+        &mut self,
+        prim: &PrimPath,
+        type_name: &str,
+        m: &DMat4,
+        label: &str,
+    ) -> Result<(), String> {
+        let (stage, m) = (self.stage, *m);
         let emission = Emission::read(stage, prim, 1.0)?;
         lights::unrendered(stage, prim, type_name)?.into_iter().for_each(|n| self.skip(prim, n));
         if stage.bound_material(prim)?.is_some() {
@@ -72,11 +99,18 @@ impl Importer<'_> {
         };
         let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        self.add_light(prim, type_name, built);
+        self.add_light(prim, label, type_name, built, None);
         Ok(())
     }
 
-    fn add_light(&mut self, prim: &PrimPath, type_name: &str, built: Built) {
+    fn add_light(
+        &mut self,
+        prim: &PrimPath,
+        label: &str,
+        type_name: &str,
+        built: Built,
+        shaping: Option<LightShaping>,
+    ) {
         let emitter = match built {
             Ok(e) if dark(&e) => Err("emits nothing (intensity or color 0): not rendered".to_string()),
             other => other,
@@ -86,7 +120,9 @@ impl Importer<'_> {
                 for p in extent(&emitter) {
                     self.grow(p);
                 }
-                self.scene.lights.push(UsdLight { path: prim.to_string(), prim_type: type_name.into(), emitter });
+                let path = label.to_string();
+                let prim_type = type_name.into();
+                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture: None });
             }
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }
@@ -169,6 +205,29 @@ fn sphere(r: f64, point: bool, m: &DMat4, emission: &Emission) -> (Built, Option
         return (Err("of radius 0 emits nothing: not rendered".into()), note);
     }
     (Ok(Emitter::Sphere { center, radius: radius as f32, radiance }), note)
+}
+
+/// A RectLight's `texture:file` under `m`, read from its (resolved) asset; `None` when none
+/// is authored, an error naming the file when it cannot be found or read.
+fn rect_texture(
+    stage: &Stage,
+    prim: &PrimPath,
+    width: f64,
+    height: f64,
+    m: &DMat4,
+) -> Result<Option<RectTexture>, String> {
+    let Some(Value::Asset { authored, resolved }) = lights::input(stage, prim, "texture:file")? else {
+        return Ok(None);
+    };
+    if authored.is_empty() {
+        return Ok(None);
+    }
+    let name = resolved.ok_or_else(|| format!("texture:file {authored} not found"))?;
+    let bytes = stage.read_asset(&name).map_err(|e| format!("texture:file {name}: {e}"))?;
+    let corner = m.transform_point3(DVec3::new(0.5 * width, 0.5 * height, 0.0)).as_vec3();
+    let across = m.transform_vector3(DVec3::new(-width, 0.0, 0.0)).as_vec3();
+    let down = m.transform_vector3(DVec3::new(0.0, -height, 0.0)).as_vec3();
+    Ok(Some(RectTexture { name, bytes, corner, across, down }))
 }
 
 /// RectLight: `width` along local X, `height` along local Y, centred, emitting towards the

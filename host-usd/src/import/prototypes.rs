@@ -11,9 +11,9 @@ use crate::instancer;
 use crate::stage::{PrimPath, Stage, Step};
 use glam::DMat4;
 
-/// A renderable gprim under a prototype root: its path, type and transform relative to
-/// the root's parent.
-type Part = (PrimPath, String, DMat4);
+/// A renderable gprim or a light under a prototype root: its path, type, transform relative
+/// to the root's parent, and whether it is a mesh light (MeshLightAPI).
+type Part = (PrimPath, String, DMat4, bool);
 
 /// The prototype roots known so far, what lies under each, and the instancers not yet
 /// expanded.
@@ -99,14 +99,16 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Keeps a visible gprim under prototype roots for their instancers.
+    /// Keeps a visible gprim or light under prototype roots for their instancers.
     pub(super) fn prototype_gprim(&mut self, prim: &PrimPath, type_name: &str) -> Result<(), String> {
         let stage = self.stage;
+        let mesh_light = !crate::lights::KINDS.contains(&type_name)
+            && stage.applied_schemas(prim)?.iter().any(|s| s == "MeshLightAPI");
         for i in 0..self.prototypes.roots.len() {
             let root = &self.prototypes.roots[i];
             if prim.is_at_or_below(root) {
                 let rel = self.worlds.relative_to(stage, prim, root)?;
-                self.prototypes.parts[i].push((prim.clone(), type_name.to_string(), rel));
+                self.prototypes.parts[i].push((prim.clone(), type_name.to_string(), rel, mesh_light));
             }
         }
         Ok(())
@@ -148,15 +150,34 @@ impl Importer<'_> {
         let parts = std::mem::take(&mut self.prototypes.parts);
         let expanded = instances.iter().try_for_each(|inst| {
             let Some(list) = index.get(inst.prototype).copied().flatten().map(|i| &parts[i]) else { return Ok(()) };
-            list.iter().try_for_each(|(p, t, rel)| {
+            list.iter().try_for_each(|(p, t, rel, mesh_light)| {
                 let m = self.conversion * *world * inst.transform * *rel;
                 let label = format!("{p}[{prim}:{}]", inst.index);
-                self.gprim(p, t, &label, &m).map_err(fail(p))
+                self.prototype_part(p, t, *mesh_light, &label, &m).map_err(fail(p))
             })
         });
         self.prototypes.parts = parts;
         expanded?;
         self.scene.counts.instances += instances.len();
         Ok(())
+    }
+
+    /// One prim kept under a prototype root, for one instance at `m`: a light, a mesh light
+    /// (MeshLightAPI) or a gprim.
+    fn prototype_part(
+        &mut self,
+        prim: &PrimPath,
+        type_name: &str,
+        mesh_light: bool,
+        label: &str,
+        m: &DMat4,
+    ) -> Result<(), String> {
+        if crate::lights::KINDS.contains(&type_name) {
+            return self.light_at(prim, type_name, m, label);
+        }
+        if mesh_light {
+            return self.mesh_light_at(prim, type_name, m, label);
+        }
+        self.gprim(prim, type_name, label, m)
     }
 }

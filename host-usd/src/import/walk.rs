@@ -58,7 +58,8 @@ impl Importer<'_> {
             self.register_instancer(prim)?;
         }
         if self.prototypes.contains(prim) {
-            if GPRIMS.contains(&t) && !self.hidden(prim).map_err(fail(prim))? {
+            let kept = GPRIMS.contains(&t) || crate::lights::KINDS.contains(&t);
+            if kept && !self.hidden(prim).map_err(fail(prim))? {
                 self.prototype_gprim(prim, t).map_err(fail(prim))?;
             }
             return Ok(());

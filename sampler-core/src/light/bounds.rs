@@ -28,6 +28,9 @@ pub struct LightBounds {
     pub two_sided: bool,
 }
 
+/// Radians added to a shaped light's emission spread in its bounds.
+const SHAPED_MARGIN: f32 = 1e-3;
+
 /// Luminance of linear RGB.
 fn luminance(c: Vec3) -> f32 {
     0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
@@ -65,7 +68,7 @@ impl LightBounds {
             let (min, max) = points.iter().fold((points[0], points[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
             Some(Self { min, max, power, axis: normal, cos_normals: 1.0, cos_emission: 0.0, two_sided })
         };
-        match (light, light.surface()) {
+        let bounds = match (light, light.surface()) {
             (SceneLight::Point(l), _) => every(l.position(), l.position()),
             (SceneLight::Sphere(_), Some(LightSurface::Sphere { center, radius })) => {
                 every(center - Vec3::splat(radius), center + Vec3::splat(radius))
@@ -84,6 +87,34 @@ impl LightBounds {
                 facing(&v, normal, l.is_two_sided())
             }
             _ => None,
+        };
+        bounds.map(|b| b.shaped(light))
+    }
+
+    /// These bounds narrowed to a shaped light's cone when it is narrower than a hemisphere:
+    /// the emission leaves within `cutoff` of the shaping axis, and at full strength within its
+    /// soft start, so the importance stays positive wherever the light can shine (the soft band
+    /// is the emission spread θe beyond the normals' cone θo, as pbrt-v4 bounds a spot light).
+    fn shaped(self, light: &SceneLight) -> Self {
+        let shaping = match light {
+            SceneLight::Point(l) => l.shaping(),
+            SceneLight::Sphere(l) => l.shaping(),
+            SceneLight::Rect(l) => l.shaping(),
+            SceneLight::Disk(l) => l.shaping(),
+            _ => return self,
+        };
+        if shaping.cutoff() >= core::f32::consts::FRAC_PI_2 {
+            return self;
+        }
+        let (start, cutoff) = (shaping.soft_start(), shaping.cutoff());
+        // A margin over the band keeps a hard cone (θe = 0, where `importance` would cull
+        // every point) and the rounding of the angles on the safe side.
+        Self {
+            axis: shaping.axis(),
+            cos_normals: libm::cosf(start),
+            cos_emission: libm::cosf(cutoff - start + SHAPED_MARGIN),
+            two_sided: false,
+            ..self
         }
     }
 

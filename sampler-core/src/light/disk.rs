@@ -2,8 +2,8 @@
 //! which keeps strata compact) and converted to solid angle, d²/(|cos| A).
 
 use super::{
-    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
-    unit,
+    Emission, Light, LightError, LightHit, LightSample, Shaping, area_sample, area_to_solid_angle, checked_rgb,
+    emitted, finite, unit,
 };
 use crate::frame::Frame;
 use crate::sampling::square_to_uniform_disk_concentric;
@@ -33,7 +33,7 @@ impl DiskLight {
         if radius <= 0.0 {
             return Err(LightError::ZeroRadius);
         }
-        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false };
+        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false, shaping: Shaping::NONE };
         Ok(Self { center: finite(center)?, frame: Frame::from_normal(unit(normal)?), radius, emission })
     }
 
@@ -47,6 +47,18 @@ impl DiskLight {
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
+    }
+
+    /// The same disk, its radiance shaped by `shaping` (UsdLux's ShapingAPI).
+    #[must_use]
+    pub fn with_shaping(self, shaping: Shaping) -> Self {
+        Self { emission: Emission { shaping, ..self.emission }, ..self }
+    }
+
+    /// How its radiance falls off away from the shaping axis.
+    #[must_use]
+    pub fn shaping(&self) -> &Shaping {
+        &self.emission.shaping
     }
 
     /// The disk's surface.
@@ -85,7 +97,7 @@ impl Light for DiskLight {
         }
         let d = square_to_uniform_disk_concentric(u) * self.radius;
         let q = self.center + self.frame.s * d.x + self.frame.t * d.y;
-        area_sample(p, q, self.frame.n, self.area(), self.emission.radiance)
+        area_sample(p, q, self.frame.n, self.area(), |d| self.emission.towards(d))
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -97,7 +109,7 @@ impl Light for DiskLight {
 
     fn eval(&self, p: Vec3, dir: Vec3) -> Option<LightHit> {
         let distance = self.intersect(p, dir)?;
-        emitted(&self.emission, -dir.dot(self.frame.n)).map(|radiance| LightHit { radiance, distance })
+        emitted(&self.emission, -dir.dot(self.frame.n), dir).map(|radiance| LightHit { radiance, distance })
     }
 
     fn is_delta(&self) -> bool {

@@ -27,6 +27,7 @@ mod point;
 mod rect;
 mod scene_light;
 mod select;
+mod shaping;
 mod sphere;
 mod spherical_rect;
 mod spherical_triangle;
@@ -40,6 +41,7 @@ pub use point::PointLight;
 pub use rect::RectLight;
 pub use scene_light::{LightSurface, SceneLight};
 pub use select::{PowerSelector, SelectedLight};
+pub use shaping::Shaping;
 pub use sphere::SphereLight;
 pub use tree::{LightNode, LightTree, MAX_DEPTH, TreeError};
 pub use triangle::{TriangleLight, TriangleSampling};
@@ -106,15 +108,27 @@ pub struct Emission {
     pub radiance: Vec3,
     /// Both sides emit (the scene format's lights emit on their front side only).
     pub two_sided: bool,
+    /// How the radiance falls off away from an axis ([`Shaping::NONE`]: it does not).
+    pub shaping: Shaping,
 }
 
 impl Emission {
-    /// The power leaving a surface of area `area` that emits this radiance uniformly: π·L·A per
-    /// emitting side.
+    /// The power leaving a flat surface of area `area` that emits this radiance: π·L·A per
+    /// emitting side, times the shaping's cosine-weighted integral over π when shaped.
     #[must_use]
     pub fn power(&self, area: f32) -> Vec3 {
-        let sides = if self.two_sided { 2.0 } else { 1.0 };
-        self.radiance * (sides * core::f32::consts::PI * area)
+        if self.shaping.is_none() {
+            let sides = if self.two_sided { 2.0 } else { 1.0 };
+            return self.radiance * (sides * core::f32::consts::PI * area);
+        }
+        self.radiance * area * self.shaping.integral(true, self.two_sided)
+    }
+
+    /// The radiance leaving towards `dir` (unit, from the receiver towards the emitter).
+    #[inline]
+    #[must_use]
+    pub fn towards(&self, dir: Vec3) -> Vec3 {
+        if self.shaping.is_none() { self.radiance } else { self.radiance * self.shaping.factor(-dir) }
     }
 }
 
@@ -167,22 +181,24 @@ fn unit(v: Vec3) -> Result<Vec3, LightError> {
     if n == Vec3::ZERO { Err(LightError::DegenerateDirection) } else { Ok(n) }
 }
 
-/// The radiance `emission` sends towards a receiver that sees the side whose cosine with the
-/// front normal (towards the receiver) is `cos_front`; `None` for a dark side or a grazing view.
+/// The radiance `emission` sends along the ray of unit direction `dir` to a receiver that sees
+/// the side whose cosine with the front normal (towards the receiver) is `cos_front`; `None`
+/// for a dark side or a grazing view.
 #[inline]
-fn emitted(emission: &Emission, cos_front: f32) -> Option<Vec3> {
-    (cos_front > 0.0 || (emission.two_sided && cos_front < 0.0)).then_some(emission.radiance)
+fn emitted(emission: &Emission, cos_front: f32, dir: Vec3) -> Option<Vec3> {
+    (cos_front > 0.0 || (emission.two_sided && cos_front < 0.0)).then(|| emission.towards(dir))
 }
 
-/// The sample of a point `q` drawn uniformly on an area `area` of normal `normal`, seen from
-/// `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
+/// The sample of a point `q` drawn uniformly on an area `area` of normal `normal` emitting
+/// `radiance(dir)` along the direction `dir` from `p`, seen from `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
 #[inline]
-fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, radiance: Vec3) -> Option<LightSample> {
+fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, radiance: impl Fn(Vec3) -> Vec3) -> Option<LightSample> {
     let v = q - p;
     let distance = v.length();
     let dir = v / distance;
     let pdf = area_to_solid_angle(distance, dir.dot(normal), area);
-    (pdf > 0.0 && pdf.is_finite()).then_some(LightSample { dir, distance, radiance, pdf, delta: false })
+    let ok = pdf > 0.0 && pdf.is_finite();
+    ok.then(|| LightSample { dir, distance, radiance: radiance(dir), pdf, delta: false })
 }
 
 /// The density with respect to solid angle of a point drawn uniformly on an area `area`, seen

@@ -1,20 +1,22 @@
-//! A point light: radiant intensity `I` from one position; a delta light whose irradiance on a
-//! surface facing it at distance d is I/d².
+//! A point light: radiant intensity `I` from one position, shaped into a spot light by a
+//! ShapingAPI cone and focus where given; a delta light whose irradiance on a surface facing it
+//! at distance d is I·factor(ω)/d².
 
-use super::{Light, LightError, LightHit, LightSample, checked_rgb, finite};
+use super::{Light, LightError, LightHit, LightSample, Shaping, checked_rgb, finite};
 use glam::{Vec2, Vec3};
 
-/// An isotropic point light.
+/// A point light, isotropic unless shaped.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointLight {
     position: Vec3,
     intensity: Vec3,
+    shaping: Shaping,
 }
 
 impl PointLight {
     /// A light at `position` of radiant intensity `intensity` (RGB, W/sr).
     pub fn new(position: Vec3, intensity: Vec3) -> Result<Self, LightError> {
-        Ok(Self { position: finite(position)?, intensity: checked_rgb(intensity)? })
+        Ok(Self { position: finite(position)?, intensity: checked_rgb(intensity)?, shaping: Shaping::NONE })
     }
 
     /// Where the light is.
@@ -23,10 +25,22 @@ impl PointLight {
         self.position
     }
 
-    /// Its radiant intensity (RGB, W/sr).
+    /// Its radiant intensity (RGB, W/sr) before shaping: along the shaping axis.
     #[must_use]
     pub fn intensity(&self) -> Vec3 {
         self.intensity
+    }
+
+    /// The same light, its intensity shaped by `shaping` (a spot light).
+    #[must_use]
+    pub fn with_shaping(self, shaping: Shaping) -> Self {
+        Self { shaping, ..self }
+    }
+
+    /// How its intensity falls off away from the shaping axis.
+    #[must_use]
+    pub fn shaping(&self) -> &Shaping {
+        &self.shaping
     }
 }
 
@@ -38,7 +52,9 @@ impl Light for PointLight {
             return None;
         }
         let distance = libm::sqrtf(d2);
-        Some(LightSample { dir: d / distance, distance, radiance: self.intensity / d2, pdf: 1.0, delta: true })
+        let dir = d / distance;
+        let radiance = self.intensity * self.shaping.factor(-dir) / d2;
+        Some(LightSample { dir, distance, radiance, pdf: 1.0, delta: true })
     }
 
     fn pdf(&self, _p: Vec3, _dir: Vec3) -> f32 {
@@ -54,7 +70,10 @@ impl Light for PointLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        4.0 * core::f32::consts::PI * self.intensity
+        if self.shaping.is_none() {
+            return 4.0 * core::f32::consts::PI * self.intensity;
+        }
+        self.intensity * self.shaping.integral(false, false)
     }
 }
 

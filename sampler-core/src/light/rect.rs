@@ -5,7 +5,8 @@
 
 use super::spherical_rect::SphericalRect;
 use super::{
-    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
+    Emission, Light, LightError, LightHit, LightSample, Shaping, area_sample, area_to_solid_angle, checked_rgb,
+    emitted, finite,
 };
 use glam::{DVec3, Vec2, Vec3};
 
@@ -36,7 +37,7 @@ impl RectLight {
         if !(area > 0.0 && area.is_finite()) || skew > 1e-4 * e1.length() * e2.length() {
             return Err(LightError::ZeroArea);
         }
-        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false };
+        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false, shaping: Shaping::NONE };
         Ok(Self { p0, e1, e2, normal: cross / area, area, emission })
     }
 
@@ -50,6 +51,18 @@ impl RectLight {
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
+    }
+
+    /// The same rectangle, its radiance shaped by `shaping` (UsdLux's ShapingAPI).
+    #[must_use]
+    pub fn with_shaping(self, shaping: Shaping) -> Self {
+        Self { emission: Emission { shaping, ..self.emission }, ..self }
+    }
+
+    /// How its radiance falls off away from the shaping axis.
+    #[must_use]
+    pub fn shaping(&self) -> &Shaping {
+        &self.emission.shaping
     }
 
     /// The rectangle's surface.
@@ -104,15 +117,15 @@ impl Light for RectLight {
         if !self.lit_from(p) {
             return None;
         }
-        let radiance = self.emission.radiance;
         if let Some(rect) = self.spherical(p) {
             let v: DVec3 = rect.sample(u);
             let distance = v.length();
             let dir = (v / distance).as_vec3();
             let pdf = (1.0 / rect.solid_angle()) as f32;
+            let radiance = self.emission.towards(dir);
             return Some(LightSample { dir, distance: distance as f32, radiance, pdf, delta: false });
         }
-        area_sample(p, self.p0 + u.x * self.e1 + u.y * self.e2, self.normal, self.area, radiance)
+        area_sample(p, self.p0 + u.x * self.e1 + u.y * self.e2, self.normal, self.area, |d| self.emission.towards(d))
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -128,7 +141,7 @@ impl Light for RectLight {
 
     fn eval(&self, p: Vec3, dir: Vec3) -> Option<LightHit> {
         let distance = self.intersect(p, dir)?;
-        emitted(&self.emission, -dir.dot(self.normal)).map(|radiance| LightHit { radiance, distance })
+        emitted(&self.emission, -dir.dot(self.normal), dir).map(|radiance| LightHit { radiance, distance })
     }
 
     fn is_delta(&self) -> bool {

@@ -3,7 +3,9 @@
 //! distance to the sphere follows from the same sines. From inside only a two-sided sphere sends
 //! light in: points drawn uniformly on its area, converted to solid angle.
 
-use super::{Emission, Light, LightError, LightHit, LightSample, area_to_solid_angle, checked_rgb, emitted, finite};
+use super::{
+    Emission, Light, LightError, LightHit, LightSample, Shaping, area_to_solid_angle, checked_rgb, emitted, finite,
+};
 use crate::frame::Frame;
 use crate::mapping::square_to_sphere;
 use crate::sampling::{TWO_PI, square_to_uniform_cone};
@@ -30,7 +32,7 @@ impl SphereLight {
         if radius <= 0.0 {
             return Err(LightError::ZeroRadius);
         }
-        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false };
+        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false, shaping: Shaping::NONE };
         Ok(Self { center: finite(center)?, radius, emission })
     }
 
@@ -44,6 +46,18 @@ impl SphereLight {
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
+    }
+
+    /// The same sphere, its radiance shaped by `shaping` (UsdLux's ShapingAPI).
+    #[must_use]
+    pub fn with_shaping(self, shaping: Shaping) -> Self {
+        Self { emission: Emission { shaping, ..self.emission }, ..self }
+    }
+
+    /// How its radiance falls off away from the shaping axis.
+    #[must_use]
+    pub fn shaping(&self) -> &Shaping {
+        &self.emission.shaping
     }
 
     /// The sphere's surface.
@@ -105,7 +119,7 @@ impl Light for SphereLight {
             let pdf = 1.0 / (TWO_PI * one_minus_cos);
             // A sphere too far for its cone to be represented adds nothing f32 can hold.
             let ok = pdf.is_finite() && distance.is_finite();
-            return ok.then_some(LightSample { dir, distance, radiance: self.emission.radiance, pdf, delta: false });
+            return ok.then(|| LightSample { dir, distance, radiance: self.emission.towards(dir), pdf, delta: false });
         }
         if !self.emission.two_sided {
             return None;
@@ -124,7 +138,7 @@ impl Light for SphereLight {
         (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
             dir,
             distance,
-            radiance: self.emission.radiance,
+            radiance: self.emission.towards(dir),
             pdf,
             delta: false,
         })
@@ -158,7 +172,7 @@ impl Light for SphereLight {
         let normal = (p + t * dir - self.center) / self.radius;
         // From outside the near hit faces the ray (cos towards it ≥ 0 up to rounding).
         let cos_front = if near > 0.0 { (-dir.dot(normal)).max(f32::MIN_POSITIVE) } else { -dir.dot(normal) };
-        emitted(&self.emission, cos_front).map(|radiance| LightHit { radiance, distance: t })
+        emitted(&self.emission, cos_front, dir).map(|radiance| LightHit { radiance, distance: t })
     }
 
     fn is_delta(&self) -> bool {
@@ -166,7 +180,13 @@ impl Light for SphereLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        self.emission.power(self.area())
+        if self.emission.shaping.is_none() {
+            return self.emission.power(self.area());
+        }
+        // Seen along any direction the sphere shows a disk of area πr² whatever the axis: the
+        // power is πr²·L·∫ factor dω (4π²r²L unshaped), once per emitting side.
+        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
+        self.emission.radiance * (sides * PI * self.radius * self.radius) * self.emission.shaping.integral(false, false)
     }
 }
 

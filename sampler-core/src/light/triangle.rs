@@ -4,7 +4,8 @@
 
 use super::spherical_triangle::SphericalTriangle;
 use super::{
-    Emission, Light, LightError, LightHit, LightSample, area_sample, area_to_solid_angle, checked_rgb, emitted, finite,
+    Emission, Light, LightError, LightHit, LightSample, Shaping, area_sample, area_to_solid_angle, checked_rgb,
+    emitted, finite,
 };
 use glam::{Vec2, Vec3};
 
@@ -55,7 +56,7 @@ impl TriangleLight {
         if !(len > 0.0 && len.is_finite()) {
             return Err(LightError::ZeroArea);
         }
-        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false };
+        let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false, shaping: Shaping::NONE };
         Ok(Self { v, normal: cross / len, area: 0.5 * len, emission, sampling: TriangleSampling::default() })
     }
 
@@ -138,7 +139,7 @@ impl Light for TriangleLight {
         // Uniform barycentrics by the square-root warp.
         let su = libm::sqrtf(u.x);
         let q = self.v[0] + (u.y * su) * (self.v[1] - self.v[0]) + (su * (1.0 - u.y)) * (self.v[2] - self.v[0]);
-        area_sample(p, q, self.normal, self.area, radiance)
+        area_sample(p, q, self.normal, self.area, |_| radiance)
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -154,7 +155,7 @@ impl Light for TriangleLight {
 
     fn eval(&self, p: Vec3, dir: Vec3) -> Option<LightHit> {
         let distance = self.intersect(p, dir)?;
-        emitted(&self.emission, -dir.dot(self.normal)).map(|radiance| LightHit { radiance, distance })
+        emitted(&self.emission, -dir.dot(self.normal), dir).map(|radiance| LightHit { radiance, distance })
     }
 
     fn is_delta(&self) -> bool {

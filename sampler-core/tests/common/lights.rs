@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use sampler_core::light::{
-    DiskLight, DistantLight, Light, RectLight, SceneLight, SphereLight, TriangleLight, TriangleSampling,
+    DiskLight, DistantLight, Light, RectLight, SceneLight, Shaping, SphereLight, TriangleLight, TriangleSampling,
 };
 
 /// A light seen from `p`: `axis` points towards it and `cone` (radians) holds every direction
@@ -84,6 +84,21 @@ pub fn light_cases() -> Vec<LightCase> {
             Vec3::new(-0.5, 0.1, 0.98),
             tri_centre,
             1.7,
+        ),
+        case(
+            "rect shaped (cone 40° soft, focus 2)",
+            rect.with_shaping(Shaping::new(rect.normal(), 0.7, 0.5, 2.0, Vec3::new(0.2, 0.5, 1.0)).unwrap()),
+            Vec3::new(0.9, -1.0, 0.2),
+            Vec3::new(0.0, -1.0, 2.0),
+            1.2,
+        ),
+        case(
+            "sphere shaped (cone 30°)",
+            sphere(Vec3::new(0.0, 0.0, 1.5), 0.6)
+                .with_shaping(Shaping::new(Vec3::NEG_Z, 0.5, 0.0, 0.0, Vec3::ZERO).unwrap()),
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.5),
+            0.6,
         ),
     ]
 }
