@@ -109,13 +109,8 @@ mod tests {
 
     #[test]
     fn lanes_find_the_exact_pixels() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = sampler_core::rng::Pcg32::new(11, 3);
+        let mut next = || rng.next_f32();
         for (w, h) in [(1, 1), (2, 1), (7, 3), (1024, 512), (4096, 2048), (16384, 8192)] {
             let lookup = LatLongLookup::new(w, h);
             for k in 0..100_000u32 {

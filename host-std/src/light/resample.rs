@@ -147,21 +147,20 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
         let found = pixels.pixels_x4(Vec4::from_array(s.map(|s| s as f32)), Vec4::from_array(t.map(|t| t as f32)));
         found.map(|(i, j)| clamped(image.texels[j * image.width + i]))
     };
-    // The mean of k × k stratified points of texel (x, y), row by row, four at a time.
+    // The mean of k × k stratified points of texel (x, y), row by row.
     let average = |x: usize, y: usize, k: usize| -> [f64; 3] {
         let mut acc = [0.0f64; 3];
         let at = |i: usize| (i as f64 + 0.5) / (n * k) as f64;
-        let points = k * k;
-        for first in (0..points).step_by(4) {
-            let q = |l: usize| (first + l).min(points - 1);
-            let found =
-                lookup4(std::array::from_fn(|l| at(x * k + q(l) % k)), std::array::from_fn(|l| at(y * k + q(l) / k)));
-            for f in &found[..(points - first).min(4)] {
+        each_point(
+            &lookup4,
+            k * k,
+            |q| (at(x * k + q % k), at(y * k + q / k)),
+            |f| {
                 for c in 0..3 {
                     acc[c] += f[c] as f64;
                 }
-            }
-        }
+            },
+        );
         acc.map(|a| a / (k * k) as f64)
     };
     let mut out = vec![[0.0f32; 3]; n * n];
@@ -170,17 +169,10 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     let band = BAND_ROWS.min(n);
     out.par_chunks_mut(n * band).enumerate().for_each(|(b, rows)| {
         let y0 = b * band;
-        let width = n + 1;
-        let count = (band + 1) * width;
-        let mut corner: Vec<f64> = Vec::with_capacity(count + 3);
-        for first in (0..count).step_by(4) {
-            let q = |l: usize| ((first + l).min(count - 1) % width, y0 + (first + l).min(count - 1) / width);
-            let found = lookup4(
-                std::array::from_fn(|l| q(l).0 as f64 / n as f64),
-                std::array::from_fn(|l| q(l).1 as f64 / n as f64),
-            );
-            corner.extend(found.iter().take(count - first).map(|&t| lum(t)));
-        }
+        let (width, count) = (n + 1, (band + 1) * (n + 1));
+        let mut corner: Vec<f64> = Vec::with_capacity(count);
+        let at = |q: usize| ((q % width) as f64 / n as f64, (y0 + q / width) as f64 / n as f64);
+        each_point(&lookup4, count, at, |t| corner.push(lum(t)));
         for (k, texel) in rows.iter_mut().enumerate() {
             let (x, y) = (k % n, y0 + k / n);
             let mean = average(x, y, ss);
@@ -195,6 +187,22 @@ pub fn latlong_to_equal_area(image: &RgbImage, level: u32, ss: usize) -> Vec<[f3
     });
     splat_excess(image, n, &clamped, &mut out);
     out
+}
+
+/// Calls `visit` with the texel `lookup4` finds at each of the `count` points `at(q)` of the
+/// square, in order, looked up four at a time (the last four padded with the last point).
+#[inline]
+fn each_point(
+    lookup4: &impl Fn([f64; 4], [f64; 4]) -> [[f32; 3]; 4],
+    count: usize,
+    at: impl Fn(usize) -> (f64, f64),
+    mut visit: impl FnMut([f32; 3]),
+) {
+    for first in (0..count).step_by(4) {
+        let points: [(f64, f64); 4] = std::array::from_fn(|l| at((first + l).min(count - 1)));
+        let found = lookup4(points.map(|p| p.0), points.map(|p| p.1));
+        found[..(count - first).min(4)].iter().for_each(|&t| visit(t));
+    }
 }
 
 /// Adds the radiance that `clamped` cut from the source's bright pixels to the equal-area map
