@@ -164,16 +164,21 @@ fn shading_points(c: &mut Criterion) {
     eprintln!("arena: ProductArena<256, 2048> = {} bytes", std::mem::size_of::<ProductArena>());
 }
 
-/// Build + 16 warps per shading point, the two-level product at 8×8, 16×16 and 32×32 cells
-/// beside the quadtree product, on the same points (docs/perf.md, "The two products").
-fn two_level_points(c: &mut Criterion) {
-    let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
+/// The BRDFs the product benchmarks build for: Lambert, GGX α 0.01 / 0.1 / 0.3, car paint.
+fn product_brdfs() -> Vec<(&'static str, Box<dyn Brdf>)> {
+    vec![
         ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
         ("ggx a=0.01", Box::new(RoughConductor::new(0.01, Vec3::ONE))),
         ("ggx a=0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
         ("ggx a=0.3", Box::new(RoughConductor::new(0.3, Vec3::ONE))),
         ("carpaint", Box::new(CarPaint::default())),
-    ];
+    ]
+}
+
+/// Build + 16 warps per shading point, the two-level product at 8×8, 16×16 and 32×32 cells
+/// beside the quadtree product, on the same points (docs/perf.md, "The two products").
+fn two_level_points(c: &mut Criterion) {
+    let brdfs = product_brdfs();
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let mut two: Box<TwoLevelArena> = Box::default();
     let cones: Vec<Vec<Cone>> = [3u32, 4, 5]
@@ -224,13 +229,7 @@ fn two_level_points(c: &mut Criterion) {
 /// products"), 1024² map: what a K per lobe width would cost (docs/perf.md, "Building a product
 /// sampler"; error at equal time against K in docs/tuning.md).
 fn quadtree_k(c: &mut Criterion) {
-    let brdfs: Vec<(&str, Box<dyn Brdf>)> = vec![
-        ("lambert", Box::new(Lambert::new(Vec3::splat(0.5)))),
-        ("ggx a=0.01", Box::new(RoughConductor::new(0.01, Vec3::ONE))),
-        ("ggx a=0.1", Box::new(RoughConductor::new(0.1, Vec3::ONE))),
-        ("ggx a=0.3", Box::new(RoughConductor::new(0.3, Vec3::ONE))),
-        ("carpaint", Box::new(CarPaint::default())),
-    ];
+    let brdfs = product_brdfs();
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
     let points = shading_point_set();
     let map = sunny_map(10);
