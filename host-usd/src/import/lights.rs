@@ -1,8 +1,9 @@
 //! UsdLux lights into the scene, each under its world transform (the up-axis conversion
 //! included): DistantLight, SphereLight (a point with `treatAsPoint`), RectLight, DiskLight,
 //! CylinderLight (its side tessellated into emitting triangles) and meshes with MeshLightAPI.
-//! Spheres (points too), rectangles and disks carry their ShapingAPI cone and focus. A light that emits nothing (zero intensity, colour or size) is a note, as the schema makes
-//! it dark; a value that cannot be a light (not finite, negative) is an error naming the prim.
+//! Spheres (points too), rectangles and disks carry their ShapingAPI cone and focus. A light
+//! that emits nothing (zero intensity, colour or size) is a note, as the schema makes it dark;
+//! a value that cannot be a light (not finite, negative) is an error naming the prim.
 
 use super::Importer;
 use crate::lights::{self, Emission, Emitter, RectTexture, UsdLight};
@@ -64,10 +65,7 @@ impl Importer<'_> {
             _ => return Err(format!("{type_name} is not a light kind read here")),
         };
         let shaping = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read(stage, prim, &m)? } else { None };
-        self.add_light(prim, label, type_name, built, shaping);
-        if let Some(light) = self.scene.lights.last_mut().filter(|l| l.path == label) {
-            light.texture = texture;
-        }
+        self.add_light(prim, label, type_name, built, shaping, texture);
         Ok(())
     }
 
@@ -99,7 +97,7 @@ impl Importer<'_> {
         };
         let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        self.add_light(prim, label, type_name, built, None);
+        self.add_light(prim, label, type_name, built, None, None);
         Ok(())
     }
 
@@ -110,6 +108,7 @@ impl Importer<'_> {
         type_name: &str,
         built: Built,
         shaping: Option<LightShaping>,
+        texture: Option<RectTexture>,
     ) {
         let emitter = match built {
             Ok(e) if dark(&e) => Err("emits nothing (intensity or color 0): not rendered".to_string()),
@@ -122,7 +121,7 @@ impl Importer<'_> {
                 }
                 let path = label.to_string();
                 let prim_type = type_name.into();
-                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture: None });
+                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture });
             }
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }

@@ -189,8 +189,9 @@ fn emitted(emission: &Emission, cos_front: f32, dir: Vec3) -> Option<Vec3> {
     (cos_front > 0.0 || (emission.two_sided && cos_front < 0.0)).then(|| emission.towards(dir))
 }
 
-/// The sample of a point `q` drawn uniformly on an area `area` of normal `normal` emitting
-/// `radiance(dir)` along the direction `dir` from `p`, seen from `p`; `None` where the density is not positive and finite (`q` at `p`, or seen edge-on).
+/// The sample of a point `q` drawn uniformly on an area `area` of normal `normal`, seen from
+/// `p` along the unit `dir` and emitting `radiance(dir)` that way; `None` where the density is
+/// not positive and finite (`q` at `p`, or seen edge-on).
 #[inline]
 fn area_sample(p: Vec3, q: Vec3, normal: Vec3, area: f32, radiance: impl Fn(Vec3) -> Vec3) -> Option<LightSample> {
     let v = q - p;
