@@ -1,7 +1,8 @@
 //! The car paint's BRDF draws four at a time: the points grouped by the lobe they pick, four
 //! directions of one lobe at a time (the coat's or the flakes' visible normals, the base's
-//! cosine warp), then the coat, flake and base terms of BRDF × cos in `Vec4` lanes. Every lane is bit for bit the one-at-a-time draw of `CarPaint::sample_batch`:
-//! the same IEEE operations in the same order, selects where it branches (tests below).
+//! cosine warp), then the coat, flake and base terms of BRDF × cos in `Vec4` lanes. Every lane
+//! is bit for bit the one-at-a-time draw of `CarPaint::sample_batch`: the same IEEE operations
+//! in the same order, selects where it branches (tests below).
 
 use super::BrdfDraw;
 use super::carpaint::CarPaint;
