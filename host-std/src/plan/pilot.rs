@@ -18,9 +18,17 @@
 //! whose sample weights are bounded for the material and lighting compete ([`eligible`]): the
 //! MIS plans always (each sample is weighted against a technique that covers the light), env
 //! sampling where B·cos is bounded (its weight is B·cos × the map's total power), BRDF sampling
-//! where the lighting is (its weight is L × B·cos/p). And each MIS strategy competes with the
-//! rules' split only: the splits differ by less than the pilot can tell apart
-//! ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the others. A plan
+//! where the lighting is (its weight is L × B·cos/p). Each MIS strategy competes with the
+//! rules' split and plain MIS (1:1) only: the splits between differ by less than the pilot
+//! can tell apart ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the
+//! others.
+//!
+//! Nor can a pilot see the rare pixels where a plan fails. Env-only sampling fails where the
+//! bright part of the map is hidden (in a shadow, the sky is lit only by the few samples that
+//! miss the sun), and those few pixels carry most of the image's error: a pilot of a few dozen
+//! pixels rarely holds one, so it finds env sampling better than it is. Env-only sampling
+//! therefore replaces the rules' plan only where it scores [`OVERRIDE_MARGIN`]× better than
+//! every plan with BRDF samples too ([`decide`]; docs/perf.md, "`auto` and its pilot"). A plan
 //! that builds a sampler per shading point (two-level-MIS) competes only where the render's
 //! samples per shading point let it repay its build ([`affordable`]): elsewhere the pilot
 //! is the pilot without it, at no cost.
@@ -103,7 +111,7 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
             peak <= ENV_ONLY_LOBE_PEAK
         }
         Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
-        Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak),
+        Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak) || env_share == 0.5,
         Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
         Strategy::TwoLevelMis { .. } => true,
         Strategy::Product
@@ -232,8 +240,11 @@ fn measure(
 
 /// The rule's plan unless another scores [`OVERRIDE_MARGIN`]× better, or
 /// [`COSTLIER_OVERRIDE_MARGIN`]× where it costs more than the rule's (or the rule's was not
-/// measured or not trusted: then the best); `None` when nothing was scored.
+/// measured or not trusted: then the best); env-only sampling only where it also scores
+/// [`OVERRIDE_MARGIN`]× better than every plan with BRDF samples (see the module's note).
+/// `None` when nothing was scored.
 fn decide(scores: &[Option<f64>], rule: Option<usize>, samples_per_point: usize) -> Option<usize> {
+    let scores = &without_unproven_env(scores);
     let (best, best_score) =
         scores.iter().enumerate().filter_map(|(c, s)| s.map(|s| (c, s))).min_by(|a, b| a.1.total_cmp(&b.1))?;
     match rule.and_then(|r| scores[r].map(|s| (r, s))) {
@@ -244,6 +255,24 @@ fn decide(scores: &[Option<f64>], rule: Option<usize>, samples_per_point: usize)
         }
         None => Some(best),
     }
+}
+
+/// `scores` without env-only sampling's where a plan with BRDF samples scores within
+/// [`OVERRIDE_MARGIN`] of it.
+fn without_unproven_env(scores: &[Option<f64>]) -> Vec<Option<f64>> {
+    let with_brdf_samples = |c: usize| {
+        matches!(PLANS[c].strategy, Strategy::Mis { .. } | Strategy::ProductMis { .. } | Strategy::TwoLevelMis { .. })
+    };
+    let best_with_brdf_samples =
+        scores.iter().enumerate().filter(|&(c, _)| with_brdf_samples(c)).filter_map(|(_, s)| *s).reduce(f64::min);
+    scores
+        .iter()
+        .enumerate()
+        .map(|(c, &s)| match (PLANS[c].strategy, s, best_with_brdf_samples) {
+            (Strategy::Env, Some(e), Some(b)) if e * OVERRIDE_MARGIN >= b => None,
+            _ => s,
+        })
+        .collect()
 }
 
 /// Per candidate of [`PLANS`], relative variance × cost from its pixel pairs (`measured`: the
@@ -344,11 +373,13 @@ mod tests {
     #[test]
     fn the_rules_plan_stands_unless_another_is_measured_better_by_the_margin() {
         // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1, two-level-mis.
-        let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(4.9)];
+        let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(5.2)];
         assert_eq!(decide(&scores, Some(3), 4), Some(0), "5.1 against 4.0: overridden");
+        let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(4.9)];
         assert_eq!(decide(&scores, Some(5), 4), Some(5), "4.9 against 4.0: kept");
         let close = [Some(4.5), None, Some(9.0), Some(5.6), None, None];
         assert_eq!(decide(&close, Some(3), 4), Some(3), "5.6 against 4.5: kept");
+        let clear = [Some(4.0), None, Some(9.0), Some(5.6), None, None];
         // Product-MIS costs more than MIS: it replaces the rule's MIS only when twice as good.
         let product = [None, None, Some(9.0), None, Some(5.0), None];
         assert_eq!(decide(&product, Some(2), 4), Some(2), "5.0 against 9.0, costlier: kept");
@@ -357,8 +388,8 @@ mod tests {
         // MIS costs less than product-MIS: it replaces the rule's product-MIS at the lower margin.
         let cheaper = [None, None, Some(5.0), None, Some(6.5), None];
         assert_eq!(decide(&cheaper, Some(4), 4), Some(2), "5.0 against 6.5, cheaper: overridden");
-        assert_eq!(decide(&close, Some(1), 4), Some(0), "the rule's plan not trusted: the best");
-        assert_eq!(decide(&close, None, 4), Some(0), "no rule: the best");
+        assert_eq!(decide(&clear, Some(1), 4), Some(0), "the rule's plan not trusted: the best");
+        assert_eq!(decide(&clear, None, 4), Some(0), "no rule: the best");
         assert_eq!(decide(&[None; 7], Some(2), 4), None);
         // Two-level-MIS, built per shading point, costs more than MIS at any split: it
         // replaces the rule's MIS only when twice as good.
@@ -366,5 +397,38 @@ mod tests {
         assert_eq!(decide(&two_level, Some(2), 16), Some(2), "5.0 against 9.0, costlier: kept");
         let two_level = [None, None, Some(9.0), None, None, None, Some(4.4)];
         assert_eq!(decide(&two_level, Some(2), 16), Some(6), "4.4 against 9.0, costlier: overridden");
+    }
+
+    #[test]
+    fn env_only_sampling_must_beat_every_plan_with_brdf_samples_by_the_margin() {
+        // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1, two-level-mis.
+        // A diffuse ground under a low sun: env looks 1.2× better than MIS in the pilot, and
+        // MIS 1:1 1.4× better than the rule's MIS 3:1.
+        let ground = [Some(2.1), None, Some(2.5), Some(3.5), Some(5.5), None, None];
+        assert_eq!(decide(&ground, Some(3), 4), Some(2), "MIS 1:1, not env");
+        assert_eq!(without_unproven_env(&ground)[0], None);
+        // Clearly ahead of every plan with BRDF samples, env sampling replaces the rule's plan.
+        let open_sky = [Some(2.1), None, Some(5.0), Some(3.5), Some(5.5), None, None];
+        assert_eq!(decide(&open_sky, Some(3), 4), Some(0));
+        // A product-MIS plan within the margin also holds env sampling back.
+        let glossy = [Some(2.1), None, Some(5.0), Some(3.5), Some(2.4), None, None];
+        assert_eq!(decide(&glossy, Some(3), 4), Some(3), "env held back; product-MIS costlier, not 2× better");
+        // Without any plan with BRDF samples scored, env sampling stands on its own score.
+        let alone = [Some(2.1), Some(9.0), None, None, None, None, None];
+        assert_eq!(decide(&alone, Some(1), 4), Some(0));
+    }
+
+    #[test]
+    fn plain_mis_competes_beside_the_rules_split() {
+        use sampler_core::brdf::{Lambert, RoughConductor};
+        use sampler_core::glam::Vec3;
+        let mis = |share: f64| PLANS.iter().position(|p| p.strategy == Strategy::Mis { env_share: share }).unwrap();
+        let diffuse = Bsdf::Diffuse(Lambert::new(Vec3::ONE));
+        // Extended light: the rules lean on env samples, and plain MIS competes too.
+        assert!(eligible(mis(0.75), &diffuse, 21.0) && eligible(mis(0.5), &diffuse, 21.0));
+        // Under a sun, and on glossy lobes, the rules' split is plain MIS.
+        assert!(!eligible(mis(0.75), &diffuse, 713.0) && eligible(mis(0.5), &diffuse, 713.0));
+        let glossy = Bsdf::Conductor(RoughConductor::new(0.01, Vec3::ONE));
+        assert!(!eligible(mis(0.75), &glossy, 21.0) && eligible(mis(0.5), &glossy, 21.0));
     }
 }
