@@ -1,8 +1,9 @@
 //! What a light tree's pick and pmf cost as the number of lights grows (docs/perf.md, "Many
 //! lights"): N small one-sided triangles with random normals scattered over a 10 × 2 × 10 slab
-//! above a floor, shading points on the floor; per N, the tree's size, the mean depth of a pick
-//! and the CPU time of one pick plus the pmf of the light picked (what a shading point spends on
-//! light selection with MIS). Logarithmic growth shows as a constant cost per level.
+//! above a floor, shading points on the floor; per N, the tree's size, the CPU time of its build
+//! per light, the mean depth of a pick and the CPU time of one pick plus the pmf of the light
+//! picked (what a shading point spends on light selection with MIS). Logarithmic growth shows as
+//! a constant cost per level.
 //!
 //! `cargo run --release -p sampler-core --example light_tree_cost [-- N...]`
 use glam::{Vec2, Vec3};
@@ -29,8 +30,10 @@ fn lights(n: usize, rng: &mut Pcg32) -> Vec<SceneLight> {
 fn main() {
     let sizes: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let sizes = if sizes.is_empty() { vec![10, 100, 1_000, 10_000, 100_000, 1_000_000] } else { sizes };
-    println!("| lights | nodes | bytes per node | mean depth | ns per pick + pmf | ns per level |");
-    println!("|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| lights | nodes | bytes per node | build, ns per light | mean depth | ns per pick + pmf | ns per level |"
+    );
+    println!("|---:|---:|---:|---:|---:|---:|---:|");
     for n in sizes {
         let mut rng = Pcg32::new(n as u64, 7);
         let lights = lights(n, &mut rng);
@@ -38,7 +41,9 @@ fn main() {
         let mut order = vec![0u32; n];
         let mut nodes = vec![LightNode { bounds: bounds[0].unwrap(), index: 0, leaf: true }; 2 * n];
         let mut paths = vec![0u64; n];
+        let start = cpu_seconds();
         let tree = LightTree::build(&bounds, &mut order, &mut nodes, &mut paths).unwrap();
+        let build_ns = (cpu_seconds() - start) * 1e9 / n as f64;
         let queries: Vec<(Vec3, f64)> = (0..QUERIES)
             .map(|_| (Vec3::new(12.0 * rng.next_f32() - 6.0, 0.0, 12.0 * rng.next_f32() - 6.0), rng.next_f64()))
             .collect();
@@ -55,7 +60,7 @@ fn main() {
         let mean_depth = picked.map(|s| depths[s.index] as f64).sum::<f64>() / QUERIES as f64;
         let ns = seconds * 1e9 / QUERIES as f64;
         println!(
-            "| {n} | {} | {} | {mean_depth:.1} | {ns:.0} | {:.1} |",
+            "| {n} | {} | {} | {build_ns:.0} | {mean_depth:.1} | {ns:.0} | {:.1} |",
             tree.nodes().len(),
             size_of::<LightNode>(),
             ns / mean_depth.max(1.0)
