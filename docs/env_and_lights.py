@@ -15,7 +15,14 @@ light, so those variants are measured against their own). Then one `ppis report`
   with an angle);
 - `share-S`: mis and product-mis at 16 visibility samples per shading point with
   `--light-share S` for S in --shares (default ¼, ½, ¾; at the default four per point the split is
-  one light pair and one environment pair whatever the share).
+  one light pair and one environment pair whatever the share; `none` for no such variant);
+- `points-V`: mis, product-mis and auto at V visibility samples per shading point
+  (`--samples-per-point V`) and the default share, for V in --per-point (default none).
+
+  python3 docs/env_and_lights.py --out DIR --shares none --per-point 8,16,32 --cone-methods mis,product-mis,auto SCENE.json
+
+measures the budget per shading point alone (`--cone-methods`: the methods of `cone`, which is
+every variant's base; default all five).
 
 Every variant's relMSE per region is interpolated log-log at t, the CPU time of `cone`'s MIS at
 1024 spp (* marks a value extrapolated past a variant's measured times), and printed as one
@@ -36,13 +43,15 @@ def has_sun(scene):
     return any(l['type'] == 'distant' and l.get('angle_deg', 0) > 0 for l in lights)
 
 
-def variants(has_distant, shares):
+def variants(has_distant, shares, per_point, cone_methods):
     """(name, methods, extra flags, uses the map reference)."""
-    out = [('cone', 'mis,product-mis,auto,sis,lightcuts', [], False)]
+    out = [('cone', cone_methods, [], False)]
     if has_distant:
         out.append(('map', 'mis,product-mis,auto', ['--distant-in-env'], True))
     for s in shares:
         out.append(('share-' + s, 'mis,product-mis', ['--samples-per-point', '16', '--light-share', s], False))
+    for v in per_point:
+        out.append(('points-' + v, 'mis,product-mis,auto', ['--samples-per-point', v], False))
     return out
 
 
@@ -83,8 +92,11 @@ def main():
     ap.add_argument('--out', required=True)
     ap.add_argument('--size', default='128')
     ap.add_argument('--ppis', default='target/release/ppis')
-    ap.add_argument('--shares', default='0.25,0.5,0.75', help='the lights\' shares at V = 16')
+    ap.add_argument('--shares', default='0.25,0.5,0.75', help='the lights\' shares at V = 16, or none')
+    ap.add_argument('--per-point', default='none', help='visibility samples per shading point to compare, or none')
+    ap.add_argument('--cone-methods', default='mis,product-mis,auto,sis,lightcuts')
     a = ap.parse_args()
+    listed = lambda v: [] if v == 'none' else v.split(',')
     os.makedirs(a.out, exist_ok=True)
     size = ['--width', a.size, '--height', a.size]
     sun = has_sun(a.scene)
@@ -95,7 +107,7 @@ def main():
         run([a.ppis, 'render', a.scene, '--method', 'mis', '--spp', '8192', '--shading-points', '1024',
              '--seed', '777', '-o', path] + size + (['--distant-in-env'] if in_map else []))
     curves = {}
-    for name, methods, flags, in_map in variants(sun, a.shares.split(',')):
+    for name, methods, flags, in_map in variants(sun, listed(a.shares), listed(a.per_point), a.cone_methods):
         folder = os.path.join(a.out, name)
         table = os.path.join(folder, 'error_vs_time.csv')
         if not os.path.exists(table):
