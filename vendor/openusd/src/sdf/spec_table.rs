@@ -3,9 +3,9 @@
 //!
 //! A simple prim has several property specs. Keyed by their own paths, each needs a path
 //! node and a table slot for the layer's life; keyed by their owner's path and their name,
-//! they live in the owner's entry, and the name is a token the parser shares between every
-//! prim that authors it. A property whose path does not take apart into a structured owner
-//! and name ([`Path::as_property`]) keeps an entry of its own.
+//! they live in the owner's entry, named by an index into the layer's distinct names (the
+//! record's 4 bytes, not a 24-byte token beside it). A property whose path does not take
+//! apart into a structured owner and name ([`Path::as_property`]) keeps an entry of its own.
 
 use std::collections::HashMap;
 
