@@ -11,7 +11,7 @@ use std::{
 use anyhow::Result;
 
 use crate::sdf::spec_table::SpecTable;
-use crate::sdf::{FieldTable, Path, PathMap, SpecData, SpecType, Value};
+use crate::sdf::{FieldTable, Fields, Path, PathMap, SpecData, SpecType, Value};
 use crate::tf;
 
 /// The scene-description storage interface, mirroring C++ `SdfAbstractData`.
@@ -182,7 +182,9 @@ impl Data {
     /// the trait can't name `SpecData`.
     pub fn create_spec(&mut self, path: Path, ty: SpecType) -> &mut SpecData {
         let slot = self.specs.get_or_insert_with(&path, || SpecData::new(ty));
-        *slot = SpecData::new(ty);
+        // Field by field: the record keeps the name its table gave it (`SpecData::name`).
+        slot.ty = ty;
+        slot.fields = Fields::default();
         slot
     }
 
@@ -227,7 +229,9 @@ impl Data {
 
     /// Mutably borrow the spec record at `path`. The way to reach a
     /// `&mut SpecData` for in-place field edits, since the [`AbstractData`]
-    /// interface is field-level.
+    /// interface is field-level. Edit its `ty` and `fields`; to replace the whole record
+    /// use [`insert_spec`](Self::insert_spec), which keeps the name a property's record
+    /// holds for its table.
     pub fn spec_mut(&mut self, path: &Path) -> Option<&mut SpecData> {
         self.specs.get_mut(path)
     }

@@ -97,7 +97,14 @@ pub struct SpecData {
     pub ty: sdf::SpecType,
     /// The fields stored on this spec, in authored order, kept compact (see [`Fields`]).
     pub fields: Fields,
+    /// ppis patch: a property spec's name, as the index its layer's table
+    /// (`sdf::spec_table`) gives the name; unused elsewhere. Held in what is otherwise the
+    /// record's padding, so a property spec in its prim's entry is 24 bytes, not 24 and a
+    /// 24-byte name token (see PATCHED.md, "Property specs as a name index").
+    pub(crate) name: u32,
 }
+
+const _: () = assert!(std::mem::size_of::<SpecData>() == 24);
 
 /// Errors raised by typed spec-level authoring helpers.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -119,6 +126,7 @@ impl SpecData {
         Self {
             ty,
             fields: Fields::default(),
+            name: 0,
         }
     }
 

@@ -3,9 +3,9 @@
 //!
 //! A simple prim has several property specs. Keyed by their own paths, each needs a path
 //! node and a table slot for the layer's life; keyed by their owner's path and their name,
-//! they live in the owner's entry, and the name is a token the parser shares between every
-//! prim that authors it. A property whose path does not take apart into a structured owner
-//! and name ([`Path::as_property`]) keeps an entry of its own.
+//! they live in the owner's entry, named by an index into the layer's distinct names (the
+//! record's 4 bytes, not a 24-byte token beside it). A property whose path does not take
+//! apart into a structured owner and name ([`Path::as_property`]) keeps an entry of its own.
 
 use std::collections::HashMap;
 
@@ -16,8 +16,9 @@ use crate::tf;
 #[derive(Debug, Default, Clone)]
 struct Entry {
     spec: Option<SpecData>,
-    /// In the order they were added, names unique.
-    properties: Vec<(tf::Token, SpecData)>,
+    /// In the order they were added, names unique; each names itself by its
+    /// [`SpecData::name`], an index into the table's [`Names`].
+    properties: Vec<SpecData>,
     /// Each property's slot by name, once there are more than [`SCAN_LIMIT`]: a scan (or a
     /// sorted insertion) per property made a prim of `n` properties cost `n²`.
     index: Option<Box<HashMap<tf::Token, u32>>>,
@@ -28,18 +29,18 @@ const SCAN_LIMIT: usize = 16;
 
 impl Entry {
     /// The slot of `name` among the properties.
-    fn find(&self, name: &str) -> Option<usize> {
+    fn find(&self, names: &Names, name: &str) -> Option<usize> {
         match &self.index {
             Some(index) => index.get(name).map(|&at| at as usize),
-            None => self.properties.iter().position(|(token, _)| token.as_str() == name),
+            None => self.properties.iter().position(|spec| names.text(spec.name).as_str() == name),
         }
     }
 
-    /// Appends a property not yet here, returning its slot.
-    fn push(&mut self, name: tf::Token, spec: SpecData) -> usize {
+    /// Appends a property not yet here (named by its `name`), returning its slot.
+    fn push(&mut self, names: &Names, spec: SpecData) -> usize {
         let at = self.properties.len();
         if let Some(index) = &mut self.index {
-            index.insert(name.clone(), slot(at));
+            index.insert(names.text(spec.name).clone(), slot(at));
         }
         // A prim's few properties are held for the layer's life in a list of exactly their
         // number. Shrinking a doubled list once the layer is parsed (`shrink_to_fit`) leaves
@@ -49,21 +50,21 @@ impl Entry {
         if self.properties.len() < SCAN_LIMIT {
             self.properties.reserve_exact(1);
         }
-        self.properties.push((name, spec));
+        self.properties.push(spec);
         if self.index.is_none() && self.properties.len() > SCAN_LIMIT {
-            let index = self.properties.iter().enumerate().map(|(at, (name, _))| (name.clone(), slot(at)));
+            let index = self.properties.iter().enumerate().map(|(at, spec)| (names.text(spec.name).clone(), slot(at)));
             self.index = Some(Box::new(index.collect()));
         }
         at
     }
 
     /// Removes the property at slot `at`; the last property takes its slot.
-    fn remove(&mut self, at: usize) -> SpecData {
-        let (name, spec) = self.properties.swap_remove(at);
+    fn remove(&mut self, names: &Names, at: usize) -> SpecData {
+        let spec = self.properties.swap_remove(at);
         if let Some(index) = &mut self.index {
-            index.remove(name.as_str());
-            if let Some((moved, _)) = self.properties.get(at) {
-                index.insert(moved.clone(), slot(at));
+            index.remove(names.text(spec.name).as_str());
+            if let Some(moved) = self.properties.get(at) {
+                index.insert(names.text(moved.name).clone(), slot(at));
             }
         }
         spec
@@ -71,6 +72,34 @@ impl Entry {
 
     fn is_empty(&self) -> bool {
         self.spec.is_none() && self.properties.is_empty()
+    }
+}
+
+/// The distinct property names of a layer, each by an index: a property spec holds the
+/// index (4 bytes) instead of a token (24). A layer's many prims author a few names, so
+/// the table is small; a name stays once no spec holds it.
+#[derive(Debug, Default, Clone)]
+struct Names {
+    texts: Vec<tf::Token>,
+    ids: HashMap<tf::Token, u32>,
+}
+
+impl Names {
+    /// The index of `name`, added if new.
+    fn id(&mut self, name: &str, token: impl FnOnce() -> tf::Token) -> u32 {
+        if let Some(&id) = self.ids.get(name) {
+            return id;
+        }
+        let id = u32::try_from(self.texts.len()).expect("fewer than 2^32 property names");
+        let token = token();
+        self.texts.push(token.clone());
+        self.ids.insert(token, id);
+        id
+    }
+
+    /// The name of index `id`.
+    fn text(&self, id: u32) -> &tf::Token {
+        &self.texts[id as usize]
     }
 }
 
@@ -84,6 +113,7 @@ fn slot(at: usize) -> u32 {
 #[derive(Debug, Default, Clone)]
 pub(crate) struct SpecTable {
     entries: PathMap<Entry>,
+    names: Names,
     len: usize,
 }
 
@@ -105,7 +135,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get(key)?;
         match name {
-            Some(name) => entry.find(name).map(|at| &entry.properties[at].1),
+            Some(name) => entry.find(&self.names, name).map(|at| &entry.properties[at]),
             None => entry.spec.as_ref(),
         }
     }
@@ -114,7 +144,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         match name {
-            Some(name) => entry.find(name).map(|at| &mut entry.properties[at].1),
+            Some(name) => entry.find(&self.names, name).map(|at| &mut entry.properties[at]),
             None => entry.spec.as_mut(),
         }
     }
@@ -162,28 +192,33 @@ impl SpecTable {
         make: impl FnOnce() -> SpecData,
     ) -> &mut SpecData {
         let entry = self.entries.entry(owner.clone()).or_default();
-        let at = match entry.find(name) {
+        let at = match entry.find(&self.names, name) {
             Some(at) => at,
             None => {
                 self.len += 1;
-                entry.push(token(), make())
+                let mut spec = make();
+                spec.name = self.names.id(name, token);
+                entry.push(&self.names, spec)
             }
         };
-        &mut entry.properties[at].1
+        &mut entry.properties[at]
     }
 
     /// Puts `spec` at `path`, returning the spec it replaces.
     pub(crate) fn insert(&mut self, path: Path, spec: SpecData) -> Option<SpecData> {
         let mut spec = Some(spec);
         let slot = self.get_or_insert_with(&path, || spec.take().expect("made once"));
-        spec.map(|new| std::mem::replace(slot, new))
+        spec.map(|mut new| {
+            new.name = slot.name;
+            std::mem::replace(slot, new)
+        })
     }
 
     pub(crate) fn remove(&mut self, path: &Path) -> Option<SpecData> {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         let removed = match name {
-            Some(name) => entry.find(name).map(|at| entry.remove(at)),
+            Some(name) => entry.find(&self.names, name).map(|at| entry.remove(&self.names, at)),
             None => entry.spec.take(),
         };
         if entry.is_empty() {
@@ -198,15 +233,17 @@ impl SpecTable {
     /// (see [`FieldTable`]).
     pub(crate) fn share_fields(&mut self, path: &Path, table: &mut FieldTable) {
         let Some(entry) = self.entries.get_mut(path) else { return };
-        for spec in entry.spec.iter_mut().chain(entry.properties.iter_mut().map(|(_, spec)| spec)) {
+        for spec in entry.spec.iter_mut().chain(entry.properties.iter_mut()) {
             table.share(&mut spec.fields);
         }
     }
 
     pub(crate) fn iter(&self) -> impl Iterator<Item = (Path, &SpecData)> {
-        self.entries.iter().flat_map(|(path, entry)| {
+        let names = &self.names;
+        self.entries.iter().flat_map(move |(path, entry)| {
             let own = entry.spec.as_ref().map(|spec| (path.clone(), spec));
-            let properties = entry.properties.iter().map(move |(name, spec)| {
+            let properties = entry.properties.iter().map(move |spec| {
+                let name = names.text(spec.name);
                 let property = path.append_property(name).expect("a structured owner takes its property");
                 (property, spec)
             });
@@ -297,6 +334,22 @@ mod tests {
         }
         let again = table.property_or_insert_with(&owner, &tf::Token::from("p1"), || spec(SpecType::Attribute));
         assert_eq!(again.unwrap().ty, SpecType::Relationship);
+    }
+
+    /// A property made anew or replaced keeps its name, which its record holds for the table.
+    #[test]
+    fn replaced_properties_keep_their_names() {
+        let mut data = crate::sdf::Data::default();
+        let (a, b) = (path("/P.a").unwrap(), path("/P.b").unwrap());
+        data.create_spec(a.clone(), SpecType::Attribute);
+        data.create_spec(b.clone(), SpecType::Attribute).add("default", 1.0);
+        data.create_spec(b.clone(), SpecType::Relationship);
+        data.insert_spec(a.clone(), SpecData::new(SpecType::Relationship));
+        assert_eq!(data.spec(&a).map(|s| s.ty), Some(SpecType::Relationship));
+        assert!(data.spec(&b).is_some_and(|s| s.ty == SpecType::Relationship && s.fields.is_empty()));
+        let mut all: Vec<String> = data.iter().map(|(p, _)| p.to_string()).collect();
+        all.sort();
+        assert_eq!(all, ["/P.a", "/P.b"]);
     }
 
     /// Inserting at a path that holds a spec replaces it; merging through the accessor keeps it.

@@ -4,9 +4,11 @@ use std::{borrow::Cow, cell::RefCell, fmt::Debug, io, mem, path::Path};
 
 use anyhow::{Context, Result};
 use layout::ValueRep;
+use overlay::Overlay;
 
 mod coding;
 mod layout;
+mod overlay;
 mod reader;
 mod writer;
 
@@ -23,62 +25,30 @@ pub const MAGIC: &[u8] = b"PXR-USDC";
 /// deduplicated and shared across specs, so a spec read from the file keeps only
 /// the start of its fieldset; the fields are resolved on demand from the compact
 /// [`CrateFile`] arrays rather than expanded into a per-spec list. Fields
-/// authored after load are layered in a small overlay, leaving the backend both
-/// lazy and writable (C++ `Usd_CrateData` likewise keeps each field as either a
-/// `ValueRep` into the crate or an in-memory `VtValue`).
-#[derive(Debug)]
+/// authored after load are layered over them by [`Overlay`], keyed by the spec's
+/// path, leaving the backend both lazy and writable (C++ `Usd_CrateData` likewise
+/// keeps each field as either a `ValueRep` into the crate or an in-memory `VtValue`).
+/// ppis patch: 8 bytes (the layer's table holds one per spec of the file for its
+/// life, several per simple prim; see PATCHED.md).
+#[derive(Debug, Clone, Copy)]
 struct Spec {
     /// Specifies the type of an object.
     ty: sdf::SpecType,
     /// Start index into the file's `fieldsets` for the fields read from the
     /// crate, or [`NO_FIELDSET`] for a spec created in memory.
     fieldset: u32,
-    /// Fields authored after load, layered over the crate fields in authored
-    /// order. `Some` sets or overrides a field; `None` tombstones one so it
-    /// reads as absent even when the crate holds it. Boxed, and absent until a
-    /// field is authored (ppis patch: a spec is 16 bytes instead of 48, and the
-    /// layer's table holds one per spec of the file; see PATCHED.md).
-    authored: Option<Box<Vec<(String, Option<sdf::Value>)>>>,
 }
 
 /// [`Spec::fieldset`] of a spec created in memory.
 const NO_FIELDSET: u32 = u32::MAX;
 
-const _: () = assert!(mem::size_of::<Spec>() == 16);
+const _: () = assert!(mem::size_of::<Spec>() == 8);
+const _: () = assert!(mem::size_of::<(u32, Spec)>() == 12);
 
 impl Spec {
     /// Start index into the file's `fieldsets`, or `None` for a spec created in memory.
     fn fieldset(&self) -> Option<usize> {
         (self.fieldset != NO_FIELDSET).then_some(self.fieldset as usize)
-    }
-
-    /// The fields authored after load.
-    fn authored_fields(&self) -> &[(String, Option<sdf::Value>)] {
-        self.authored.as_deref().map_or(&[], Vec::as_slice)
-    }
-
-    /// Returns the authored override for `field`: `Some(&Some(value))` when set,
-    /// `Some(&None)` when tombstoned, `None` when the crate fields alone decide.
-    fn authored(&self, field: &str) -> Option<&Option<sdf::Value>> {
-        self.authored_fields().iter().find(|(k, _)| k == field).map(|(_, v)| v)
-    }
-
-    /// Sets the authored override for `field`, replacing any prior one.
-    fn set_authored(&mut self, field: &str, value: Option<sdf::Value>) {
-        let authored = self.authored.get_or_insert_with(Box::default);
-        if let Some(slot) = authored.iter_mut().find(|(k, _)| k == field) {
-            slot.1 = value;
-        } else {
-            authored.push((field.to_owned(), value));
-        }
-    }
-
-    /// Drops any authored override for `field`, restoring authored order so a
-    /// later set re-appends rather than reusing the old slot.
-    fn remove_authored(&mut self, field: &str) {
-        if let Some(authored) = &mut self.authored {
-            authored.retain(|(k, _)| k != field);
-        }
     }
 }
 
@@ -106,6 +76,8 @@ pub struct CrateData<R> {
     /// Keyed by prim (and other non-property) paths; a property spec lives in its
     /// owner's entry (see [`Entry`]).
     data: sdf::PathMap<Entry>,
+    /// Fields authored after load.
+    authored: Overlay,
 }
 
 impl<R> CrateData<R>
@@ -138,7 +110,6 @@ where
             let new = Spec {
                 ty: spec.spec_type,
                 fieldset,
-                authored: None,
             };
             match file.paths[spec.path_index].name {
                 reader::NO_PROPERTY => entry.spec = Some(new),
@@ -152,6 +123,7 @@ where
         Ok(Self {
             file: RefCell::new(file),
             data,
+            authored: Overlay::default(),
         })
     }
 }
@@ -179,18 +151,6 @@ impl<R> CrateData<R> {
             None => self.data.get(path)?.spec.as_ref(),
         }
     }
-
-    /// The spec at `path`, to author its fields.
-    fn spec_mut(&mut self, path: &sdf::Path) -> Option<&mut Spec> {
-        match path.as_property() {
-            Some((owner, name)) => {
-                let entry = self.data.get_mut(owner)?;
-                let at = entry.find(&self.file.get_mut().tokens, name).ok()?;
-                Some(&mut entry.properties[at].1)
-            }
-            None => self.data.get_mut(path)?.spec.as_mut(),
-        }
-    }
 }
 
 impl<R> sdf::AbstractData for CrateData<R>
@@ -206,7 +166,7 @@ where
         let Some(spec) = self.spec(path) else {
             return false;
         };
-        if let Some(authored) = spec.authored(field) {
+        if let Some(authored) = self.authored.get(path, field) {
             return authored.is_some();
         }
         match spec.fieldset() {
@@ -224,7 +184,7 @@ where
         let Some(spec) = self.spec(path) else {
             return Ok(None);
         };
-        if let Some(authored) = spec.authored(field) {
+        if let Some(authored) = self.authored.get(path, field) {
             return Ok(authored.as_ref().map(Cow::Borrowed));
         }
         let Some(start) = spec.fieldset() else {
@@ -253,12 +213,12 @@ where
             for (name, _) in crate_fields(&self.file.borrow(), start) {
                 // A tombstoned crate field is skipped; an overridden one keeps
                 // its crate position and is not duplicated by the overlay pass.
-                if !matches!(spec.authored(name), Some(None)) {
+                if !matches!(self.authored.get(path, name), Some(None)) {
                     names.push(name.to_owned());
                 }
             }
         }
-        for (field, value) in spec.authored_fields() {
+        for (field, value) in self.authored.fields(path) {
             if value.is_some() && !names.iter().any(|n| n == field) {
                 names.push(field.clone());
             }
@@ -284,8 +244,8 @@ where
         let new = Spec {
             ty,
             fieldset: NO_FIELDSET,
-            authored: None,
         };
+        self.authored.clear(&path);
         let Some((owner, name)) = path.as_property() else {
             self.data.entry(path).or_default().spec = Some(new);
             return;
@@ -303,6 +263,7 @@ where
     }
 
     fn erase_spec(&mut self, path: &sdf::Path) {
+        self.authored.clear(path);
         let (key, name) = match path.as_property() {
             Some((owner, name)) => (owner, Some(name)),
             None => (path, None),
@@ -324,8 +285,8 @@ where
     }
 
     fn set_field(&mut self, path: &sdf::Path, field: &str, value: sdf::Value) {
-        match self.spec_mut(path) {
-            Some(spec) => spec.set_authored(field, Some(value)),
+        match self.spec(path) {
+            Some(_) => self.authored.set(path, field, Some(value)),
             None => debug_assert!(false, "set_field on absent spec at {path}"),
         }
     }
@@ -339,13 +300,10 @@ where
         // idempotent and lets a later set re-append in authored order.
         let masks_crate =
             fieldset.is_some_and(|start| crate_fields(&self.file.borrow(), start).any(|(name, _)| name == field));
-        let Some(spec) = self.spec_mut(path) else {
-            return;
-        };
         if masks_crate {
-            spec.set_authored(field, None);
+            self.authored.set(path, field, None);
         } else {
-            spec.remove_authored(field);
+            self.authored.remove(path, field);
         }
     }
 }
@@ -358,7 +316,7 @@ fn crate_fields<R>(file: &CrateFile<R>, start: usize) -> impl Iterator<Item = (&
         .get(start..)
         .unwrap_or(&[])
         .iter()
-        .map_while(|slot| *slot)
+        .map_while(|&slot| (slot != reader::END_OF_FIELDSET).then_some(slot as usize))
         .map(move |index| {
             let field = &file.fields[index];
             (field_name(file, field.token_index), field.value_rep)
@@ -469,6 +427,48 @@ mod tests {
         data.erase_spec(&p("/A"));
         assert!(!data.has_spec(&p("/A")) && data.has_spec(&p("/A.w")));
         assert_eq!(all(&data), ["/", "/A.primvars:y", "/A.w", "/A.z", "/A/B"]);
+        Ok(())
+    }
+
+    /// Fields authored after load lie over the file's: a set overrides, an erase of a file
+    /// field hides it, re-authoring appends, and making or erasing a spec drops its
+    /// overlay.
+    #[test]
+    fn fields_authored_after_load() -> Result<()> {
+        let p = |text: &str| sdf::path(text).unwrap();
+        let mut layer = sdf::Data::default();
+        layer.create_spec(p("/"), sdf::SpecType::PseudoRoot);
+        layer.create_spec(p("/A"), sdf::SpecType::Prim).add("kind", sdf::Value::Token("group".into()));
+        layer.create_spec(p("/A.x"), sdf::SpecType::Attribute).add("default", 1.0);
+        let mut bytes = io::Cursor::new(Vec::new());
+        CrateWriter::write(&layer, &mut bytes)?;
+        bytes.set_position(0);
+        let mut data = CrateData::open(bytes, true)?;
+        let x = p("/A.x");
+        let field = |data: &CrateData<_>, path: &sdf::Path, name: &str| data.get_field(path, name).ok().map(|v| v.into_owned());
+
+        data.set_field(&x, "default", sdf::Value::Double(2.0));
+        data.set_field(&x, "custom", sdf::Value::Bool(true));
+        assert_eq!(field(&data, &x, "default"), Some(sdf::Value::Double(2.0)));
+        assert_eq!(data.list_fields(&x).unwrap(), ["default", "custom"]);
+        assert_eq!(field(&data, &p("/A"), "kind"), Some(sdf::Value::Token("group".into())));
+
+        data.erase_field(&x, "default");
+        assert!(!data.has_field(&x, "default") && data.try_field(&x, "default")?.is_none());
+        data.erase_field(&x, "custom");
+        data.erase_field(&x, "custom");
+        assert!(data.list_fields(&x).unwrap().is_empty());
+        data.set_field(&x, "custom", sdf::Value::Bool(false));
+        data.set_field(&x, "default", sdf::Value::Double(3.0));
+        assert_eq!(data.list_fields(&x).unwrap(), ["default", "custom"]);
+
+        // A spec made anew at the path, or erased, takes its overlay with it.
+        data.create_spec(x.clone(), sdf::SpecType::Attribute);
+        assert!(data.list_fields(&x).unwrap().is_empty() && data.try_field(&x, "custom")?.is_none());
+        data.set_field(&p("/A"), "kind", sdf::Value::Token("component".into()));
+        data.erase_spec(&p("/A"));
+        data.create_spec(p("/A"), sdf::SpecType::Prim);
+        assert!(data.list_fields(&p("/A")).unwrap().is_empty());
         Ok(())
     }
 

@@ -43,8 +43,10 @@ pub struct CrateFile<R> {
     pub strings: Vec<usize>,
     /// All unique fields.
     pub fields: Vec<Field>,
-    /// A vector of groups of fields, invalid-index terminated.
-    pub fieldsets: Vec<Option<usize>>,
+    /// A vector of groups of fields, each ended by [`END_OF_FIELDSET`] (ppis patch: a
+    /// 4-byte slot, as the file stores it, instead of a 16-byte `Option<usize>`; a
+    /// layer holds several per prim for its life).
+    pub fieldsets: Vec<u32>,
     /// ppis patch: every unique path of the PATHS section, by its index there, as a node
     /// of [`nodes`](Self::nodes) and, for a prim's property, the token of its name. A
     /// property's path node is made only when a value names it ([`path`](Self::path)): the
@@ -65,6 +67,9 @@ pub struct CrateFile<R> {
 /// recursion on the caller's stack, one frame per level of file-controlled data; deeper
 /// nesting than this is refused as corrupt instead of overflowing the stack.
 pub const MAX_VALUE_DEPTH: usize = 128;
+
+/// The slot of [`CrateFile::fieldsets`] that ends a fieldset (Pixar's invalid field index).
+pub const END_OF_FIELDSET: u32 = u32::MAX;
 
 /// [`PathSlot::name`] of a path that is not a prim's property.
 pub const NO_PROPERTY: u32 = u32::MAX;
@@ -148,10 +153,10 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         self.fieldsets
             .iter()
             .enumerate()
-            .filter_map(|(i, index)| index.map(|index| (i, index)))
-            .try_for_each(|(index, fieldset)| {
+            .filter(|(_, &slot)| slot != END_OF_FIELDSET)
+            .try_for_each(|(index, &fieldset)| {
                 self.fields
-                    .get(fieldset)
+                    .get(fieldset as usize)
                     .with_context(|| format!("Invalid fieldset index {index}: {fieldset}"))?;
 
                 anyhow::Ok(())
@@ -172,7 +177,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
             if spec.fieldset_index > 0 {
                 ensure!(
-                    self.fieldsets[spec.fieldset_index - 1].is_none(),
+                    self.fieldsets[spec.fieldset_index - 1] == END_OF_FIELDSET,
                     "Invalid spec {}, the element at the prior index {} must be a default-constructed field index",
                     index,
                     spec.fieldset_index
@@ -344,16 +349,9 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
             let decoded = self.read_encoded_ints::<u32>(count)?;
 
-            const INVALID_INDEX: u32 = u32::MAX;
+            debug_assert_eq!(decoded.len(), count);
 
-            let sets = decoded
-                .into_iter()
-                .map(|i| if i == INVALID_INDEX { None } else { Some(i as usize) })
-                .collect::<Vec<_>>();
-
-            debug_assert_eq!(sets.len(), count);
-
-            sets
+            decoded
         };
 
         Ok(())
