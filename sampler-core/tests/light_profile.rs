@@ -93,7 +93,11 @@ fn normalize_divides_by_the_mean_intensity_of_the_profile() {
     let ratio = raw.factor(d).x / normalized.factor(d).x;
     // The table spans 135°, more than a hemisphere: its flux over 4π.
     let flux = quadrature(|d| f64::from(raw.factor(d).x), 800);
-    assert!((f64::from(ratio) - flux / (4.0 * PI)).abs() < 2e-3 * ratio as f64, "{ratio} against {}", flux / (4.0 * PI));
+    assert!(
+        (f64::from(ratio) - flux / (4.0 * PI)).abs() < 2e-3 * ratio as f64,
+        "{ratio} against {}",
+        flux / (4.0 * PI)
+    );
     // Normalised, the profile's flux is the unshaped light's: 4π.
     assert!((quadrature(|d| f64::from(normalized.factor(d).x), 800) - 4.0 * PI).abs() < 5e-3);
 }
@@ -179,7 +183,13 @@ fn profiled_area_lights_estimate_what_quadrature_sees() {
             Vec3::new(0.0, 0.0, 2.0),
             0.5,
         ),
-        ("rectangle", rect.with_shaping(shaping(rect.normal(), 0.0)).into(), Vec3::new(0.8, 0.3, 0.0), Vec3::new(0.0, 0.0, 1.5), 1.2),
+        (
+            "rectangle",
+            rect.with_shaping(shaping(rect.normal(), 0.0)).into(),
+            Vec3::new(0.8, 0.3, 0.0),
+            Vec3::new(0.0, 0.0, 1.5),
+            1.2,
+        ),
         (
             "disk",
             DiskLight::new(Vec3::new(0.0, 0.0, 1.0), Vec3::NEG_Z, 0.8, Vec3::splat(3.0))

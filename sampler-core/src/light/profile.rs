@@ -74,7 +74,10 @@ impl<'a> IntensityProfile<'a> {
     /// ones one of the ranges of [`HorizontalSymmetry`]).
     pub fn new(vertical: &'a [f32], horizontal: &'a [f32], intensity: &'a [f32]) -> Result<Self, ProfileError> {
         let increasing = |a: &[f32]| a.windows(2).all(|w| w[1] > w[0]) && a.iter().all(|x| x.is_finite());
-        if vertical.len() < 2 || !increasing(vertical) || vertical[0] < -ANGLE_EPS || vertical[vertical.len() - 1] > PI + ANGLE_EPS
+        if vertical.len() < 2
+            || !increasing(vertical)
+            || vertical[0] < -ANGLE_EPS
+            || vertical[vertical.len() - 1] > PI + ANGLE_EPS
         {
             return Err(ProfileError::BadVertical);
         }
@@ -121,6 +124,12 @@ impl<'a> IntensityProfile<'a> {
     #[must_use]
     pub fn horizontal(&self) -> &'a [f32] {
         self.horizontal
+    }
+
+    /// The intensities, `[h · vertical().len() + v]`.
+    #[must_use]
+    pub fn intensities(&self) -> &'a [f32] {
+        self.intensity
     }
 
     /// The largest intensity of the table.

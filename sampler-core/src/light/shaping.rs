@@ -38,7 +38,8 @@ const PROFILE_SIMPSON_STEPS: usize = 32;
 
 impl Shaping {
     /// No shaping: every direction keeps the full emission.
-    pub const NONE: Self = Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE, profile: None, active: false };
+    pub const NONE: Self =
+        Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE, profile: None, active: false };
 
     /// The emission about the world `axis` (any length) cut off beyond `cone_angle` radians
     /// (≥ π: no cutoff), softened over the fraction `softness` of the cone (clamped to [0, 1]),
