@@ -32,13 +32,12 @@ pub struct IesFile {
 
 /// The numbers of the file, read in order, each an error naming it when missing or malformed.
 struct Numbers<'a> {
-    tokens: std::iter::Peekable<std::str::Split<'a, [char; 5]>>,
-    read: usize,
+    tokens: std::str::Split<'a, [char; 5]>,
 }
 
 impl<'a> Numbers<'a> {
     fn new(text: &'a str) -> Self {
-        Self { tokens: text.split([' ', '\t', '\r', '\n', ',']).peekable(), read: 0 }
+        Self { tokens: text.split([' ', '\t', '\r', '\n', ',']) }
     }
 
     fn next_token(&mut self) -> Option<&'a str> {
@@ -51,11 +50,17 @@ impl<'a> Numbers<'a> {
     }
 
     fn number(&mut self, what: &str) -> Result<f64, String> {
-        let t = self.next_token().ok_or_else(|| format!("the file ends before {what}"))?;
-        self.read += 1;
+        self.number_or_else(|| what.to_string())
+    }
+
+    /// The next number; `what` names it only when it is missing or malformed.
+    fn number_or_else(&mut self, what: impl FnOnce() -> String) -> Result<f64, String> {
+        let Some(t) = self.next_token() else {
+            return Err(format!("the file ends before {}", what()));
+        };
         match t.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(format!("{what} is `{}`, not a finite number", t.chars().take(40).collect::<String>())),
+            _ => Err(format!("{} is `{}`, not a finite number", what(), t.chars().take(40).collect::<String>())),
         }
     }
 
@@ -158,16 +163,16 @@ fn table(n: &mut Numbers<'_>, format: String) -> Result<IesFile, String> {
     let vertical_deg = angles(v, "vertical", 180.0)?;
     let horizontal_deg = angles(h, "horizontal", 360.0)?;
     let mut candela = Vec::with_capacity(v * h);
-    for j in 0..h {
-        for k in 0..v {
-            let at = format!("the candela value at {}° vertical, {}° horizontal", vertical_deg[k], horizontal_deg[j]);
-            let c = n.number(&at)?;
+    for hd in &horizontal_deg {
+        for vd in &vertical_deg {
+            let at = || format!("the candela value at {vd}° vertical, {hd}° horizontal");
+            let c = n.number_or_else(at)?;
             if c < 0.0 {
-                return Err(format!("{at} is negative ({c})"));
+                return Err(format!("{} is negative ({c})", at()));
             }
             let scaled = (c * scale) as f32;
             if !scaled.is_finite() {
-                return Err(format!("{at} times the multipliers overflows"));
+                return Err(format!("{} times the multipliers overflows", at()));
             }
             candela.push(scaled);
         }
