@@ -35,6 +35,7 @@ mod shaping;
 mod sphere;
 mod spherical_rect;
 mod spherical_triangle;
+mod tilted_integral;
 mod tree;
 mod triangle;
 
@@ -128,6 +129,16 @@ impl Emission {
             return self.radiance * (sides * core::f32::consts::PI * area);
         }
         self.radiance * area * self.shaping.integral(true, self.two_sided)
+    }
+
+    /// The power leaving a flat surface of area `area` and unit front normal `normal`, whose
+    /// shaping axis may differ from its normal (a face of a shaped mesh light).
+    #[must_use]
+    pub fn power_facing(&self, area: f32, normal: Vec3) -> Vec3 {
+        if self.shaping.is_none() {
+            return self.power(area);
+        }
+        self.radiance * area * self.shaping.integral_about(normal, self.two_sided)
     }
 
     /// The radiance leaving towards `dir` (unit, from the receiver towards the emitter).

@@ -124,6 +124,12 @@ impl Shaping {
         }
     }
 
+    /// The cone and focus factor at the angle `theta` from the axis, whose cosine is `cos`
+    /// (without a profile, which depends on the direction about the axis too).
+    pub(super) fn factor_at_angle(&self, theta: f32, cos: f32) -> Vec3 {
+        self.factor_at(theta, cos)
+    }
+
     /// The factor at the angle `theta` from the axis, whose cosine is `cos`.
     fn factor_at(&self, theta: f32, cos: f32) -> Vec3 {
         if theta > self.cutoff {
