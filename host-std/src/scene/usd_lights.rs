@@ -1,7 +1,8 @@
 //! A USD stage's UsdLux lights (host-usd's [`host_usd::lights::UsdLight`], radiometry already
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
-//! light per face with an area; a ShapingAPI cone and focus shape a point, sphere, rectangle or
-//! disk, and so does an IES profile (`shaping:ies:file`, parsed by `scene/ies.rs`); a RectLight's
+//! light per face with an area; a ShapingAPI cone and focus shape any of them but a distant
+//! light (a mesh's faces about the light's axis), and an IES profile a point, sphere, rectangle
+//! or disk (`shaping:ies:file`, parsed by `scene/ies.rs`); a RectLight's
 //! `texture:file` cuts it into one rectangle per texel (`scene/rect_texture.rs`). A light the core
 //! cannot build is a note naming its prim; an IES file that is not one is an error naming it.
 
@@ -98,7 +99,7 @@ fn push(e: &Emitter, shaping: Shaping, out: &mut Vec<SceneLight>) -> Result<(), 
             out.push(DistantLight::new(*direction, *irradiance, angle_deg.to_radians())?.into())
         }
         Emitter::Triangles { positions, triangles, radiance, two_sided } => {
-            push_triangle_lights(positions, triangles, *radiance, *two_sided, out)?;
+            push_triangle_lights(positions, triangles, *radiance, *two_sided, shaping, out)?;
         }
     }
     Ok(())
