@@ -226,3 +226,67 @@ fn unrendered_light_features_are_listed_and_warned() {
         assert!(stderr.contains(needle), "ppis render does not warn of {needle:?}: {stderr}");
     }
 }
+
+/// ShapingAPI on a CylinderLight and a mesh light (`lights_shaped_meshes.usda`): each face is
+/// shaped about the light's axis (its −Z, turned down here), not the face's normal. The tube's
+/// 45° cone lights the floor below it and not a point 53° off its axis; the upright two-sided
+/// panel (faces perpendicular to its axis) lights a point 9.5° off its axis and not one 65°
+/// off; both have less power than unshaped; an IES profile on a CylinderLight is a note.
+#[test]
+fn shaped_cylinder_and_mesh_lights_render_their_cone() {
+    use sampler_core::glam::{Vec2, Vec3};
+    use sampler_core::light::SceneLight;
+    let file = root().join("host-usd/tests/fixtures/lights_shaped_meshes.usda");
+    let converted = usd::load(&file, &usd::Options::default()).unwrap();
+    let notes = converted.notes.join("\n");
+    assert!(
+        notes.contains("/World/ProfiledTube: IES profile ies/downlight_2002.ies not rendered on a CylinderLight"),
+        "{notes}"
+    );
+    assert_eq!(converted.notes.len(), 1, "{notes}");
+    let faces = |x_range: std::ops::Range<f32>| -> Vec<SceneLight> {
+        let in_range = |l: &SceneLight| match l.surface() {
+            Some(sampler_core::light::LightSurface::Triangle(v)) => x_range.contains(&v[0].x) && v[0].y > 2.0,
+            _ => false,
+        };
+        converted.scene.lights.iter().filter(|l| in_range(l)).copied().collect()
+    };
+    let (tube, panel) = (faces(-2.0..2.0), faces(4.0..6.0));
+    assert_eq!((tube.len(), panel.len()), (128, 2));
+    for l in tube.iter().chain(&panel) {
+        let SceneLight::Triangle(t) = l else { panic!() };
+        assert!((t.shaping().axis() - Vec3::NEG_Y).length() < 1e-5, "{:?}", t.shaping().axis());
+    }
+    // Light arriving at q from a set of faces, a few samples each.
+    let arriving = |lights: &[SceneLight], q: Vec3| -> f32 {
+        let mut sum = 0.0;
+        for l in lights {
+            for k in 0..16 {
+                let u = Vec2::new((k % 4) as f32 / 4.0 + 0.125, (k / 4) as f32 / 4.0 + 0.125);
+                sum += l.sample(q, u).map_or(0.0, |s| s.radiance.x);
+            }
+        }
+        sum
+    };
+    assert!(arriving(&tube, Vec3::new(0.7, 0.0, 0.0)) > 0.0);
+    assert_eq!(arriving(&tube, Vec3::new(0.0, 0.0, 4.0)), 0.0, "53° off the axis, outside the 45° cone");
+    assert!(arriving(&panel, Vec3::new(5.5, 0.0, 0.0)) > 0.0);
+    assert_eq!(arriving(&panel, Vec3::new(5.0 + 3.0 * 65f32.to_radians().tan(), 0.0, 0.0)), 0.0);
+    let power = |lights: &[SceneLight]| lights.iter().map(|l| l.power(1.0).x).sum::<f32>();
+    let unshaped = |lights: &[SceneLight]| {
+        lights
+            .iter()
+            .map(|l| {
+                if let SceneLight::Triangle(t) = l {
+                    t.with_shaping(sampler_core::light::Shaping::NONE).power(1.0).x
+                } else {
+                    0.0
+                }
+            })
+            .sum::<f32>()
+    };
+    for (name, lights) in [("tube", &tube), ("panel", &panel)] {
+        let (p, u) = (power(lights), unshaped(lights));
+        assert!(p > 0.05 * u && p < 0.8 * u, "{name}: {p} against {u} unshaped");
+    }
+}

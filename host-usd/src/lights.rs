@@ -90,6 +90,8 @@ pub struct UsdLight {
     pub shaping: Option<crate::shaping::LightShaping>,
     /// A RectLight's `texture:file`, placed on the rectangle.
     pub texture: Option<RectTexture>,
+    /// Its ShapingAPI IES profile (the same kinds as `shaping`).
+    pub ies: Option<crate::shaping::IesShaping>,
 }
 
 /// A RectLight's texture and where it lies. The schema puts the image's first texel (its
@@ -179,18 +181,23 @@ fn linked(stage: &Stage, prim: &PrimPath, name: &str) -> Result<bool, String> {
     Ok(listed || root_off)
 }
 
-/// The light kinds whose ShapingAPI cone and focus are rendered.
+/// The light kinds whose ShapingAPI IES profile is rendered (their cone and focus too).
 pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
 
+/// The light kinds whose ShapingAPI cone and focus are not rendered (every other kind's are,
+/// a CylinderLight's and a mesh light's faces about the light's axis).
+pub const UNSHAPED_KINDS: [&str; 1] = ["DistantLight"];
+
 /// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
-/// cone and focus on kinds other than [`SHAPED_KINDS`] and its IES profile, light filters, the
+/// cone and focus on [`UNSHAPED_KINDS`], its IES profile on kinds other than
+/// [`SHAPED_KINDS`], light filters, the
 /// diffuse and specular multipliers, shadow controls, and (for `type_name`) a CylinderLight's
 /// `treatAsLine`. A RectLight's texture renders (`RectTexture`).
 pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
     let mut notes = Vec::new();
     let authored =
         |name: &str| -> Result<Option<f64>, String> { Ok(input(stage, prim, name)?.and_then(|v| v.scalar())) };
-    if !SHAPED_KINDS.contains(&type_name) {
+    if UNSHAPED_KINDS.contains(&type_name) {
         if authored("shaping:cone:angle")?.is_some_and(|a| a < 180.0) {
             notes.push(format!("ShapingAPI cone angle not rendered on a {type_name}"));
         }
@@ -200,8 +207,9 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     }
     if let Some(Value::Asset { authored, .. }) = input(stage, prim, "shaping:ies:file")?
         && !authored.is_empty()
+        && !SHAPED_KINDS.contains(&type_name)
     {
-        notes.push(format!("IES profile {authored} not rendered"));
+        notes.push(format!("IES profile {authored} not rendered on a {type_name}"));
     }
     if !stage.targets(prim, "light:filters")?.is_empty() {
         notes.push("light filters not rendered".into());

@@ -1,6 +1,8 @@
 //! UsdLux's ShapingAPI on a light: the cone (`inputs:shaping:cone:angle`, `…:softness`) and the
-//! focus (`inputs:shaping:focus`, `…:focusTint`) about the light's primary axis, its local −Z.
-//! The renderer applies them as the schema's formulas say (sampler-core's `light::Shaping`).
+//! focus (`inputs:shaping:focus`, `…:focusTint`) about the light's primary axis, its local −Z,
+//! and the IES profile (`inputs:shaping:ies:file`, `…:angleScale`, `…:normalize`), whose file is
+//! read here and parsed by the renderer. The renderer applies them as the schema's formulas say
+//! (sampler-core's `light::Shaping`).
 //!
 //! A light is shaped when it applies ShapingAPI or authors any of these inputs. The cone angle
 //! falls back to the schema's 90° on a prim that applies ShapingAPI, and to no cutoff on one
@@ -32,6 +34,56 @@ impl LightShaping {
     pub fn is_identity(&self) -> bool {
         self.cone_angle_deg >= 180.0 && (self.focus <= 0.0 || self.focus_tint == Vec3::ONE)
     }
+}
+
+/// A light's IES profile: the file's bytes and how the profile sits on the light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IesShaping {
+    /// The resolved asset path (inside a package: `pkg.usdz[lamps/a.ies]`).
+    pub name: String,
+    /// The file's bytes.
+    pub bytes: Vec<u8>,
+    /// Unit primary axis: the world image of the light's local −Z (the profile's vertical 0°).
+    pub axis: Vec3,
+    /// The world image of the light's local +X (the profile's horizontal 0°).
+    pub x: Vec3,
+    /// The world image of the light's local +Y (horizontal 90°).
+    pub y: Vec3,
+    /// `inputs:shaping:ies:angleScale`.
+    pub angle_scale: f32,
+    /// `inputs:shaping:ies:normalize`.
+    pub normalize: bool,
+}
+
+/// The largest IES file read (larger ones are refused before they are parsed).
+pub const MAX_IES_BYTES: usize = 16 << 20;
+
+/// The light's IES profile under its world transform `m`; `None` when no file is authored (or
+/// the path is empty). A file that cannot be found or read, or a non-finite angle scale, is an
+/// error naming it.
+pub fn read_ies(stage: &Stage, prim: &PrimPath, m: &DMat4) -> Result<Option<IesShaping>, String> {
+    let Some(Value::Asset { authored, resolved }) = input(stage, prim, "shaping:ies:file")? else {
+        return Ok(None);
+    };
+    if authored.is_empty() {
+        return Ok(None);
+    }
+    let name = resolved.ok_or_else(|| format!("inputs:shaping:ies:file {authored} not found"))?;
+    let bytes = stage.read_asset(&name).map_err(|e| format!("{name}: {e}"))?;
+    if bytes.len() > MAX_IES_BYTES {
+        return Err(format!("{name}: {} bytes, more than an IES file may hold here", bytes.len()));
+    }
+    let angle_scale = scalar(stage, prim, "shaping:ies:angleScale", 0.0)? as f32;
+    let normalize = scalar(stage, prim, "shaping:ies:normalize", 0.0)? != 0.0;
+    let axis = m.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
+    let (x, y) = (m.transform_vector3(DVec3::X), m.transform_vector3(DVec3::Y));
+    let independent =
+        axis.cross(x).length() > 1e-9 * x.length() && x.cross(y).length() > 1e-9 * x.length() * y.length();
+    if axis == DVec3::ZERO || !axis.is_finite() || !independent {
+        return Err("the IES-shaped light's world transform is singular".into());
+    }
+    let (axis, x, y) = (axis.as_vec3(), x.as_vec3(), y.as_vec3());
+    Ok(Some(IesShaping { name, bytes, axis, x, y, angle_scale, normalize }))
 }
 
 /// The inputs ShapingAPI adds, besides the IES profile's.

@@ -147,6 +147,32 @@ fn shaping_inputs_are_read_about_the_lights_axis() {
     }
 }
 
+/// IES profiles (`lights_ies.usda`): the file resolved and read, angleScale and normalize, the
+/// light's local −Z, +X and +Y in the world; the cone's fallback where ShapingAPI is applied and
+/// none where only the file is authored; no note. A type B file is read here (the renderer
+/// parses it); a missing file is an error naming it.
+#[test]
+fn ies_inputs_are_read_with_the_lights_frame() {
+    let s = host_usd::load(&fixture("lights_ies.usda")).unwrap();
+    let spot = light(&s, "/World/Spot");
+    let ies = spot.ies.as_ref().expect("the point light has a profile");
+    assert!(ies.name.ends_with("ies/bilateral_1995.ies"), "{}", ies.name);
+    assert_eq!(ies.bytes, std::fs::read(fixture("ies/bilateral_1995.ies")).unwrap());
+    assert!(close(ies.axis, -Vec3::Y) && close(ies.x, Vec3::X) && close(ies.y, -Vec3::Z), "{ies:?}");
+    assert_eq!((ies.angle_scale, ies.normalize), (0.0, false));
+    assert_eq!(spot.shaping.map(|x| x.cone_angle_deg), None, "cone 180° authored: no cone");
+    let panel = light(&s, "/World/Panel");
+    let ies = panel.ies.as_ref().unwrap();
+    assert_eq!((ies.angle_scale, ies.normalize), (0.5, true));
+    assert_eq!(panel.shaping.map(|x| x.cone_angle_deg), Some(90.0));
+    let disk = light(&s, "/World/Disk");
+    assert!(disk.ies.is_some() && disk.shaping.is_none());
+    assert!(s.skipped.is_empty(), "{:?}", s.skipped);
+    assert!(host_usd::load(&fixture("lights_ies_bad.usda")).unwrap().lights[0].ies.is_some());
+    let missing = host_usd::load(&fixture("lights_ies_missing.usda")).unwrap_err().to_string();
+    assert!(missing.contains("inputs:shaping:ies:file ies/nowhere.ies not found"), "{missing}");
+}
+
 /// Lights inside a PointInstancer's prototype and under instanceable references
 /// (`lights_instanced.usda`): one light per visible instance, at the instance's transform.
 #[test]
@@ -171,13 +197,13 @@ fn instanced_lights_take_each_instances_transform() {
     assert_eq!(s.lights.len(), 6, "{:?}", s.lights.iter().map(|l| &l.path).collect::<Vec<_>>());
 }
 
-/// What is not rendered (`lights_unrendered.usda`) is a note each: an IES profile, a light
-/// filter, light and shadow linking, a PortalLight, a PluginLight and a dome's portals.
+/// What is not rendered (`lights_unrendered.usda`) is a note each: an IES profile on a
+/// DistantLight, a light filter, light and shadow linking, a PortalLight, a PluginLight and a dome's portals.
 #[test]
 fn what_is_not_rendered_is_a_note_each() {
     let s = host_usd::load(&fixture("lights_unrendered.usda")).unwrap();
     for (path, needle) in [
-        ("/World/Lamp", "IES profile profile.ies not rendered"),
+        ("/World/Sun", "IES profile profile.ies not rendered on a DistantLight"),
         ("/World/Lamp", "light filters not rendered"),
         ("/World/Lamp", "light linking (collection:lightLink) not honoured"),
         ("/World/Lamp", "shadow linking (collection:shadowLink) not honoured"),

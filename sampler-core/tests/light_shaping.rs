@@ -167,3 +167,64 @@ fn bounds_of_a_spot_light_cull_only_where_it_is_dark() {
     // Most points outside the cone are culled (the bounds are not a whole sphere).
     assert!(lit > 500 && culled_dark > 10_000, "{lit} lit, {culled_dark} dark points culled");
 }
+
+/// A face of a shaped mesh light, tilted from the shaping axis (the light's −Z): its power is
+/// radiance × area × ∫ factor · max(0, ω·n) dω (|ω·n| two-sided) by brute-force quadrature over
+/// the sphere, at tilts from 0° to 150°; sampled as an unshaped triangle, it estimates what
+/// quadrature of `eval` gives.
+#[test]
+fn a_tilted_shaped_triangle_has_the_power_and_radiance_of_its_falloff() {
+    use sampler_core::light::TriangleLight;
+    let axis = Vec3::new(0.0, 0.0, -1.0);
+    let shaping = Shaping::new(axis, 50f32.to_radians(), 0.4, 2.0, Vec3::new(0.2, 0.6, 1.0)).unwrap();
+    let n = 500;
+    let quad = |normal: Vec3, two_sided: bool, c: usize| {
+        let mut total = 0.0;
+        for i in 0..n {
+            let theta = PI * (i as f64 + 0.5) / n as f64;
+            for j in 0..2 * n {
+                let phi = PI * (j as f64 + 0.5) / n as f64;
+                let w =
+                    Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                let cos = w.dot(normal) as f64;
+                let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
+                total += shaping.factor(w)[c] as f64 * cos * theta.sin();
+            }
+        }
+        total * (PI / n as f64).powi(2)
+    };
+    for tilt_deg in [0.0f32, 30.0, 80.0, 150.0] {
+        let t = tilt_deg.to_radians();
+        let normal = Vec3::new(t.sin(), 0.0, -t.cos());
+        // A triangle of area ½ whose front faces `normal`.
+        let (u, v) = (Vec3::Y, normal.cross(Vec3::Y));
+        let tri = TriangleLight::new([Vec3::ZERO, u, v], Vec3::splat(2.0)).unwrap().with_shaping(shaping);
+        for two_sided in [false, true] {
+            let tri = tri.with_two_sided(two_sided);
+            for c in 0..3 {
+                let expected = 2.0 * 0.5 * quad(normal, two_sided, c);
+                let power = tri.power(1.0)[c] as f64;
+                assert!(
+                    (power - expected).abs() <= 2e-3 * expected + 1e-6,
+                    "tilt {tilt_deg}°, two-sided {two_sided}, channel {c}: {power} against {expected}"
+                );
+            }
+        }
+    }
+    // Radiance: a triangle 1 above a receiver, tilted 40° from the axis, against quadrature.
+    let t = 40f32.to_radians();
+    let normal = Vec3::new(t.sin(), 0.0, -t.cos());
+    let (u, v) = (Vec3::Y, normal.cross(Vec3::Y));
+    let c0 = Vec3::new(0.0, 0.0, 1.0);
+    let tri: SceneLight =
+        TriangleLight::new([c0 - 0.5 * u, c0 + 0.5 * u, c0 + v], Vec3::ONE).unwrap().with_shaping(shaping).into();
+    let p = Vec3::new(0.4, 0.1, 0.0);
+    let est = estimate(&tri, p, Vec3::Z, 60_000, 90);
+    let to = c0 - p;
+    for (c, &(mean, se)) in est.iter().enumerate() {
+        let quad = integrate_cone_jittered(to.normalize(), 1.2, 500, 91, |d| {
+            tri.eval(p, d).map_or(0.0, |h| h.radiance[c] as f64 * Vec3::Z.dot(d).max(0.0) as f64)
+        });
+        assert!((mean - quad).abs() <= 4.0 * se + 3e-3 * quad, "channel {c}: {mean} ± {se} against {quad}");
+    }
+}

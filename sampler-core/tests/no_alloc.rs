@@ -119,15 +119,22 @@ fn ten_thousand_shading_points_allocate_nothing() {
     assert_eq!(count, 0, "the core allocated {count} times");
 }
 
-/// Every light's sampling, density and ray query (shaped lights among them), picking a light by
-/// power, and the lights' estimator (a light sample and a BRDF sample under the balance heuristic), at 10 000 shading
+/// Every light's sampling, density and ray query (shaped lights among them, two with an IES
+/// profile, whose power is integrated inside the armed region too), picking a light by power, and the lights' estimator (a light sample and a BRDF sample under the balance heuristic), at 10 000 shading
 /// points.
 #[test]
 fn light_sampling_allocates_nothing() {
     use sampler_core::light::*;
     let l = Vec3::new(1.0, 2.0, 3.0);
     let spot = Shaping::new(Vec3::NEG_Z, 1.0, 0.3, 2.0, Vec3::splat(0.1)).unwrap();
-    let lights: [SceneLight; 8] = [
+    static VERTICAL: [f32; 3] = [0.0, 1.0, 2.0];
+    static HORIZONTAL: [f32; 3] = [0.0, std::f32::consts::FRAC_PI_2, std::f32::consts::PI];
+    static CANDELA: [f32; 9] = [5.0, 3.0, 0.0, 5.0, 2.0, 1.0, 5.0, 4.0, 0.5];
+    let table = Box::leak(Box::new(IntensityProfile::new(&VERTICAL, &HORIZONTAL, &CANDELA).unwrap()));
+    let ies = spot.with_profile(table, Vec3::X, Vec3::Y, 0.7, true).unwrap();
+    let lights: [SceneLight; 10] = [
+        RectLight::new(Vec3::new(-1.0, -1.0, 2.5), Vec3::Y * 2.0, Vec3::X * 2.0, l).unwrap().with_shaping(ies).into(),
+        PointLight::new(Vec3::new(0.5, 0.0, 3.0), l).unwrap().with_shaping(ies).into(),
         PointLight::new(Vec3::new(0.0, 0.0, 3.0), l).unwrap().with_shaping(spot).into(),
         SphereLight::new(Vec3::new(1.0, 0.0, 2.0), 0.5, l).unwrap().with_two_sided(true).with_shaping(spot).into(),
         RectLight::new(Vec3::new(-1.0, -1.0, 2.0), Vec3::X * 2.0, Vec3::Y * 2.0, l)
@@ -140,13 +147,13 @@ fn light_sampling_allocates_nothing() {
         DistantLight::new(Vec3::new(0.2, 0.3, 1.0), l, 0.01).unwrap().into(),
         DistantLight::new(Vec3::new(0.2, 0.3, 1.0), l, 0.0).unwrap().into(),
     ];
-    let weights = lights.map(|x| x.power(10.0).x);
-    let mut cdf = [0.0f64; 9];
+    let mut cdf = [0.0f64; 11];
     let mut rng = Pcg32::new(2, 3);
     let mut sink = 0.0f64;
     ARMED.with(|a| a.set(true));
+    let weights = lights.map(|x| x.power(10.0).x);
     let selector = PowerSelector::build(&weights, &mut cdf).unwrap();
-    let infinite = [6u32];
+    let infinite = [8u32];
     let set = LightSet::new(&lights, selector, &infinite).unwrap();
     let brdf = RoughConductor::new(0.2, Vec3::ONE);
     let sp = ShadingPoint { frame: Frame::from_normal(Vec3::Z), wo: Vec3::Z, brdf: &brdf };

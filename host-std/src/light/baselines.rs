@@ -47,8 +47,8 @@ pub struct LightcutTable {
 }
 
 impl LightcutTable {
-    /// The tree over `env`'s [`DEFAULT_ENV_LIGHTS`] strata and the point lights and delta
-    /// distant lights of `scene_lights`.
+    /// The tree over `env`'s [`DEFAULT_ENV_LIGHTS`] strata and the unshaped point lights and
+    /// delta distant lights of `scene_lights`.
     #[must_use]
     pub fn new(env: Option<&EnvHierarchy<'_>>, scene_lights: &[SceneLight]) -> Self {
         let mut lights: Vec<CutLight> = env
@@ -61,7 +61,9 @@ impl LightcutTable {
         let dark = PointLight::new(Vec3::ZERO, Vec3::ZERO).expect("a dark point light at the origin is valid");
         for light in &mut rest {
             let taken = match light {
-                SceneLight::Point(p) => {
+                // Lightcuts' bounds take a point light as isotropic: a shaped one (a cone, a
+                // focus, an IES profile) stays with the other lights.
+                SceneLight::Point(p) if p.shaping().is_none() => {
                     Some(CutLight { kind: CutLightKind::Point, at: p.position(), intensity: p.intensity() })
                 }
                 SceneLight::Distant(d) if d.is_delta() => {

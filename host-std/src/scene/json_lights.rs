@@ -6,7 +6,7 @@
 use crate::scene::mesh;
 use crate::scene::mesh_light::push_triangle_lights;
 use sampler_core::glam::Vec3;
-use sampler_core::light::{DiskLight, DistantLight, PointLight, RectLight, SceneLight, SphereLight};
+use sampler_core::light::{DiskLight, DistantLight, PointLight, RectLight, SceneLight, Shaping, SphereLight};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -91,7 +91,7 @@ pub(super) fn lights_of(light: JsonLight, dir: &Path) -> Result<Vec<SceneLight>,
 fn mesh_light(file: &Path, to_world: Option<[[f32; 4]; 4]>, radiance: Vec3) -> Result<Vec<SceneLight>, String> {
     let (positions, triangles) = mesh::load_placed(file, to_world).map_err(|e| e.to_string())?;
     let mut lights = Vec::with_capacity(triangles.len());
-    match push_triangle_lights(&positions, &triangles, radiance, false, &mut lights) {
+    match push_triangle_lights(&positions, &triangles, radiance, false, Shaping::NONE, &mut lights) {
         Ok(0) => Err(format!("{}: no face of the mesh has an area", file.display())),
         Ok(_) => Ok(lights),
         Err(e) => Err(format!("{}: {e}", file.display())),

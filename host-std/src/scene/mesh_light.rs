@@ -3,22 +3,23 @@
 //! and cylinder lights alike.
 
 use sampler_core::glam::Vec3;
-use sampler_core::light::SceneLight;
-use sampler_core::light::{LightError, TriangleLight};
+use sampler_core::light::{LightError, SceneLight, Shaping, TriangleLight};
 
 /// Appends the triangle lights of the mesh (`positions`, `triangles`) emitting `radiance`, on both
-/// sides when `two_sided`, to `out`; returns how many. On an error `out` is left as it was.
+/// sides when `two_sided`, shaped by `shaping` (about the light's axis, not each face's normal),
+/// to `out`; returns how many. On an error `out` is left as it was.
 pub(crate) fn push_triangle_lights(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
     radiance: Vec3,
     two_sided: bool,
+    shaping: Shaping,
     out: &mut Vec<SceneLight>,
 ) -> Result<usize, LightError> {
     let before = out.len();
     for t in triangles {
         match TriangleLight::new(t.map(|i| positions[i as usize]), radiance) {
-            Ok(l) => out.push(l.with_two_sided(two_sided).into()),
+            Ok(l) => out.push(l.with_two_sided(two_sided).with_shaping(shaping).into()),
             Err(LightError::ZeroArea) => {}
             Err(e) => {
                 out.truncate(before);

@@ -3,6 +3,7 @@
 //! for the environment a scene names.
 
 pub mod builtin;
+pub mod ies;
 pub mod json;
 mod json_lights;
 pub mod mesh;

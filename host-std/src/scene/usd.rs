@@ -65,7 +65,7 @@ pub fn load(path: &Path, options: &Options) -> anyhow::Result<Converted> {
         time: options.time,
     };
     let usd = host_usd::load_with(path, &import)?;
-    Ok(convert(usd, (options.width, options.height)))
+    convert(usd, (options.width, options.height))
 }
 
 /// The image size: `size`'s overrides, else the render settings' resolution, else
@@ -89,7 +89,10 @@ fn image_size(usd: &UsdScene, cam: &host_usd::Camera, size: (Option<u32>, Option
 fn files_read(usd: &UsdScene) -> Vec<PathBuf> {
     let textures = usd.materials.iter().flat_map(|m| &m.textures).filter_map(|t| t.source.resolved.as_deref());
     let dome = usd.dome.iter().filter_map(|d| d.texture.as_ref().map(|(name, _)| name.as_str()));
-    let lights = usd.lights.iter().filter_map(|l| l.texture.as_ref().map(|t| t.name.as_str()));
+    let lights = usd.lights.iter().flat_map(|l| {
+        let texture = l.texture.as_ref().map(|t| t.name.as_str());
+        texture.into_iter().chain(l.ies.as_ref().map(|i| i.name.as_str()))
+    });
     let mut files: Vec<PathBuf> = (usd.layers.iter().map(String::as_str).chain(textures).chain(dome).chain(lights))
         .map(|id| PathBuf::from(id.split_once('[').map_or(id, |(file, _)| file)))
         .filter(|p| p.is_file())
@@ -203,8 +206,9 @@ fn bsdf(l: &Lobes) -> Bsdf {
     }
 }
 
-/// Converts an imported USD scene, rendered at `size` (width, height) where given.
-pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted {
+/// Converts an imported USD scene, rendered at `size` (width, height) where given; an error
+/// when a light's IES file cannot be parsed.
+pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> anyhow::Result<Converted> {
     let files = files_read(&usd);
     let mut notes: Vec<String> = usd.skipped.iter().map(|s| format!("{}: {}", s.path, s.what)).collect();
     // Decode each material's textures; the material's plain BRDF is its value at their means.
@@ -295,7 +299,7 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> Converted
         (source, placement)
     });
     let name = usd.file.file_name().map_or_else(|| "usd".into(), |n| n.to_string_lossy().into_owned());
-    let lights = crate::scene::usd_lights::convert(&usd.lights, &mut notes);
+    let lights = crate::scene::usd_lights::convert(&usd.lights, &mut notes).map_err(anyhow::Error::msg)?;
     let scene = Scene { name, camera, objects, materials, env, lights, hide_emitters: false };
-    Converted { scene, notes, usd, files }
+    Ok(Converted { scene, notes, usd, files })
 }

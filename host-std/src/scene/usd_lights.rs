@@ -1,25 +1,38 @@
 //! A USD stage's UsdLux lights (host-usd's [`host_usd::lights::UsdLight`], radiometry already
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
-//! light per face with an area; a ShapingAPI cone and focus shape a point, sphere, rectangle or
-//! disk; a RectLight's `texture:file` cuts it into one rectangle per texel (`scene/rect_texture.rs`).
-//! A light the core cannot build is a note naming its prim.
+//! light per face with an area; a ShapingAPI cone and focus shape any of them but a distant
+//! light (a mesh's faces about the light's axis), and an IES profile a point, sphere, rectangle
+//! or disk (`shaping:ies:file`, parsed by `scene/ies.rs`); a RectLight's
+//! `texture:file` cuts it into one rectangle per texel (`scene/rect_texture.rs`). A light the core
+//! cannot build is a note naming its prim; an IES file that is not one is an error naming it.
 
 use crate::scene::mesh_light::push_triangle_lights;
 use crate::scene::rect_texture;
 use host_usd::lights::{Emitter, UsdLight};
-use host_usd::shaping::LightShaping;
+use host_usd::shaping::{IesShaping, LightShaping};
 use sampler_core::light::{
-    DiskLight, DistantLight, LightError, PointLight, RectLight, SceneLight, Shaping, SphereLight,
+    DiskLight, DistantLight, IntensityProfile, LightError, PointLight, RectLight, SceneLight, Shaping, SphereLight,
 };
+use std::collections::HashMap;
 
-/// The core's lights for `lights`, with a note in `notes` for each one that cannot be built.
-pub(crate) fn convert(lights: &[UsdLight], notes: &mut Vec<String>) -> Vec<SceneLight> {
+/// Each IES file's profile, parsed once however many lights use it.
+type Profiles = HashMap<String, &'static IntensityProfile<'static>>;
+
+/// The core's lights for `lights`, with a note in `notes` for each one that cannot be built;
+/// an error naming the file and the light when an IES file cannot be parsed.
+pub(crate) fn convert(lights: &[UsdLight], notes: &mut Vec<String>) -> Result<Vec<SceneLight>, String> {
     let mut out = Vec::new();
+    let mut profiles = Profiles::new();
     for l in lights {
+        let profile = match &l.ies {
+            Some(ies) => Some(profile(ies, &mut profiles).map_err(|e| format!("{e} (the IES profile of {})", l.path))?),
+            None => None,
+        };
+        let shaping = core_shaping(l.shaping.as_ref(), l.ies.as_ref().zip(profile));
         if let (Some(t), Emitter::Rect { e1, e2, radiance, .. }) = (&l.texture, &l.emitter) {
             match rect_texture::decode(t) {
                 Ok(image) => {
-                    let pushed = core_shaping(l.shaping.as_ref())
+                    let pushed = shaping
                         .and_then(|s| rect_texture::push_cells(t, &image, e1.cross(*e2), *radiance, s, &mut out));
                     match pushed {
                         Ok(0) => notes.push(format!("{}: its texture {} is black: not rendered", l.path, t.name)),
@@ -33,23 +46,42 @@ pub(crate) fn convert(lights: &[UsdLight], notes: &mut Vec<String>) -> Vec<Scene
                 }
             }
         }
-        if let Err(e) = push(&l.emitter, l.shaping.as_ref(), &mut out) {
+        if let Err(e) = shaping.and_then(|s| push(&l.emitter, s, &mut out)) {
             notes.push(format!("{}: {} not rendered ({e})", l.path, l.prim_type));
         }
     }
-    out
+    Ok(out)
 }
 
-/// The core's shaping for a light's ShapingAPI inputs.
-fn core_shaping(s: Option<&LightShaping>) -> Result<Shaping, LightError> {
-    match s {
-        Some(s) => Shaping::new(s.axis, s.cone_angle_deg.to_radians(), s.cone_softness, s.focus, s.focus_tint),
-        None => Ok(Shaping::NONE),
+/// The profile of an IES file, parsed the first time it is met; an error names the file.
+fn profile(ies: &IesShaping, profiles: &mut Profiles) -> Result<&'static IntensityProfile<'static>, String> {
+    if let Some(p) = profiles.get(&ies.name) {
+        return Ok(p);
+    }
+    let file = crate::scene::ies::parse(&ies.bytes).map_err(|e| format!("{}: {e}", ies.name))?;
+    let p = file.profile();
+    profiles.insert(ies.name.clone(), p);
+    Ok(p)
+}
+
+/// The core's shaping for a light's ShapingAPI inputs: its cone and focus, times its IES
+/// profile where it has one.
+fn core_shaping(
+    s: Option<&LightShaping>,
+    ies: Option<(&IesShaping, &'static IntensityProfile<'static>)>,
+) -> Result<Shaping, LightError> {
+    let base = match (s, ies) {
+        (Some(s), _) => Shaping::new(s.axis, s.cone_angle_deg.to_radians(), s.cone_softness, s.focus, s.focus_tint)?,
+        (None, Some((i, _))) => Shaping::new(i.axis, std::f32::consts::PI, 0.0, 0.0, sampler_core::glam::Vec3::ONE)?,
+        (None, None) => Shaping::NONE,
+    };
+    match ies {
+        Some((i, p)) => base.with_profile(p, i.x, i.y, i.angle_scale, i.normalize),
+        None => Ok(base),
     }
 }
 
-fn push(e: &Emitter, shaping: Option<&LightShaping>, out: &mut Vec<SceneLight>) -> Result<(), LightError> {
-    let shaping = core_shaping(shaping)?;
+fn push(e: &Emitter, shaping: Shaping, out: &mut Vec<SceneLight>) -> Result<(), LightError> {
     match e {
         Emitter::Point { position, intensity } => {
             out.push(PointLight::new(*position, *intensity)?.with_shaping(shaping).into())
@@ -67,7 +99,7 @@ fn push(e: &Emitter, shaping: Option<&LightShaping>, out: &mut Vec<SceneLight>) 
             out.push(DistantLight::new(*direction, *irradiance, angle_deg.to_radians())?.into())
         }
         Emitter::Triangles { positions, triangles, radiance, two_sided } => {
-            push_triangle_lights(positions, triangles, *radiance, *two_sided, out)?;
+            push_triangle_lights(positions, triangles, *radiance, *two_sided, shaping, out)?;
         }
     }
     Ok(())
@@ -85,7 +117,12 @@ pub fn describe(l: &UsdLight) -> String {
         )
     });
     let textured = l.texture.as_ref().map_or(String::new(), |t| format!("; textured by {}", t.name));
-    format!("{}{shaped}{textured}", emitter_line(l))
+    let ies = l.ies.as_ref().map_or(String::new(), |i| {
+        let table = crate::scene::ies::parse(&i.bytes).map_or_else(|e| format!("not a profile: {e}"), |f| f.describe());
+        let normalized = if i.normalize { ", normalized" } else { "" };
+        format!("; IES profile {} ({table}; angleScale {}{normalized})", i.name, i.angle_scale)
+    });
+    format!("{}{shaped}{textured}{ies}", emitter_line(l))
 }
 
 fn emitter_line(l: &UsdLight) -> String {

@@ -1,14 +1,15 @@
 //! UsdLux lights into the scene, each under its world transform (the up-axis conversion
 //! included): DistantLight, SphereLight (a point with `treatAsPoint`), RectLight, DiskLight,
 //! CylinderLight (its side tessellated into emitting triangles) and meshes with MeshLightAPI.
-//! Spheres (points too), rectangles and disks carry their ShapingAPI cone and focus. A light
+//! Every light but a DistantLight carries its ShapingAPI cone and focus (a CylinderLight's and a
+//! mesh light's about the light's −Z); spheres (points too), rectangles and disks its IES profile. A light
 //! that emits nothing (zero intensity, colour or size) is a note, as the schema makes it dark;
 //! a value that cannot be a light (not finite, negative) is an error naming the prim.
 
 use super::Importer;
 use crate::lights::{self, Emission, Emitter, RectTexture, UsdLight};
 use crate::shapes;
-use crate::shaping::{self, LightShaping};
+use crate::shaping::{self, IesShaping, LightShaping};
 use crate::stage::{PrimPath, Stage, Value};
 use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -64,8 +65,9 @@ impl Importer<'_> {
             "CylinderLight" => cylinder(size("radius", 0.5)?, size("length", 1.0)?, &m, &emission),
             _ => return Err(format!("{type_name} is not a light kind read here")),
         };
-        let shaping = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read(stage, prim, &m)? } else { None };
-        self.add_light(prim, label, type_name, built, shaping, texture);
+        let shaping = if lights::UNSHAPED_KINDS.contains(&type_name) { None } else { shaping::read(stage, prim, &m)? };
+        let ies = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read_ies(stage, prim, &m)? } else { None };
+        self.add_light(prim, label, type_name, built, Shaped { shaping, ies, texture });
         Ok(())
     }
 
@@ -97,19 +99,12 @@ impl Importer<'_> {
         };
         let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        self.add_light(prim, label, type_name, built, None, None);
+        let shaping = shaping::read(stage, prim, &m)?;
+        self.add_light(prim, label, type_name, built, Shaped { shaping, ..Shaped::default() });
         Ok(())
     }
 
-    fn add_light(
-        &mut self,
-        prim: &PrimPath,
-        label: &str,
-        type_name: &str,
-        built: Built,
-        shaping: Option<LightShaping>,
-        texture: Option<RectTexture>,
-    ) {
+    fn add_light(&mut self, prim: &PrimPath, label: &str, type_name: &str, built: Built, shaped: Shaped) {
         let emitter = match built {
             Ok(e) if dark(&e) => Err("emits nothing (intensity or color 0): not rendered".to_string()),
             other => other,
@@ -121,11 +116,20 @@ impl Importer<'_> {
                 }
                 let path = label.to_string();
                 let prim_type = type_name.into();
-                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture });
+                let Shaped { shaping, ies, texture } = shaped;
+                self.scene.lights.push(UsdLight { path, prim_type, emitter, shaping, texture, ies });
             }
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }
     }
+}
+
+/// What varies a light's emission over its surface or its directions.
+#[derive(Default)]
+struct Shaped {
+    shaping: Option<LightShaping>,
+    ies: Option<IesShaping>,
+    texture: Option<RectTexture>,
 }
 
 /// The light's emission is zero in every channel.

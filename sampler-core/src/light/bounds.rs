@@ -92,8 +92,8 @@ impl LightBounds {
     }
 
     /// These bounds narrowed to a shaped light's cone when it is narrower than a hemisphere:
-    /// the emission leaves within `cutoff` of the shaping axis, and at full strength within its
-    /// soft start, so the importance stays positive wherever the light can shine (the soft band
+    /// the emission leaves within `cutoff` of the shaping axis (the cone's, or an IES profile's
+    /// last lit angle where that is less), and at full strength within its soft start, so the importance stays positive wherever the light can shine (the soft band
     /// is the emission spread θe beyond the normals' cone θo, as pbrt-v4 bounds a spot light).
     fn shaped(self, light: &SceneLight) -> Self {
         let shaping = match light {
@@ -103,10 +103,11 @@ impl LightBounds {
             SceneLight::Disk(l) => l.shaping(),
             _ => return self,
         };
-        if shaping.cutoff() >= core::f32::consts::FRAC_PI_2 {
+        let cutoff = shaping.emission_extent();
+        if cutoff >= core::f32::consts::FRAC_PI_2 {
             return self;
         }
-        let (start, cutoff) = (shaping.soft_start(), shaping.cutoff());
+        let start = shaping.soft_start().min(cutoff);
         // A margin over the band keeps a hard cone (θe = 0, where `importance` would cull
         // every point) and the rounding of the angles on the safe side.
         Self {

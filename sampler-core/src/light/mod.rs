@@ -2,6 +2,8 @@
 //! solid angle with an exact density (for MIS with BRDF sampling): a point light, a sphere, a
 //! rectangle, a disk, a triangle (the faces of mesh lights) and a distant light with or without an
 //! angular size. Radiometry follows the scene format's `lights` section (docs/scene-format.md).
+//! Points, spheres, rectangles, disks and triangles may be shaped ([`Shaping`]: UsdLux's cone,
+//! focus and IES profile, the last an [`IntensityProfile`] borrowed for the program's life).
 //!
 //! Every light implements [`Light`]; [`SceneLight`] holds any of them behind one type. Many
 //! lights are picked by power ([`PowerSelector`]) or, per shading point, by a light tree
@@ -23,7 +25,9 @@
 mod bounds;
 mod disk;
 mod distant;
+mod oriented_profile;
 mod point;
+mod profile;
 mod rect;
 mod scene_light;
 mod select;
@@ -31,13 +35,16 @@ mod shaping;
 mod sphere;
 mod spherical_rect;
 mod spherical_triangle;
+mod tilted_integral;
 mod tree;
 mod triangle;
 
 pub use bounds::LightBounds;
 pub use disk::DiskLight;
 pub use distant::{DistantLight, MIN_DISTANT_ANGLE};
+pub use oriented_profile::OrientedProfile;
 pub use point::PointLight;
+pub use profile::{HorizontalSymmetry, IntensityProfile, ProfileError};
 pub use rect::RectLight;
 pub use scene_light::{LightSurface, SceneLight};
 pub use select::{PowerSelector, SelectedLight};
@@ -122,6 +129,16 @@ impl Emission {
             return self.radiance * (sides * core::f32::consts::PI * area);
         }
         self.radiance * area * self.shaping.integral(true, self.two_sided)
+    }
+
+    /// The power leaving a flat surface of area `area` and unit front normal `normal`, whose
+    /// shaping axis may differ from its normal (a face of a shaped mesh light).
+    #[must_use]
+    pub fn power_facing(&self, area: f32, normal: Vec3) -> Vec3 {
+        if self.shaping.is_none() {
+            return self.power(area);
+        }
+        self.radiance * area * self.shaping.integral_about(normal, self.two_sided)
     }
 
     /// The radiance leaving towards `dir` (unit, from the receiver towards the emitter).

@@ -149,7 +149,7 @@ impl Light for RectLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        self.emission.power(self.area)
+        self.emission.power_facing(self.area, self.normal())
     }
 }
 

@@ -6,12 +6,15 @@
 //!   softness), the factor 1 − smoothstep(θ; start, cutoff); 1 below start;
 //! - the focus: f = |cos θ|^focus and the RGB factor lerp(f, focusTint, 1) = tint + f·(1 − tint).
 //!
-//! The radiance (or intensity) a light sends along a direction is its unshaped value times
-//! [`Shaping::factor`]. The samplers keep drawing as unshaped lights do (their densities do not
+//! and, where the light carries an IES profile ([`Shaping::with_profile`]), the profile's
+//! intensity towards the direction ([`OrientedProfile`]; the cone and focus multiply it, as
+//! HdEmbree applies them). The radiance (or intensity) a light sends along a direction is its
+//! unshaped value times [`Shaping::factor`]. The samplers keep drawing as unshaped lights do (their densities do not
 //! change); the factor enters the value, so the estimates stay unbiased.
 
+use super::oriented_profile::OrientedProfile;
 use super::{LightError, checked_rgb, unit};
-use core::f32::consts::PI;
+use core::f32::consts::{FRAC_PI_2, PI};
 use glam::Vec3;
 
 /// A ShapingAPI cone and focus about an axis; [`Shaping::NONE`] leaves emission unchanged.
@@ -22,6 +25,7 @@ pub struct Shaping {
     start: f32,
     focus: f32,
     tint: Vec3,
+    profile: Option<OrientedProfile>,
     /// Some direction's emission changes (kept so that unshaped lights test one flag).
     active: bool,
 }
@@ -29,9 +33,13 @@ pub struct Shaping {
 /// Simpson intervals per smooth piece of the factor in [`Shaping::integral`].
 const SIMPSON_STEPS: usize = 64;
 
+/// Simpson intervals per piece between a profile's vertical angles (many pieces, each narrow).
+const PROFILE_SIMPSON_STEPS: usize = 32;
+
 impl Shaping {
     /// No shaping: every direction keeps the full emission.
-    pub const NONE: Self = Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE, active: false };
+    pub const NONE: Self =
+        Self { axis: Vec3::Z, cutoff: PI, start: PI, focus: 0.0, tint: Vec3::ONE, profile: None, active: false };
 
     /// The emission about the world `axis` (any length) cut off beyond `cone_angle` radians
     /// (≥ π: no cutoff), softened over the fraction `softness` of the cone (clamped to [0, 1]),
@@ -45,7 +53,35 @@ impl Shaping {
         let start = cutoff * (1.0 - softness.clamp(0.0, 1.0));
         let (focus, tint) = (focus.max(0.0), checked_rgb(focus_tint)?);
         let active = cutoff < PI || (focus > 0.0 && tint != Vec3::ONE);
-        Ok(Self { axis: unit(axis)?, cutoff, start, focus, tint, active })
+        Ok(Self { axis: unit(axis)?, cutoff, start, focus, tint, profile: None, active })
+    }
+
+    /// The same shaping times an IES profile placed on the light ([`OrientedProfile::new`]:
+    /// its horizontal angle 0 towards `x`, 90° towards `y`, rescaled by `angle_scale`, divided
+    /// by its mean when `normalize`).
+    pub fn with_profile(
+        self,
+        profile: &'static super::IntensityProfile<'static>,
+        x: Vec3,
+        y: Vec3,
+        angle_scale: f32,
+        normalize: bool,
+    ) -> Result<Self, LightError> {
+        let oriented = OrientedProfile::new(profile, self.axis, x, y, angle_scale, normalize)?;
+        Ok(Self { profile: Some(oriented), active: true, ..self })
+    }
+
+    /// The IES profile, if the light carries one.
+    #[must_use]
+    pub fn profile(&self) -> Option<&OrientedProfile> {
+        self.profile.as_ref()
+    }
+
+    /// The angle from the axis beyond which nothing is emitted: the cone's cutoff, or less
+    /// where the profile sends nothing further out.
+    #[must_use]
+    pub fn emission_extent(&self) -> f32 {
+        self.profile.map_or(self.cutoff, |p| self.cutoff.min(p.extent()))
     }
 
     /// The shaping changes no direction's emission.
@@ -80,7 +116,18 @@ impl Shaping {
             return Vec3::ONE;
         }
         let cos = self.axis.dot(emitted).clamp(-1.0, 1.0);
-        self.factor_at(libm::acosf(cos), cos)
+        let theta = libm::acosf(cos);
+        let base = self.factor_at(theta, cos);
+        match &self.profile {
+            Some(p) if base != Vec3::ZERO => base * p.factor(theta, emitted),
+            _ => base,
+        }
+    }
+
+    /// The cone and focus factor at the angle `theta` from the axis, whose cosine is `cos`
+    /// (without a profile, which depends on the direction about the axis too).
+    pub(super) fn factor_at_angle(&self, theta: f32, cos: f32) -> Vec3 {
+        self.factor_at(theta, cos)
     }
 
     /// The factor at the angle `theta` from the axis, whose cosine is `cos`.
@@ -100,29 +147,58 @@ impl Shaping {
 
     /// ∫ factor(ω) w(ω) dω over the sphere, with w = 1 (`cosine` false: a point's or a sphere's
     /// power over its unshaped one times 4π) or w = |cos θ| on the front hemisphere, and on both
-    /// when `two_sided` (a flat emitter's power over its unshaped one times π per side).
+    /// when `two_sided` (a flat emitter's power over its unshaped one times π per side). The
+    /// integrand is smooth between the soft start, 90° and a profile's vertical angles; Simpson's
+    /// rule runs over each piece, the profile entering through its exact mean about the axis.
     #[must_use]
     pub fn integral(&self, cosine: bool, two_sided: bool) -> Vec3 {
-        let end = if cosine && !two_sided { self.cutoff.min(PI / 2.0) } else { self.cutoff };
+        let extent = self.emission_extent();
+        let end = if cosine && !two_sided { extent.min(FRAC_PI_2) } else { extent };
+        let mut total = Vec3::ZERO;
+        let mut fixed = [self.start, FRAC_PI_2];
+        if fixed[0] > fixed[1] {
+            fixed.swap(0, 1);
+        }
+        let (mut a, mut fi) = (0.0f32, 0);
+        let mut knots = self.profile.as_ref().map(|p| p.knots().peekable());
+        while a < end {
+            let mut b = end;
+            while fi < fixed.len() && fixed[fi] <= a + 1e-6 {
+                fi += 1;
+            }
+            if fi < fixed.len() {
+                b = b.min(fixed[fi]);
+            }
+            if let Some(k) = knots.as_mut() {
+                while k.next_if(|&t| t <= a + 1e-6).is_some() {}
+                if let Some(&t) = k.peek() {
+                    b = b.min(t);
+                }
+            }
+            total += self.piece_integral(a, b, cosine);
+            a = b;
+        }
+        total * (2.0 * PI)
+    }
+
+    /// Simpson's rule for ∫ factor's mean about the axis · w · sin θ dθ over [a, b], a piece on
+    /// which it is smooth.
+    fn piece_integral(&self, a: f32, b: f32, cosine: bool) -> Vec3 {
+        let mid = 0.5 * (a + b);
+        let mean = self.profile.as_ref().map(|p| p.mean_over_phi(mid));
         let weight = |theta: f32| {
             let (s, c) = (libm::sinf(theta), libm::cosf(theta));
             let w = if cosine { c.abs() } else { 1.0 };
-            self.factor_at(theta, c) * (w * s)
+            let profile = mean.as_ref().map_or(1.0, |m| m(theta));
+            self.factor_at(theta, c) * (w * s * profile)
         };
-        let pieces = [(0.0, self.start.min(end)), (self.start.min(end), end)];
-        let mut total = Vec3::ZERO;
-        for (a, b) in pieces {
-            if b <= a {
-                continue;
-            }
-            let h = (b - a) / SIMPSON_STEPS as f32;
-            let mut sum = weight(a) + weight(b);
-            for k in 1..SIMPSON_STEPS {
-                sum += weight(a + k as f32 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
-            }
-            total += sum * (h / 3.0);
+        let steps = if self.profile.is_some() { PROFILE_SIMPSON_STEPS } else { SIMPSON_STEPS };
+        let h = (b - a) / steps as f32;
+        let mut sum = weight(a) + weight(b);
+        for k in 1..steps {
+            sum += weight(a + k as f32 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
         }
-        total * (2.0 * PI)
+        sum * (h / 3.0)
     }
 }
 

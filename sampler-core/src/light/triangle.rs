@@ -78,6 +78,19 @@ impl TriangleLight {
         Self { emission: Emission { two_sided, ..self.emission }, ..self }
     }
 
+    /// The same triangle, its radiance shaped by `shaping` about the shaping's own axis (for a
+    /// mesh light, the light's primary axis rather than this face's normal).
+    #[must_use]
+    pub fn with_shaping(self, shaping: Shaping) -> Self {
+        Self { emission: Emission { shaping, ..self.emission }, ..self }
+    }
+
+    /// How its radiance falls off away from the shaping axis.
+    #[must_use]
+    pub fn shaping(&self) -> &Shaping {
+        &self.emission.shaping
+    }
+
     /// The triangle's surface.
     #[must_use]
     pub fn surface(&self) -> super::LightSurface {
@@ -126,7 +139,6 @@ impl Light for TriangleLight {
         if !self.lit_from(p) {
             return None;
         }
-        let radiance = self.emission.radiance;
         if let Some(tri) = self.spherical(p) {
             let dir = tri.sample(u);
             // The distance to the triangle's plane along the drawn direction.
@@ -134,12 +146,14 @@ impl Light for TriangleLight {
             let distance = ((self.v[0].as_dvec3() - p.as_dvec3()).dot(n) / dir.dot(n)) as f32;
             let pdf = (1.0 / tri.solid_angle()) as f32;
             let ok = distance > 0.0 && distance.is_finite();
-            return ok.then_some(LightSample { dir: dir.as_vec3(), distance, radiance, pdf, delta: false });
+            let dir = dir.as_vec3();
+            let radiance = self.emission.towards(dir);
+            return ok.then_some(LightSample { dir, distance, radiance, pdf, delta: false });
         }
         // Uniform barycentrics by the square-root warp.
         let su = libm::sqrtf(u.x);
         let q = self.v[0] + (u.y * su) * (self.v[1] - self.v[0]) + (su * (1.0 - u.y)) * (self.v[2] - self.v[0]);
-        area_sample(p, q, self.normal, self.area, |_| radiance)
+        area_sample(p, q, self.normal, self.area, |dir| self.emission.towards(dir))
     }
 
     fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
@@ -163,7 +177,7 @@ impl Light for TriangleLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        self.emission.power(self.area)
+        self.emission.power_facing(self.area, self.normal)
     }
 }
 
