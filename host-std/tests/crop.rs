@@ -7,6 +7,7 @@ mod common;
 
 use host_std::light::environment::Environment;
 use host_std::plan::{Method, Rendered, Settings, render, render_crop};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::render::crop::Crop;
 use host_std::scene::{Bsdf, builtin};
 use host_std::trace::bvh::Bvh;
@@ -18,7 +19,7 @@ fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
         method,
         spp,
         shading_points,
-        brdf_samples: 32,
+        brdf_samples: BrdfSamples::PerLobe,
         seed: 5,
         progress: false,
         shadows: true,

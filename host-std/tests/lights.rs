@@ -8,6 +8,7 @@
 //! thread count, and area lights occlude.
 
 use host_std::plan::{Method, Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
@@ -21,7 +22,7 @@ fn settings(method: Method, spp: usize) -> Settings {
         method,
         spp,
         shading_points: 4,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed: 11,
         progress: false,
         shadows: true,

@@ -10,6 +10,7 @@ use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::Method;
 use host_std::plan::pilot;
 use host_std::plan::{Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::render::strategy::Strategy;
 use host_std::scene::{Bsdf, Material, Scene};
 use host_std::trace::bvh::Bvh;
@@ -27,7 +28,7 @@ fn chosen(scene: &Scene, env: &Environment, spp: usize, seed: u64) -> String {
         method: Method::Auto,
         spp,
         shading_points: spp / 16,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed,
         progress: false,
         shadows: true,
@@ -122,7 +123,7 @@ fn measured(scene: &Scene, env: &Environment, spp: usize, shading_points: usize)
         method: Method::Auto,
         spp,
         shading_points,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed: 3,
         progress: false,
         shadows: true,

@@ -4,6 +4,7 @@
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::Method;
 use host_std::plan::{Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
@@ -15,7 +16,7 @@ fn settings(method: Method, spp: usize, p: usize) -> Settings {
         method,
         spp,
         shading_points: p,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::PerLobe,
         seed: 7,
         progress: false,
         shadows: true,

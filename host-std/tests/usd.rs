@@ -6,6 +6,7 @@
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::usd;
 use host_std::trace::bvh::Bvh;
 use host_std::trace::camera::Camera;
@@ -92,7 +93,7 @@ fn dome_light_orientation_matches_the_convention() {
             method: Method::Mis,
             spp: 16,
             shading_points: 4,
-            brdf_samples: 64,
+            brdf_samples: BrdfSamples::Fixed(64),
             seed: 3,
             progress: false,
             shadows: true,
@@ -160,7 +161,7 @@ fn textures_are_looked_up_at_each_hit() {
         method: Method::Auto,
         spp: 16,
         shading_points: 4,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed: 5,
         progress: false,
         shadows: true,

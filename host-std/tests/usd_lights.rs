@@ -10,6 +10,7 @@
 
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::{Method, Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Scene, json, usd};
 use host_std::trace::bvh::Bvh;
 use sampler_core::glam::Mat3;
@@ -29,7 +30,7 @@ fn render_mean(scene: &Scene, seed: u64) -> Vec<f64> {
         method: Method::Mis,
         spp: 512,
         shading_points: 128,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed,
         progress: false,
         shadows: true,

@@ -8,6 +8,7 @@
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, Scene, Shape};
 use host_std::scene::{json, usd};
 use host_std::trace::bvh::Bvh;
@@ -27,7 +28,7 @@ fn render_scene(scene: &Scene, seed: u64) -> Vec<[f32; 3]> {
         method: Method::ProductMis,
         spp: 1024,
         shading_points: 64,
-        brdf_samples: 64,
+        brdf_samples: BrdfSamples::Fixed(64),
         seed,
         progress: false,
         shadows: true,

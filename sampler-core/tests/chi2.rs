@@ -217,6 +217,17 @@ fn quadtree_product_sampler_with_refined_leaves_matches_its_pdf() {
     assert!(f.is_empty(), "{}", f.join("\n"));
 }
 
+/// The renderer's K per lobe (host-std `render::brdf_samples`: 16 diffuse, 64 one glossy lobe,
+/// 128 layered): trees from 16 samples, and product-MIS's refinement at 1/K of the mass from
+/// 64, are sampled as their pdf says on every BRDF.
+#[test]
+fn quadtree_product_sampler_from_the_renderers_smaller_k_matches_its_pdf() {
+    for params in [ProductParams { brdf_samples: 16, ..ProductParams::default() }, ProductParams::for_mis(64)] {
+        let f = product_cases(params);
+        assert!(f.is_empty(), "K = {}: {}", params.brdf_samples, f.join("\n"));
+    }
+}
+
 /// Bilinear B̃: the density varies inside texels and leaves (linearly along each axis, so a
 /// dyadic cell's mass is still its centre's density times its area).
 #[test]

@@ -149,7 +149,7 @@ fn run(estimator: &str) {
             "product" | "wavelet" => product_units(estimator, &mut arena, &e, &case, &sp),
             "env" => env_units(&e, &case, &sp, &mut rng),
             "two-level" | "two-level-mis" => two_level_units(estimator, &e, &case, &sp, &mut rng),
-            "product-mis" | "product-mis probed" | "product-mis for_mis" => {
+            "product-mis" | "product-mis probed" | "product-mis for_mis" | "product-mis for_mis K=16" => {
                 product_mis_units(estimator, &mut arena, &e, &case, &sp)
             }
             "product-mis split 3:1" | "product-mis split 1:3" => {
@@ -235,6 +235,13 @@ fn product_mis_estimator_with_probed_leaves_is_unbiased() {
 #[test]
 fn product_mis_estimator_with_the_mis_preset_is_unbiased() {
     run("product-mis for_mis");
+}
+
+/// The same from 16 BRDF samples, the renderer's K for a diffuse BRDF (host-std
+/// `render::brdf_samples`): coarser trees, refined from 1/16 of the mass.
+#[test]
+fn product_mis_estimator_with_the_mis_preset_from_16_samples_is_unbiased() {
+    run("product-mis for_mis K=16");
 }
 
 /// MIS with three env samples to each BRDF sample.

@@ -8,6 +8,7 @@ use glam::Vec3;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Rendered, Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
 use sampler_core::brdf::Lambert;
@@ -19,7 +20,7 @@ fn run(scene: &Scene, env: &Environment, method: Method, spp: usize, brdf_sample
         method,
         spp,
         shading_points: 2,
-        brdf_samples,
+        brdf_samples: BrdfSamples::Fixed(brdf_samples),
         seed: 3,
         progress: false,
         shadows: true,

@@ -15,6 +15,7 @@ use glam::Vec3;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Settings, render};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, Scene};
 use host_std::trace::bvh::Bvh;
 use rayon::prelude::*;
@@ -47,7 +48,7 @@ fn renders(
                 method,
                 spp,
                 shading_points,
-                brdf_samples: 256,
+                brdf_samples: BrdfSamples::Fixed(256),
                 seed,
                 progress: false,
                 shadows: true,

@@ -14,7 +14,8 @@ pub struct Candidate {
     pub strategy: Strategy,
     /// Time per visibility sample relative to MIS's pairs at two samples per shading point,
     /// measured once over the benchmark scenes (docs/perf.md, "Cost per visibility sample"),
-    /// without [`build`](Self::build).
+    /// without [`build`](Self::build). Product-MIS's is measured at each material's K from its
+    /// lobes (`render::brdf_samples`); a K set for every material by `--brdf-samples` keeps it.
     pub cost: f64,
     /// Time of the sampler built at every shading point, in the unit of [`cost`](Self::cost)
     /// (0: no sampler is built per shading point — product-MIS's serves a pixel and its
@@ -37,8 +38,8 @@ pub const PLANS: [Candidate; 7] = [
     Candidate { strategy: Strategy::Brdf, cost: 0.78, build: 0.0 },
     Candidate { strategy: Strategy::Mis { env_share: 0.5 }, cost: 1.0, build: 0.0 },
     Candidate { strategy: Strategy::Mis { env_share: 0.75 }, cost: 1.0, build: 0.0 },
-    Candidate { strategy: Strategy::ProductMis { product_share: 0.5 }, cost: 1.8, build: 0.0 },
-    Candidate { strategy: Strategy::ProductMis { product_share: 0.75 }, cost: 2.07, build: 0.0 },
+    Candidate { strategy: Strategy::ProductMis { product_share: 0.5 }, cost: 1.45, build: 0.0 },
+    Candidate { strategy: Strategy::ProductMis { product_share: 0.75 }, cost: 1.67, build: 0.0 },
     Candidate {
         strategy: Strategy::TwoLevelMis { two_level_share: 0.5 },
         cost: TWO_LEVEL_MIS_COST,

@@ -15,6 +15,7 @@ pub use method::Method;
 use crate::cpu_time::process_cpu_time;
 use crate::light::baselines::{LightcutTable, sis_strata};
 use crate::light::lights::{LightOptions, LightTable};
+use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
@@ -35,8 +36,8 @@ pub struct Settings {
     pub spp: usize,
     /// Primary rays (shading points) per pixel; divides `spp`.
     pub shading_points: usize,
-    /// BRDF samples that build each product sampler.
-    pub brdf_samples: usize,
+    /// BRDF samples that build each material's product samplers.
+    pub brdf_samples: BrdfSamples,
     /// The seed every pixel's sequences derive from.
     pub seed: u64,
     /// Show a progress bar on stderr (after the first second).
@@ -55,7 +56,6 @@ impl Settings {
         Options {
             spp: self.spp,
             shading_points: self.shading_points,
-            brdf_samples: self.brdf_samples,
             seed: self.seed,
             progress: self.progress,
             shadows: self.shadows,
@@ -137,7 +137,7 @@ pub fn render_crop(
     let plans: Vec<MaterialPlan> = scene
         .materials
         .iter()
-        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf))
+        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf, settings.brdf_samples))
         .collect();
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));

@@ -10,6 +10,7 @@
 //! which tile. Each pixel gets P shading points (primary rays jittered uniformly inside the
 //! pixel: a box filter) and each shading point spp/P visibility samples.
 
+pub mod brdf_samples;
 pub mod crop;
 pub mod pixel;
 pub mod product_arena;
@@ -37,8 +38,6 @@ pub struct Options {
     pub spp: usize,
     /// Primary rays (shading points) per pixel; divides `spp`.
     pub shading_points: usize,
-    /// BRDF samples that build each product sampler.
-    pub brdf_samples: usize,
     /// The seed every pixel's sequences derive from.
     pub seed: u64,
     /// Show a progress bar on stderr (after the first second).

@@ -43,7 +43,7 @@ pub fn reuse_cosine(brdf: &dyn Brdf) -> f32 {
     (REUSE_SHARE * brdf.lobe_width().min(WIDEST_REUSED_LOBE)).cos()
 }
 
-/// The render's K is at most the largest arena's capacity: the command line checks it
+/// Every material's K is at most the largest arena's capacity: the command line checks it
 /// (`product_arena::check_brdf_samples`) before it renders.
 const BRDF_SAMPLES_FIT: &str = "--brdf-samples within the product arenas' capacity";
 
@@ -97,10 +97,10 @@ impl SamplerCache {
             Strategy::Brdf => Sampling::Brdf,
             Strategy::Mis { env_share } => Sampling::Mis { env_share },
             Strategy::Ris => Sampling::Ris,
-            Strategy::Product => Sampling::Product(self.product(ctx, env, ProductKind::QUADTREE, lead)),
-            Strategy::Wavelet => Sampling::Product(self.product(ctx, env, ProductKind::WAVELET, lead)),
+            Strategy::Product => Sampling::Product(self.product(env, plan, ProductKind::QUADTREE, lead)),
+            Strategy::Wavelet => Sampling::Product(self.product(env, plan, ProductKind::WAVELET, lead)),
             Strategy::ProductMis { product_share } => {
-                Sampling::ProductMis { sampler: self.shared_product(ctx, env, plan, lead), product_share }
+                Sampling::ProductMis { sampler: self.shared_product(env, plan, lead), product_share }
             }
             Strategy::TwoStage => {
                 let sat = ctx.sat.expect("the summed-area table is built when a material is sampled two-stage");
@@ -132,19 +132,20 @@ impl SamplerCache {
         arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect("the cones are of a level the map and the arena hold")
     }
 
-    /// A product sampler of the paper's estimator, built for `lead` alone.
+    /// A product sampler of the paper's estimator, built for `lead` alone from its material's K.
     fn product<'s, 'e>(
         &'s mut self,
-        ctx: &Context<'s, 'e>,
         env: &'s EnvHierarchy<'e>,
+        plan: &MaterialPlan,
         kind: ProductKind,
         lead: &Lead<'_>,
     ) -> ProductSampler<'s, 'e> {
-        let params = ProductParams { brdf_samples: ctx.options.brdf_samples, kind, ..ProductParams::default() };
-        let arena = match &mut self.arena {
-            Some(arena) => arena,
-            empty => empty.insert(SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT)),
-        };
+        let params = ProductParams { brdf_samples: plan.brdf_samples, kind, ..ProductParams::default() };
+        // Materials of different K share the arena: it grows when one needs more.
+        if self.arena.as_ref().is_none_or(|a| a.capacity() < params.brdf_samples) {
+            self.arena = Some(SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT));
+        }
+        let arena = self.arena.as_mut().expect("sized above");
         let sp = lead.sp;
         arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT)
     }
@@ -153,7 +154,6 @@ impl SamplerCache {
     /// material's reuse angle (and the material is not textured), otherwise built anew and kept.
     fn shared_product<'s, 'e>(
         &'s mut self,
-        ctx: &Context<'s, 'e>,
         env: &'s EnvHierarchy<'e>,
         plan: &MaterialPlan,
         lead: &Lead<'_>,
@@ -164,7 +164,7 @@ impl SamplerCache {
         let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
         let slot = &mut self.shared[hit.material];
         if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
-            let params = ProductParams::for_mis(ctx.options.brdf_samples);
+            let params = ProductParams::for_mis(plan.brdf_samples);
             let c = match &mut *slot {
                 Some(c) => c,
                 empty => {

@@ -2,6 +2,7 @@
 //! `plan`): the strategy, with the share of the budget a two-technique strategy spends on its
 //! first technique.
 
+use crate::render::brdf_samples::BrdfSamples;
 use crate::render::sampler_cache::reuse_cosine;
 use crate::scene::Bsdf;
 
@@ -73,12 +74,15 @@ pub struct MaterialPlan {
     /// Cosine of the angle within which a product-MIS sampler is reused (see
     /// [`reuse_cosine`]).
     pub reuse_cosine: f32,
+    /// BRDF samples its product samplers are built from.
+    pub brdf_samples: usize,
 }
 
 impl MaterialPlan {
-    /// The plan that samples `bsdf` with `strategy`.
+    /// The plan that samples `bsdf` with `strategy`, its product samplers built from
+    /// `brdf_samples`' K for it.
     #[must_use]
-    pub fn new(strategy: Strategy, bsdf: &Bsdf) -> Self {
-        Self { strategy, reuse_cosine: reuse_cosine(bsdf.as_brdf()) }
+    pub fn new(strategy: Strategy, bsdf: &Bsdf, brdf_samples: BrdfSamples) -> Self {
+        Self { strategy, reuse_cosine: reuse_cosine(bsdf.as_brdf()), brdf_samples: brdf_samples.for_bsdf(bsdf) }
     }
 }

@@ -20,6 +20,7 @@ pub use series::Series;
 pub use tables::{csv, markdown, relmse_at};
 
 use crate::plan::{self, Method, Settings, ShadingPoints};
+use crate::render::brdf_samples::BrdfSamples;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
@@ -128,7 +129,7 @@ pub fn sweep(
         method: series.method,
         spp,
         shading_points: points.resolve(series.method, spp),
-        brdf_samples: series.brdf_samples.unwrap_or(base.brdf_samples),
+        brdf_samples: series.brdf_samples.map_or(base.brdf_samples, BrdfSamples::Fixed),
         ..*base
     };
     let mut measure = |series: Series, spp: usize| {

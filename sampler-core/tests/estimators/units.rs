@@ -97,7 +97,7 @@ pub(super) fn two_level_units(
         .collect()
 }
 
-/// Product-MIS at one case with the default, probed or `for_mis` settings.
+/// Product-MIS at one case with the default, probed or `for_mis` settings (at K = 256, or 16).
 pub(super) fn product_mis_units(
     estimator: &str,
     arena: &mut ProductArena,
@@ -112,6 +112,7 @@ pub(super) fn product_mis_units(
             ..ProductParams::default()
         },
         "product-mis for_mis" => ProductParams::for_mis(256),
+        "product-mis for_mis K=16" => ProductParams::for_mis(16),
         _ => ProductParams::default(),
     };
     (0..600u64)
@@ -120,7 +121,7 @@ pub(super) fn product_mis_units(
             let (mut pts, mut qts) = ([DVec2::ZERO; 32], [DVec2::ZERO; 32]);
             sobol02(seed ^ 0xdef, 0, &mut pts);
             sobol02(seed ^ 0x123, 0, &mut qts);
-            if estimator == "product-mis for_mis" {
+            if estimator.starts_with("product-mis for_mis") {
                 // The renderer's batched path.
                 let mut pairs = [[estimator::Contribution::default(); 2]; 32];
                 let q = qts.map(|q| q.as_vec2());

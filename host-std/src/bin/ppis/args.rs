@@ -3,6 +3,7 @@
 use clap::Args;
 use host_std::light::lights::{LightOptions, LightSelection};
 use host_std::plan::Method;
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::Scene;
 use std::path::PathBuf;
 
@@ -171,6 +172,15 @@ impl SamplingArgs {
 pub(crate) fn check_brdf_samples(brdf_samples: u32) -> anyhow::Result<()> {
     host_std::render::product_arena::check_brdf_samples(brdf_samples as usize)
         .map_err(|e| anyhow::anyhow!("--brdf-samples {brdf_samples}: {e}"))
+}
+
+/// The render's K: `--brdf-samples` for every material, checked, or without it each
+/// material's from its lobes.
+pub(crate) fn brdf_samples(given: Option<u32>) -> anyhow::Result<BrdfSamples> {
+    match given {
+        Some(k) => check_brdf_samples(k).map(|()| BrdfSamples::Fixed(k as usize)),
+        None => Ok(BrdfSamples::PerLobe),
+    }
 }
 
 pub(crate) fn parse_method(s: &str) -> Result<Method, String> {

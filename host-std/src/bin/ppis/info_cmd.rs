@@ -15,6 +15,7 @@ use host_std::plan::rules::{
     AUTO_DIFFUSE_ENV_SHARE, PRODUCT_ALPHA, PRODUCT_ALPHA_EXTENDED, SMOOTH_LIGHTING_PEAK, SUN_PEAK, WIDE_LOBE,
     WIDE_LOBE_PRODUCT_SHARE,
 };
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
 use sampler_core::light::{Light, SceneLight};
@@ -70,7 +71,10 @@ fn print_scene(scene: &Scene) {
     );
     println!("objects: {} ({} triangles)", scene.objects.len(), scene.triangle_count());
     for (i, m) in scene.materials.iter().enumerate() {
-        println!("  material {i}: {}{}", m.bsdf.kind(), if m.twosided { ", two-sided" } else { "" });
+        let twosided = if m.twosided { ", two-sided" } else { "" };
+        // The K a render without --brdf-samples builds its product samplers from.
+        let k = BrdfSamples::PerLobe.for_bsdf(&m.bsdf);
+        println!("  material {i}: {}{twosided} (product samplers from {k} BRDF samples)", m.bsdf.kind());
     }
     print_lights(scene);
     match &scene.env {

@@ -1,7 +1,7 @@
 //! `ppis render`: one scene, one method, to a linear EXR, an sRGB PNG and optionally the
 //! stats JSON; with `--crop`, a part of the frame (a tile for `ppis merge`).
 
-use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, check_brdf_samples, parse_method};
+use crate::args::{MAX_SPP, SamplingArgs, SceneArgs, brdf_samples, parse_method};
 use crate::load::{load_scene, warn_notes};
 use crate::provenance;
 use crate::stats::Stats;
@@ -30,9 +30,11 @@ pub(crate) struct RenderArgs {
     /// Visibility samples (shadow rays) per pixel.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub(crate) spp: u32,
-    /// BRDF samples per product sampler (the paper's K; at most 1024).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
-    pub(crate) brdf_samples: u32,
+    /// BRDF samples per product sampler (the paper's K; at most 1024), for every material.
+    /// Default: each material's from its lobes — 16 diffuse, 64 one glossy lobe, 128 layered
+    /// (docs/tuning.md, "BRDF samples per sampler at equal time").
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub(crate) brdf_samples: Option<u32>,
     #[command(flatten)]
     pub(crate) sampling: SamplingArgs,
     /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
@@ -70,7 +72,7 @@ pub(crate) struct Prepared {
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
-    check_brdf_samples(args.brdf_samples)?;
+    let brdf_samples = brdf_samples(args.brdf_samples)?;
     let shading_points = match args.sampling.shading_points {
         Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
         Some(p) => p,
@@ -85,7 +87,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         method: args.method,
         spp: args.spp as usize,
         shading_points: shading_points as usize,
-        brdf_samples: args.brdf_samples as usize,
+        brdf_samples,
         seed: args.sampling.seed,
         progress: true,
         shadows: !args.sampling.unshadowed,

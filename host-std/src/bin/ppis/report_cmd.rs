@@ -8,6 +8,7 @@ use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{self, Settings, ShadingPoints};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::report::{Clock, KSweep, Series, Timing};
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
@@ -25,10 +26,11 @@ pub(crate) struct ReportArgs {
     /// Comma-separated visibility samples per pixel.
     #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     spp: Vec<u32>,
-    /// Comma-separated BRDF samples per product sampler (the paper's K; each at most 1024).
-    /// More than one: the methods that build product samplers are rendered at each, and the
-    /// report adds relMSE at equal time against K (error_vs_k.csv, .md, .svg, .png).
-    #[arg(long, default_value = "256", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..))]
+    /// Comma-separated BRDF samples per product sampler (the paper's K; each at most 1024),
+    /// for every material. More than one: the methods that build product samplers are
+    /// rendered at each, and the report adds relMSE at equal time against K (error_vs_k.csv,
+    /// .md, .svg, .png). Default: each material's K from its lobes, as `render`'s.
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..))]
     brdf_samples: Vec<u32>,
     /// Reference image (linear EXR of the same size); otherwise one is rendered.
     #[arg(long, conflicts_with = "reference_spp")]
@@ -75,6 +77,15 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
     ks.sort_unstable();
     ks.dedup();
     let reference_k = report::reference_k(&ks);
+    // One K or none: every series at the render's K (the one given, or each material's).
+    let render_k = match ks.as_slice() {
+        [] => BrdfSamples::PerLobe,
+        [k] => BrdfSamples::Fixed(*k),
+        _ => BrdfSamples::Fixed(reference_k),
+    };
+    if ks.is_empty() {
+        ks.push(reference_k);
+    }
     let base_method = match args.base {
         Some(b) if !args.methods.contains(&b) => bail!("--base {b} is not among --methods"),
         Some(b) => b,
@@ -117,7 +128,7 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         method: Method::Product,
         spp: 1,
         shading_points: 1,
-        brdf_samples: reference_k,
+        brdf_samples: render_k,
         seed: args.sampling.seed,
         progress: false,
         shadows: !args.sampling.unshadowed,

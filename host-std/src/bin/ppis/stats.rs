@@ -13,7 +13,8 @@ use std::collections::BTreeMap;
 pub(crate) struct Stats {
     /// `auto`: per material its pilot's plan and scores (empty otherwise).
     auto_plans: Vec<AutoPlan>,
-    brdf_samples: u32,
+    /// `--brdf-samples`: every material's K (`null`: each material's from its lobes).
+    brdf_samples: Option<u32>,
     /// The process's CPU seconds (every thread) building the BVH.
     bvh_cpu_seconds: Option<f64>,
     bvh_seconds: f64,
