@@ -104,6 +104,23 @@ impl Method {
     /// hundred shadow rays and BRDF evaluations) and `ppis report`'s spp range suits them too.
     #[must_use]
     pub fn samples_per_point(self) -> usize {
+        self.samples_per_point_under(Lighting::OneKind)
+    }
+
+    /// [`samples_per_point`](Self::samples_per_point) under `lighting`: where an environment
+    /// and other lights share each shading point, the MIS methods and `auto` take four times
+    /// their pairs, since each part gets its own (at four, one pair each; docs/tuning.md,
+    /// "Samples per shading point with an environment and lights").
+    #[must_use]
+    pub fn samples_per_point_under(self, lighting: Lighting) -> usize {
+        match (self, lighting) {
+            (Method::Mis | Method::ProductMis | Method::Auto, Lighting::EnvironmentAndLights) => 16,
+            _ => self.base_samples_per_point(),
+        }
+    }
+
+    /// The light samples per shading point under one kind of light.
+    fn base_samples_per_point(self) -> usize {
         match self {
             Method::Env | Method::Brdf | Method::Ris => 1,
             Method::Sis | Method::Lightcuts => 64,
@@ -201,5 +218,22 @@ pub fn strategy_name(strategy: Strategy) -> String {
             format!("{name} {}:{}", (split * 4.0).round(), ((1.0 - split) * 4.0).round())
         }
         _ => name.to_string(),
+    }
+}
+
+/// What lights a scene holds, as far as the budget per shading point is concerned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lighting {
+    /// An environment alone, or other lights alone.
+    OneKind,
+    /// An environment and other lights, each shading point sampling both.
+    EnvironmentAndLights,
+}
+
+impl Lighting {
+    /// The lighting of a scene with `lights` other lights, with or without an environment.
+    #[must_use]
+    pub fn of(environment: bool, lights: usize) -> Self {
+        if environment && lights > 0 { Lighting::EnvironmentAndLights } else { Lighting::OneKind }
     }
 }

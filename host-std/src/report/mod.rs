@@ -19,6 +19,7 @@ pub use plot::plot;
 pub use series::Series;
 pub use tables::{csv, markdown, relmse_at};
 
+use crate::plan::method::Lighting;
 use crate::plan::{self, Method, Settings, ShadingPoints};
 use crate::render::brdf_samples::BrdfSamples;
 use crate::scene::Scene;
@@ -125,10 +126,11 @@ pub fn sweep(
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
+    let lighting = Lighting::of(env.is_some(), scene.lights.len());
     let settings = |series: Series, spp: usize| Settings {
         method: series.method,
         spp,
-        shading_points: points.resolve(series.method, spp),
+        shading_points: points.resolve(series.method, spp, lighting),
         brdf_samples: series.brdf_samples.map_or(base.brdf_samples, BrdfSamples::Fixed),
         ..*base
     };

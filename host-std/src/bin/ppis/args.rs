@@ -59,7 +59,8 @@ fn parse_frame(text: &str) -> Result<String, String> {
 pub(crate) struct SamplingArgs {
     /// Primary rays (shading points) per pixel, each spending spp/P visibility samples
     /// [default: spp over the method's light samples per shading point — two pairs for the
-    /// MIS methods, one for env, brdf and ris, more for the samplers built per shading point].
+    /// MIS methods (eight under an environment and other lights), one for env, brdf and ris,
+    /// more for the samplers built per shading point].
     /// `render`: a P given must divide --spp; `report`: reduced to a divisor of each spp.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) shading_points: Option<u32>,

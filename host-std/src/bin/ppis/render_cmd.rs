@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::output;
+use host_std::plan::method::Lighting;
 use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
 use host_std::render::crop::Crop;
 use host_std::scene::Scene;
@@ -73,16 +74,21 @@ pub(crate) struct Prepared {
 
 pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let brdf_samples = brdf_samples(args.brdf_samples)?;
-    let shading_points = match args.sampling.shading_points {
-        Some(p) if !args.spp.is_multiple_of(p) => bail!("--shading-points {p} must divide --spp {}", args.spp),
-        Some(p) => p,
-        None => ShadingPoints::Rule.resolve(args.method, args.spp as usize) as u32,
-    };
+    if let Some(p) = args.sampling.shading_points
+        && !args.spp.is_multiple_of(p)
+    {
+        bail!("--shading-points {p} must divide --spp {}", args.spp);
+    }
     let (exr_path, png_path) = output_paths(&args)?;
     let threads = args.sampling.threads();
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
     let prepared = prepare(&args, &pool)?;
+    let lighting = Lighting::of(prepared.environment.is_some(), prepared.scene.lights.len());
+    let shading_points = match args.sampling.shading_points {
+        Some(p) => p,
+        None => ShadingPoints::Rule.resolve(args.method, args.spp as usize, lighting) as u32,
+    };
     let settings = Settings {
         method: args.method,
         spp: args.spp as usize,

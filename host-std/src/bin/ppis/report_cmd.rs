@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
+use host_std::plan::method::Lighting;
 use host_std::plan::{self, Settings, ShadingPoints};
 use host_std::render::brdf_samples::BrdfSamples;
 use host_std::report::{Clock, KSweep, Series, Timing};
@@ -192,7 +193,11 @@ fn render_reference(
     let settings = Settings {
         method: args.reference_method,
         spp,
-        shading_points: shading_points(args).resolve(args.reference_method, spp),
+        shading_points: shading_points(args).resolve(
+            args.reference_method,
+            spp,
+            Lighting::of(hierarchy.is_some(), scene.lights.len()),
+        ),
         seed: args.sampling.seed ^ 0x0005_eed0_f4ef,
         progress: true,
         ..*base
