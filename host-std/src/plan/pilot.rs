@@ -28,7 +28,7 @@
 //! miss the sun), and those few pixels carry most of the image's error: a pilot of a few dozen
 //! pixels rarely holds one, so it finds env sampling better than it is. Env-only sampling
 //! therefore replaces the rules' plan only where it scores [`OVERRIDE_MARGIN`]× better than
-//! every plan with BRDF samples too ([`decide`]; docs/perf.md, "`auto` and its pilot"). A plan
+//! every plan with BRDF samples too (`decide`; docs/perf.md, "`auto` and its pilot"). A plan
 //! that builds a sampler per shading point (two-level-MIS) competes only where the render's
 //! samples per shading point let it repay its build ([`affordable`]): elsewhere the pilot
 //! is the pilot without it, at no cost.
