@@ -104,7 +104,14 @@ impl Method {
     /// hundred shadow rays and BRDF evaluations) and `ppis report`'s spp range suits them too.
     #[must_use]
     pub fn samples_per_point(self) -> usize {
-        self.samples_per_point_under(Lighting::OneKind)
+        match self {
+            Method::Env | Method::Brdf | Method::Ris => 1,
+            Method::Sis | Method::Lightcuts => 64,
+            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
+            Method::TwoLevel => 2,
+            Method::TwoStage => 4,
+            Method::Product | Method::Wavelet => 16,
+        }
     }
 
     /// [`samples_per_point`](Self::samples_per_point) under `lighting`: where an environment
@@ -115,19 +122,7 @@ impl Method {
     pub fn samples_per_point_under(self, lighting: Lighting) -> usize {
         match (self, lighting) {
             (Method::Mis | Method::ProductMis | Method::Auto, Lighting::EnvironmentAndLights) => 16,
-            _ => self.base_samples_per_point(),
-        }
-    }
-
-    /// The light samples per shading point under one kind of light.
-    fn base_samples_per_point(self) -> usize {
-        match self {
-            Method::Env | Method::Brdf | Method::Ris => 1,
-            Method::Sis | Method::Lightcuts => 64,
-            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
-            Method::TwoLevel => 2,
-            Method::TwoStage => 4,
-            Method::Product | Method::Wavelet => 16,
+            _ => self.samples_per_point(),
         }
     }
 
