@@ -5,6 +5,7 @@
 
 pub mod budget;
 pub mod candidates;
+mod decision;
 pub mod method;
 pub mod pilot;
 pub mod rules;
