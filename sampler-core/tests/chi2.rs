@@ -78,10 +78,14 @@ fn env_sampler_matches_its_pdf() {
         ("1x1", TestEnv::constant(0, 2.0)),
         ("2x2", TestEnv::new(1, vec![[1.0; 3], [0.0; 3], [5.0; 3], [0.5; 3]])),
     ];
-    let alpha = sidak(2 * envs.len());
-    let views = envs
-        .iter()
-        .flat_map(|(name, env)| [(name.to_string(), env.view()), (format!("{name}, table"), env.table_view())]);
+    let alpha = sidak(3 * envs.len());
+    let views = envs.iter().flat_map(|(name, env)| {
+        [
+            (name.to_string(), env.view()),
+            (format!("{name}, table"), env.table_view()),
+            (format!("{name}, compensated"), env.compensated_view()),
+        ]
+    });
     for (name, e) in views {
         let r = chi_square_dyadic(
             SAMPLES,

@@ -95,7 +95,7 @@ impl SamplerCache {
         match plan.strategy {
             Strategy::Env => Sampling::Env,
             Strategy::Brdf => Sampling::Brdf,
-            Strategy::Mis { env_share } => Sampling::Mis { env_share },
+            Strategy::Mis { env_share } => Sampling::Mis { env_share, sampler: env.compensated() },
             Strategy::Ris => Sampling::Ris,
             Strategy::Product => Sampling::Product(self.product(env, plan, ProductKind::QUADTREE, lead)),
             Strategy::Wavelet => Sampling::Product(self.product(env, plan, ProductKind::WAVELET, lead)),

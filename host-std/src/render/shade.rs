@@ -49,6 +49,9 @@ pub enum Sampling<'s, 'e> {
     Mis {
         /// Share of the budget spent on env samples; ½ spends it in pairs.
         env_share: f64,
+        /// The environment's view the env samples draw from: its MIS-compensated density
+        /// ([`EnvHierarchy::compensated`]).
+        sampler: EnvHierarchy<'e>,
     },
     /// Resampled importance sampling.
     Ris,
@@ -102,13 +105,15 @@ pub fn shade<B: Brdf + ?Sized>(
     let budget = budget.max(1);
     match sampling {
         Sampling::ProductMis { sampler, product_share } => shade_split(sampler, sp, budget, *product_share, run, vis),
-        Sampling::Mis { env_share } if *env_share != 0.5 => shade_split(env, sp, budget, *env_share, run, vis),
+        Sampling::Mis { env_share, sampler } if *env_share != 0.5 => {
+            shade_split(sampler, sp, budget, *env_share, run, vis)
+        }
         Sampling::TwoLevelMis { sampler, two_level_share } if *two_level_share != 0.5 => {
             shade_split(sampler, sp, budget, *two_level_share, run, vis)
         }
         Sampling::TwoLevelMis { sampler, .. } => sampled_pairs(sampler, sp, (budget / 2).max(1), run, vis),
         Sampling::TwoLevel(sampler) => sampled_only(sampler, sp, budget, run, vis),
-        Sampling::Mis { .. } => sampled_pairs(env, sp, (budget / 2).max(1), run, vis),
+        Sampling::Mis { sampler, .. } => sampled_pairs(sampler, sp, (budget / 2).max(1), run, vis),
         Sampling::Env => sampled_only(env, sp, budget, run, vis),
         Sampling::Brdf => brdf_only(env, sp, budget, run, vis),
         Sampling::Ris => ris(env, sp, budget, run, vis),

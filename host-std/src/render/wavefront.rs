@@ -51,11 +51,11 @@ fn layout(sampling: &Sampling<'_, '_>, budget: usize) -> Option<Layout> {
     match *sampling {
         Sampling::Env => fits(budget).then_some(Layout::Single { technique: Technique::Sampler, n: budget }),
         Sampling::Brdf => fits(budget).then_some(Layout::Single { technique: Technique::Brdf, n: budget }),
-        Sampling::Mis { env_share: 0.5 } => {
+        Sampling::Mis { env_share: 0.5, .. } => {
             let n = (budget / 2).max(1);
             fits(n).then_some(Layout::Pairs { n })
         }
-        Sampling::Mis { env_share } => split(env_share),
+        Sampling::Mis { env_share, .. } => split(env_share),
         Sampling::ProductMis { product_share, .. } => split(product_share),
         _ => None,
     }
@@ -132,6 +132,9 @@ pub(crate) fn shade_wavefront(
     buffers.candidates.resize(buffers.samples.len(), Candidate::default());
     match sampling {
         Sampling::ProductMis { sampler, .. } => {
+            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
+        }
+        Sampling::Mis { sampler, .. } => {
             wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
         }
         _ => wavefront(env, points, &buffers.samples, weighting, &mut buffers.candidates),

@@ -10,40 +10,48 @@ use crate::mapping::{
 use crate::prefetch::prefetch;
 use glam::{Mat3, Vec2, Vec3};
 
+/// 1 / the pyramid's mean importance (its root), or 0 for a black map.
+pub(super) fn inverse_mean(pyramid: &[f32]) -> Result<f32, EnvError> {
+    let mean = pyramid[0];
+    if !mean.is_finite() || mean < 0.0 {
+        return Err(EnvError::NotSanitized);
+    }
+    let inv_mean = if mean > 0.0 { 1.0 / mean } else { 0.0 };
+    Ok(if inv_mean.is_finite() { inv_mean } else { 0.0 })
+}
+
 /// Borrowed view over a sanitized environment pyramid, with an optional world rotation.
 #[derive(Clone, Copy, Debug)]
 pub struct EnvHierarchy<'a> {
     pub(crate) finest: u32,
     pub(crate) pyramid: &'a [f32],
-    radiance: &'a [[f32; 3]],
+    pub(super) radiance: &'a [[f32; 3]],
     /// 1 / mean importance, or 0 for a black map.
-    inv_mean: f32,
+    pub(super) inv_mean: f32,
     tint: Vec3,
     world_to_map: Mat3,
     map_to_world: Mat3,
     /// The texel table env-only sampling uses instead of the descent, when attached.
     pub(crate) cdf: Option<TexelCdf<'a>>,
+    /// The MIS-compensated pyramid ([`compensate_pyramid`](super::compensate_pyramid)), when
+    /// attached.
+    pub(super) compensated: Option<&'a [f32]>,
 }
 
 impl<'a> EnvHierarchy<'a> {
     /// A view over `pyramid` (filled by [`build_pyramid`](super::build_pyramid)) and the finest-level `radiance`.
     pub fn new(finest: u32, pyramid: &'a [f32], radiance: &'a [[f32; 3]]) -> Result<Self, EnvError> {
         check_lengths(finest, radiance.len(), pyramid.len())?;
-        let mean = pyramid[0];
-        if !mean.is_finite() || mean < 0.0 {
-            return Err(EnvError::NotSanitized);
-        }
-        let inv_mean = if mean > 0.0 { 1.0 / mean } else { 0.0 };
-        let inv_mean = if inv_mean.is_finite() { inv_mean } else { 0.0 };
         Ok(Self {
             finest,
             pyramid,
             radiance,
-            inv_mean,
+            inv_mean: inverse_mean(pyramid)?,
             tint: Vec3::ONE,
             world_to_map: Mat3::IDENTITY,
             map_to_world: Mat3::IDENTITY,
             cdf: None,
+            compensated: None,
         })
     }
 

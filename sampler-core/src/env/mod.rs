@@ -14,14 +14,17 @@
 //!
 //! The pyramid's layout and builders are in `pyramid.rs`, the view over it in `hierarchy.rs`,
 //! env-only sampling in `sample.rs` and the same four descents at a time in `lanes.rs`; with a
-//! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent.
+//! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent. MIS with BRDF
+//! samples draws from a compensated pyramid (`compensation.rs`) where one is attached.
 
+mod compensation;
 mod hierarchy;
 mod lanes;
 mod pyramid;
 mod sample;
 mod texel_cdf;
 
+pub use compensation::compensate_pyramid;
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::{LANES, WarpLane};
 pub use pyramid::{

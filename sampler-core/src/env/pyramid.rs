@@ -124,7 +124,7 @@ pub fn build_pyramid_from_importance(finest: u32, importance: &[f32], pyramid: &
 /// Fills levels `finest − 1 … 0` from the finest level: in Morton order the four children of
 /// node `i` are `4i .. 4i + 4` of the next level. Accumulated in f64 so that radiances up to
 /// f32::MAX do not overflow.
-fn fill_pyramid(finest: u32, pyramid: &mut [f32]) {
+pub(super) fn fill_pyramid(finest: u32, pyramid: &mut [f32]) {
     for level in (0..finest).rev() {
         let (coarse, fine) = pyramid.split_at_mut(level_offset(level + 1));
         let coarse = &mut coarse[level_offset(level)..];

@@ -2,7 +2,8 @@
 
 use glam::{Vec2, Vec3};
 use sampler_core::env::{
-    CDF_MAX_LEVEL, EnvHierarchy, TexelCdf, build_pyramid, build_texel_cdf, pyramid_len, texel_cdf_len, texel_guide_len,
+    CDF_MAX_LEVEL, EnvHierarchy, TexelCdf, build_pyramid, build_texel_cdf, compensate_pyramid, pyramid_len,
+    texel_cdf_len, texel_guide_len,
 };
 use sampler_core::mapping::square_to_sphere;
 use sampler_core::rng::Pcg32;
@@ -15,6 +16,8 @@ pub struct TestEnv {
     /// The texel table and its guide (env-only sampling without the descent).
     pub ends: Vec<u32>,
     pub guide: Vec<u32>,
+    /// The pyramid compensated for MIS, where anything of the map stands above its mean.
+    pub compensated: Option<Vec<f32>>,
 }
 
 impl TestEnv {
@@ -27,7 +30,9 @@ impl TestEnv {
             guide = vec![0; texel_guide_len(level)];
             build_texel_cdf(level, &pyramid, &mut ends, &mut guide).unwrap();
         }
-        Self { level, rgb, pyramid, ends, guide }
+        let mut compensated = vec![0.0; pyramid.len()];
+        let compensated = compensate_pyramid(level, &pyramid, &mut compensated).unwrap().then_some(compensated);
+        Self { level, rgb, pyramid, ends, guide, compensated }
     }
 
     pub fn view(&self) -> EnvHierarchy<'_> {
@@ -39,6 +44,16 @@ impl TestEnv {
     pub fn table_view(&self) -> EnvHierarchy<'_> {
         let cdf = TexelCdf::new(self.level, &self.ends, &self.guide).unwrap();
         self.view().with_texel_cdf(cdf).unwrap()
+    }
+
+    /// [`view`](Self::view)'s MIS view: sampled by the compensated pyramid, as the renderer's
+    /// MIS samples it (the plain pyramid where nothing stands above the mean).
+    #[allow(dead_code)]
+    pub fn compensated_view(&self) -> EnvHierarchy<'_> {
+        match &self.compensated {
+            Some(c) => self.view().with_compensated(c).unwrap().compensated(),
+            None => self.view(),
+        }
     }
 
     /// Smooth random sky: a few random lobes over a dim floor, coloured.
