@@ -23,7 +23,7 @@ struct TreeLane {
     index: usize,
     /// The node's cell.
     cell: Cell,
-    /// Probability of the path (the leaf's, once there).
+    /// Probability of the path so far (the leaf's, once there).
     path: f64,
     xi: DVec2,
     /// Drawn by the defensive environment part of the mixture: no tree descent.
@@ -101,7 +101,7 @@ impl ProductSampler<'_, '_> {
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.in_tree) {
                 if lane.node.is_leaf() {
-                    (lane.in_tree, lane.path) = (false, self.paths[lane.index]);
+                    lane.in_tree = false;
                     continue;
                 }
                 busy = true;
@@ -113,6 +113,7 @@ impl ProductSampler<'_, '_> {
                     continue;
                 };
                 (lane.node, lane.index, lane.cell) = (c[k], first + k, lane.cell.child(k));
+                lane.path *= self.branches[first + k];
             }
             if !busy {
                 return;
@@ -148,6 +149,8 @@ struct PdfLane {
     /// The point's 24-bit coordinates.
     qx: u32,
     qy: u32,
+    /// Probability of the path so far.
+    path: f64,
 }
 
 impl ProductSampler<'_, '_> {
@@ -167,7 +170,7 @@ impl ProductSampler<'_, '_> {
             let n = us.len().min(os.len());
             let mut lanes = [PdfLane::default(); LANES];
             for (lane, uv) in lanes.iter_mut().zip(&us[..n]) {
-                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), ..*lane };
+                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), path: 1.0, ..*lane };
             }
             loop {
                 let mut busy = false;
@@ -178,6 +181,7 @@ impl ProductSampler<'_, '_> {
                     lane.index = lane.node.child as usize + k;
                     lane.node = self.nodes[lane.index];
                     lane.cell = lane.cell.child(k);
+                    lane.path *= self.branches[lane.index];
                 }
                 if !busy {
                     break;
@@ -185,7 +189,7 @@ impl ProductSampler<'_, '_> {
             }
             for ((o, l), uv) in os.iter_mut().zip(&lanes[..n]).zip(us) {
                 let texel = self.env.texel_relative(*uv);
-                *o = self.mixture(self.leaf_density(self.paths[l.index], l.cell, texel), texel);
+                *o = self.mixture(self.leaf_density(l.path, l.cell, texel), texel);
             }
         }
     }

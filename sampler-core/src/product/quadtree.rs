@@ -15,10 +15,12 @@
 //!   the product's mass are split further, B probed at each new child's centre: the samples
 //!   place leaves where B is large, the refinement where B̃·L is (a sun in a lobe's tail).
 //! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
-//!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
+//!   own mean, and beside it (in `branches`) the probability that the warp picks it among its
+//!   siblings, computed where the siblings' products are (a descent multiplies them); the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
 //!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`). What B̃ is in a leaf is
 //!   [`Leaves`]; the combinations that exist are the variants of [`ProductKind`].
 
+use super::arena::branch_probabilities;
 pub use super::params::{Leaves, ProductKind};
 use crate::bilinear::{self, Corners};
 use crate::cell::Cell;
@@ -34,6 +36,11 @@ pub const FILL_PRIOR: f32 = 2.0;
 
 /// Samples in a parent from which an empty child's B̃ also looks at B at its centre.
 pub const EVAL_EMPTY_FROM: usize = 4;
+
+/// More than the rounding error that subnormal products can add to a subtree's mass over the
+/// depth cap's levels (each ≤ 2⁻¹⁴⁹): `refine` passes by a subtree only when its mass is this
+/// far below the limit.
+const SUBNORMAL_SLACK: f32 = 1e-36;
 
 /// Samples in a node from which its split searches for its children's bounds instead of counting.
 const SEARCH_FROM: usize = 32;
@@ -120,6 +127,9 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     pub values: &'b [f32],
     pub env: &'b EnvHierarchy<'e>,
     pub nodes: &'b mut Vec<Node, NODES>,
+    /// Per node, its branch probability among its siblings (`branch_probabilities`; at least
+    /// NODES long).
+    pub branches: &'b mut [f64],
     pub max_depth: u32,
     /// Internal nodes by the Haar wavelet product instead of the average.
     pub wavelet: bool,
@@ -168,6 +178,14 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let (node, depth) = (self.nodes[index], cell.level);
         // A node's mass: its mean over the cell times the cell's area 4^-depth.
         let mass = node.product * f32::from_bits((127 - 2 * depth.min(63)) << 23);
+        // A subtree no heavier than the limit holds no leaf above it, and passing it by leaves
+        // its products as they are: a node's mass is the sum of its children's (non-negative
+        // terms, whose float sum is never below any one of them, scaled by powers of two),
+        // up to the rounding of subnormal products, which `SUBNORMAL_SLACK` covers. NaN and ∞
+        // never pass, and reach their leaves.
+        if mass + SUBNORMAL_SLACK <= limit {
+            return node.product;
+        }
         // Not below the map's finest level: there L is one texel's, and where B varies faster
         // than that the samples have split already.
         let deepest = self.max_depth.min(self.env.finest_level());
@@ -197,6 +215,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         }
         let product = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
         set(&mut self.nodes[index], first as u32, product);
+        self.branches[first..first + 4].copy_from_slice(&branch_probabilities(p));
         product
     }
 
@@ -263,6 +282,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let mean_b = 0.25 * ((b[0] + b[1]) + (b[2] + b[3]));
         let product = if self.wavelet { haar_product_mean(b, l, p) } else { 0.25 * ((p[0] + p[1]) + (p[2] + p[3])) };
         set(&mut self.nodes[index], first as u32, product);
+        self.branches[first..first + 4].copy_from_slice(&branch_probabilities(p));
         (mean_b, product)
     }
 
