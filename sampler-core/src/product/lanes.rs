@@ -1,4 +1,4 @@
-//! Product descents side by side: many points warped [`LANES`] at a time, branch-free within a
+//! Product descents side by side: many points warped [`WARPS`] at a time, branch-free within a
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
 //! waiting on its own mispredicted branches.
 //!
@@ -14,6 +14,11 @@ use crate::env::{LANES, WarpLane};
 use crate::mapping::SPHERE_AREA;
 use crate::warp::{ONE_MINUS_EPSILON, choose_child_branchless};
 use glam::{DVec2, Vec2, Vec3};
+
+/// Product samples drawn side by side: a renderer's batch (`estimator::BATCH`) in one go, so
+/// that the environment's descents below the leaves, whose loads miss the caches at large maps,
+/// all have theirs in flight together (twice the environment's own [`LANES`]).
+const WARPS: usize = 2 * LANES;
 
 /// One descent through the product tree.
 #[derive(Clone, Copy, Default)]
@@ -48,9 +53,9 @@ impl ProductSampler<'_, '_> {
         }
         let eps = self.defensive as f64;
         let root = self.nodes.first().copied().unwrap_or_default();
-        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        for (us, os) in u.chunks(WARPS).zip(out.chunks_mut(WARPS)) {
             let n = us.len().min(os.len());
-            let mut tree = [TreeLane::default(); LANES];
+            let mut tree = [TreeLane::default(); WARPS];
             for (lane, u) in tree.iter_mut().zip(&us[..n]) {
                 let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
                 let defensive = xi.x < eps;
@@ -64,30 +69,30 @@ impl ProductSampler<'_, '_> {
             self.descend_tree(&mut tree[..n]);
             // Below the leaves (or from the root, for defensive samples), the environment's
             // levels, also side by side.
-            let mut below = [WarpLane::default(); LANES];
+            let mut below = [WarpLane::default(); WARPS];
             for (e, t) in below.iter_mut().zip(&tree[..n]) {
                 *e = WarpLane::new(t.cell, t.xi);
                 e.alive = t.alive;
             }
             self.env.warp_down_lanes(&mut below[..n]);
-            let mut landed = [None; LANES];
+            let mut landed = [None; WARPS];
             for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
                 *l = self.finish(t, e);
             }
             // The defensive samples' densities: the product's descents side by side.
-            let (mut points, mut which, mut count) = ([Vec2::ZERO; LANES], [0; LANES], 0);
+            let (mut points, mut which, mut count) = ([Vec2::ZERO; WARPS], [0; WARPS], 0);
             for (k, t) in tree[..n].iter().enumerate() {
                 if let (true, Some((uv, _))) = (t.defensive, landed[k]) {
                     (points[count], which[count], count) = (uv, k, count + 1);
                 }
             }
-            let mut densities = [0.0f32; LANES];
+            let mut densities = [0.0f32; WARPS];
             self.pdf_square_many(&points[..count], &mut densities[..count]);
             for (&k, &d) in which[..count].iter().zip(&densities) {
                 landed[k] = landed[k].map(|(uv, _)| (uv, d / SPHERE_AREA));
             }
             // The directions at once.
-            let mut dirs = [Vec3::ZERO; LANES];
+            let mut dirs = [Vec3::ZERO; WARPS];
             self.env.dirs_of(&landed.map(|l| l.map_or(Vec2::ZERO, |(uv, _)| uv))[..n], &mut dirs[..n]);
             for (k, o) in os.iter_mut().enumerate().take(n) {
                 *o = landed[k].map(|(uv, pdf)| DirectionSample { dir: dirs[k], uv, pdf });

@@ -44,6 +44,7 @@ const SUBNORMAL_SLACK: f32 = 1e-36;
 
 /// Samples in a node from which its split searches for its children's bounds instead of counting.
 const SEARCH_FROM: usize = 32;
+const _: () = assert!(SEARCH_FROM <= 255, "split packs its counts in bytes");
 
 /// Bits per axis of the quantised square coordinates; also the largest possible depth.
 pub const COORD_BITS: u32 = 24;
@@ -322,7 +323,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
 
     /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
     /// sorted by the next two Morton bits' digit, so three binary searches find them in a long
-    /// run, and counting each digit in a short one (most of the tree's runs, where a scan costs
+    /// run, and counting the digits in a short one (most of the tree's runs, where a scan costs
     /// less than the searches' unpredictable branches).
     fn split(&self, depth: u32, lo: usize, hi: usize) -> [usize; 5] {
         if hi - lo >= SEARCH_FROM {
@@ -330,14 +331,15 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             let below = |d: usize| lo + run.partition_point(|&k| digit(k, depth) < d);
             return [lo, below(1), below(2), below(3), hi];
         }
-        // Register accumulators (an array of counters would chain through memory).
-        let (mut below1, mut below2, mut below3) = (0usize, 0usize, 0usize);
+        // Three counters packed in the bytes of one register (a run here is shorter than
+        // `SEARCH_FROM` ≤ 255):
+        // digit d adds one to the counts of "below d + 1", …, "below 3", i.e. 0x010101 >> 8d.
+        let mut packed = 0u32;
         for &k in &self.keys[lo..hi] {
-            let d = digit(k, depth);
-            below1 += usize::from(d < 1);
-            below2 += usize::from(d < 2);
-            below3 += usize::from(d < 3);
+            packed += 0x01_0101 >> (8 * digit(k, depth));
         }
+        let count = |byte: u32| ((packed >> (8 * byte)) & 0xFF) as usize;
+        let (below1, below2, below3) = (count(2), count(1), count(0));
         [lo, lo + below1, lo + below2, lo + below3, hi]
     }
 }
