@@ -1,9 +1,12 @@
 //! Runs many shading-point builds in a loop, for profilers (`perf record`, callgrind).
-//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations] [mis|points] [K]`
+//! `cargo run --release -p sampler-core --example profile_build -- [brdf] [iterations] [mode] [K] [level]`
 //! (brdf: lambert, phong, carpaint, ggx — α 0.1 — or ggxA for GGX α = A)
-//! (`mis`: the product-MIS preset `ProductParams::for_mis`, probed and refined leaves; `points`:
-//! only the shading points, build + 16 warps each, without the stages after them, for a CPU-time
-//! measure of the whole process such as `perf stat -e task-clock`).
+//! (mode `mis`: the product-MIS preset `ProductParams::for_mis`, probed and refined leaves;
+//! `points`: only the shading points, build + 16 warps each, without the stages after them, for
+//! a CPU-time measure of the whole process such as `perf stat -e task-clock`; `many`: as
+//! `points`, the 16 warps drawn together by `sample_many` as the renderer draws them;
+//! `mis-many`: as `many` with the product-MIS preset; level: the map is 2^level square, 10 by
+//! default).
 
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
@@ -19,13 +22,14 @@ fn main() {
     let which = args.get(1).map_or("ggx", String::as_str);
     let iters: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(50_000);
     let k: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(256);
-    let params = if args.get(3).is_some_and(|a| a == "mis") {
+    let mode = args.get(3).map_or("", String::as_str);
+    let params = if mode.starts_with("mis") {
         ProductParams::for_mis(k)
     } else {
         ProductParams { brdf_samples: k, ..ProductParams::default() }
     };
     let brdf = brdf_named(which);
-    let level = 10;
+    let level: u32 = args.get(5).and_then(|s| s.parse().ok()).unwrap_or(10);
     let n = 1usize << level;
     let mut rgb = vec![[0.5f32; 3]; n * n];
     rgb[n * 300 + 200] = [1e5; 3];
@@ -45,12 +49,18 @@ fn main() {
         nodes += s.node_count();
         let mut pts = [DVec2::ZERO; 16];
         sobol02(i, 0, &mut pts);
-        for u in pts {
-            acc += s.sample(u).map_or(0.0, |d| d.pdf as f64);
+        if mode.ends_with("many") {
+            let mut drawn = [None; 16];
+            s.sample_many(&pts, &mut drawn);
+            acc += drawn.iter().map(|d| d.map_or(0.0, |d| d.pdf as f64)).sum::<f64>();
+        } else {
+            for u in pts {
+                acc += s.sample(u).map_or(0.0, |d| d.pdf as f64);
+            }
         }
     }
     let dt = t.elapsed().as_secs_f64();
-    if args.get(3).is_some_and(|a| a == "points") {
+    if mode == "points" || mode.ends_with("many") {
         println!("{which}: {:.2} µs per shading point ({acc:.3e})", dt / iters as f64 * 1e6);
         return;
     }

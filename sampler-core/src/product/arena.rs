@@ -1,6 +1,6 @@
 //! The caller-owned scratch memory of the product and its build: K BRDF samples drawn from a
-//! randomised (0,2)-sequence, the quadtree over their points with the product computed in the
-//! same traversal, then each node's path probability.
+//! randomised (0,2)-sequence, then the quadtree over their points with the product and each
+//! node's branch probability computed in the same traversal.
 
 use super::bilinear::Corners;
 use super::params::{ProductError, ProductParams};
@@ -16,7 +16,7 @@ use heapless::Vec;
 
 /// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
 /// Reused from point to point; never allocates. `size_of::<ProductArena<K, NODES>>()` is about
-/// 48·K + 16·NODES bytes: each node's 8 bytes and its path probability's 8. The default NODES
+/// 48·K + 16·NODES bytes: each node's 8 bytes and its branch probability's 8. The default NODES
 /// holds the largest trees that 256 samples make (docs/perf.md#tree-size-and-memory); when
 /// NODES is exhausted, splitting stops and leaves keep the mean of their samples (still exact
 /// sampling). A bilinear B̃ ([`Leaves::Bilinear`]) also stores four corner values per node and
@@ -33,8 +33,9 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     values: [f32; K],
     keys: Vec<u64, K>,
     nodes: Vec<Node, NODES>,
-    /// Per node, the probability that the warp reaches it (see `path_probabilities`).
-    paths: [f64; NODES],
+    /// Per node, the probability that the warp picks it among its parent's children (see
+    /// [`branch_probabilities`]).
+    branches: [f64; NODES],
     /// B̃ at each node's corners (bilinear B̃ only: needs CORNERS ≥ NODES).
     corners: Vec<Corners, CORNERS>,
     /// What the last build made (`None` before the first).
@@ -72,7 +73,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             values: [0.0; K],
             keys: Vec::new(),
             nodes: Vec::new(),
-            paths: [0.0; NODES],
+            branches: [0.0; NODES],
             corners: Vec::new(),
             built: None,
         }
@@ -127,6 +128,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             values: &self.values[..count],
             env,
             nodes: &mut self.nodes,
+            branches: &mut self.branches,
             max_depth: params.max_depth.min(COORD_BITS),
             wavelet: kind.is_wavelet(),
             eval,
@@ -136,7 +138,6 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             corners: &mut self.corners,
         };
         builder.build();
-        path_probabilities(&self.nodes, &mut self.paths[..self.nodes.len()]);
         let root = self.nodes.first().map_or(0.0, |n| n.product);
         let has_product = root > 0.0 && root.is_finite();
         let defensive = if has_product { params.defensive.clamp(0.0, 1.0) } else { 1.0 };
@@ -166,7 +167,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         Some(ProductSampler {
             env,
             nodes: &self.nodes,
-            paths: &self.paths[..self.nodes.len()],
+            branches: &self.branches[..self.nodes.len()],
             corners: &self.corners,
             defensive,
             brdf_samples,
@@ -175,36 +176,26 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
     }
 }
 
-/// Each node's path probability: the product of the branch probabilities from the root down to
-/// it, multiplied in the warp's order (so bit for bit what a descent would multiply). Computed
-/// once per build, top-down (children always follow their parent in `nodes`), so that the warp
-/// and the density read it at the leaf instead of dividing at every level.
-fn path_probabilities(nodes: &[Node], paths: &mut [f64]) {
-    if let Some(root) = paths.first_mut() {
-        *root = 1.0;
-    }
-    for (i, n) in nodes.iter().enumerate() {
-        if n.is_leaf() {
+/// The branch probabilities of four children of masses `mass`: `branch_probability` for each,
+/// each column's share computed once. The build calls it wherever it sets a parent's children
+/// (children always follow their parent in the arena's nodes); a descent multiplies them from
+/// the root down, so a leaf's path probability is the product of its branches in the warp's
+/// order.
+#[inline]
+pub(crate) fn branch_probabilities(mass: [f32; 4]) -> [f64; 4] {
+    let m = mass.map(f64::from);
+    let total = m[0] + m[1] + m[2] + m[3];
+    let mut out = [0.0; 4];
+    for dx in 0..2 {
+        let column = m[dx] + m[dx + 2];
+        // Written as `branch_probability`'s test, so that NaN masses give what it gives.
+        if total <= 0.0 || column <= 0.0 {
             continue;
         }
-        let first = n.child as usize;
-        let c = &nodes[first..first + 4];
-        let m = [c[0].product, c[1].product, c[2].product, c[3].product].map(f64::from);
-        // `branch_probability` for the four children, each column's share computed once.
-        let total = m[0] + m[1] + m[2] + m[3];
-        let parent = paths[i];
-        for dx in 0..2 {
-            let column = m[dx] + m[dx + 2];
-            let (top, bottom) = if total <= 0.0 || column <= 0.0 {
-                (0.0, 0.0)
-            } else {
-                let share = column / total;
-                (share * (m[dx] / column), share * (m[dx + 2] / column))
-            };
-            paths[first + dx] = parent * top;
-            paths[first + dx + 2] = parent * bottom;
-        }
+        let share = column / total;
+        (out[dx], out[dx + 2]) = (share * (m[dx] / column), share * (m[dx + 2] / column));
     }
+    out
 }
 
 /// Probability that the warp picks child `k` among four of masses `mass`: the column, then the
@@ -225,34 +216,22 @@ pub(crate) fn branch_probability(mass: [f32; 4], k: usize) -> f64 {
 mod tests {
     use super::*;
 
-    /// Each node's path probability is the product of `branch_probability` down to it, bit for
-    /// bit, including children of a parent whose column has no mass.
+    /// The four branches are `branch_probability`'s, bit for bit, including children of a
+    /// parent whose column (or whole mass) is zero.
     #[test]
-    fn paths_are_the_products_of_the_branch_probabilities() {
-        let node = |child: u32, product: f32| Node { child, product };
-        let nodes = [
-            node(1, 1.0),
-            node(5, 0.3),
-            node(0, 0.0),
-            node(0, 0.7),
-            node(0, 1e-7),
-            node(0, 0.1),
-            node(0, 0.0),
-            node(0, 3.0),
-            node(0, 0.0),
-        ];
-        // Every node's entry is written: none keeps the NaN it starts with.
-        let mut paths = [f64::NAN; 9];
-        path_probabilities(&nodes, &mut paths);
-        assert!(paths.iter().all(|p| !p.is_nan()));
-        let mass = |first: usize| [0, 1, 2, 3].map(|k| nodes[first + k].product);
-        assert_eq!(paths[0], 1.0);
-        for k in 0..4 {
-            assert_eq!(paths[1 + k].to_bits(), (1.0 * branch_probability(mass(1), k)).to_bits());
-            let want = paths[1] * branch_probability(mass(5), k);
-            assert_eq!(paths[5 + k].to_bits(), want.to_bits(), "child {k}");
+    fn branches_are_the_branch_probabilities() {
+        for mass in [
+            [0.3, 0.0, 0.7, 1e-7],
+            [0.0, 0.1, 0.0, 3.0],
+            [0.0; 4],
+            [1.0, 2.0, 3.0, 4.0],
+            [5.0, 0.0, 0.0, 0.0],
+            [f32::NAN, 1.0, 0.0, 2.0],
+        ] {
+            let got = branch_probabilities(mass);
+            for (k, g) in got.iter().enumerate() {
+                assert_eq!(g.to_bits(), branch_probability(mass, k).to_bits(), "{mass:?}, child {k}");
+            }
         }
-        assert_eq!(paths[6], 0.0);
-        assert_eq!(paths[8], 0.0);
     }
 }

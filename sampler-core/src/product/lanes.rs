@@ -1,4 +1,4 @@
-//! Product descents side by side: many points warped [`LANES`] at a time, branch-free within a
+//! Product descents side by side: many points warped [`WARPS`] at a time, branch-free within a
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
 //! waiting on its own mispredicted branches.
 //!
@@ -15,6 +15,11 @@ use crate::mapping::SPHERE_AREA;
 use crate::warp::{ONE_MINUS_EPSILON, choose_child_branchless};
 use glam::{DVec2, Vec2, Vec3};
 
+/// Product samples drawn side by side: a renderer's batch (`estimator::BATCH`) in one go, so
+/// that the environment's descents below the leaves, whose loads miss the caches at large maps,
+/// all have theirs in flight together (twice the environment's own [`LANES`]).
+const WARPS: usize = 2 * LANES;
+
 /// One descent through the product tree.
 #[derive(Clone, Copy, Default)]
 struct TreeLane {
@@ -23,7 +28,7 @@ struct TreeLane {
     index: usize,
     /// The node's cell.
     cell: Cell,
-    /// Probability of the path (the leaf's, once there).
+    /// Probability of the path so far (the leaf's, once there).
     path: f64,
     xi: DVec2,
     /// Drawn by the defensive environment part of the mixture: no tree descent.
@@ -48,9 +53,9 @@ impl ProductSampler<'_, '_> {
         }
         let eps = self.defensive as f64;
         let root = self.nodes.first().copied().unwrap_or_default();
-        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        for (us, os) in u.chunks(WARPS).zip(out.chunks_mut(WARPS)) {
             let n = us.len().min(os.len());
-            let mut tree = [TreeLane::default(); LANES];
+            let mut tree = [TreeLane::default(); WARPS];
             for (lane, u) in tree.iter_mut().zip(&us[..n]) {
                 let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(ONE_MINUS_EPSILON));
                 let defensive = xi.x < eps;
@@ -64,30 +69,30 @@ impl ProductSampler<'_, '_> {
             self.descend_tree(&mut tree[..n]);
             // Below the leaves (or from the root, for defensive samples), the environment's
             // levels, also side by side.
-            let mut below = [WarpLane::default(); LANES];
+            let mut below = [WarpLane::default(); WARPS];
             for (e, t) in below.iter_mut().zip(&tree[..n]) {
                 *e = WarpLane::new(t.cell, t.xi);
                 e.alive = t.alive;
             }
             self.env.warp_down_lanes(&mut below[..n]);
-            let mut landed = [None; LANES];
+            let mut landed = [None; WARPS];
             for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
                 *l = self.finish(t, e);
             }
             // The defensive samples' densities: the product's descents side by side.
-            let (mut points, mut which, mut count) = ([Vec2::ZERO; LANES], [0; LANES], 0);
+            let (mut points, mut which, mut count) = ([Vec2::ZERO; WARPS], [0; WARPS], 0);
             for (k, t) in tree[..n].iter().enumerate() {
                 if let (true, Some((uv, _))) = (t.defensive, landed[k]) {
                     (points[count], which[count], count) = (uv, k, count + 1);
                 }
             }
-            let mut densities = [0.0f32; LANES];
+            let mut densities = [0.0f32; WARPS];
             self.pdf_square_many(&points[..count], &mut densities[..count]);
             for (&k, &d) in which[..count].iter().zip(&densities) {
                 landed[k] = landed[k].map(|(uv, _)| (uv, d / SPHERE_AREA));
             }
             // The directions at once.
-            let mut dirs = [Vec3::ZERO; LANES];
+            let mut dirs = [Vec3::ZERO; WARPS];
             self.env.dirs_of(&landed.map(|l| l.map_or(Vec2::ZERO, |(uv, _)| uv))[..n], &mut dirs[..n]);
             for (k, o) in os.iter_mut().enumerate().take(n) {
                 *o = landed[k].map(|(uv, pdf)| DirectionSample { dir: dirs[k], uv, pdf });
@@ -101,7 +106,7 @@ impl ProductSampler<'_, '_> {
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.in_tree) {
                 if lane.node.is_leaf() {
-                    (lane.in_tree, lane.path) = (false, self.paths[lane.index]);
+                    lane.in_tree = false;
                     continue;
                 }
                 busy = true;
@@ -113,6 +118,7 @@ impl ProductSampler<'_, '_> {
                     continue;
                 };
                 (lane.node, lane.index, lane.cell) = (c[k], first + k, lane.cell.child(k));
+                lane.path *= self.branches[first + k];
             }
             if !busy {
                 return;
@@ -148,6 +154,8 @@ struct PdfLane {
     /// The point's 24-bit coordinates.
     qx: u32,
     qy: u32,
+    /// Probability of the path so far.
+    path: f64,
 }
 
 impl ProductSampler<'_, '_> {
@@ -167,7 +175,7 @@ impl ProductSampler<'_, '_> {
             let n = us.len().min(os.len());
             let mut lanes = [PdfLane::default(); LANES];
             for (lane, uv) in lanes.iter_mut().zip(&us[..n]) {
-                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), ..*lane };
+                *lane = PdfLane { node: root, qx: quantize(uv.x), qy: quantize(uv.y), path: 1.0, ..*lane };
             }
             loop {
                 let mut busy = false;
@@ -178,6 +186,7 @@ impl ProductSampler<'_, '_> {
                     lane.index = lane.node.child as usize + k;
                     lane.node = self.nodes[lane.index];
                     lane.cell = lane.cell.child(k);
+                    lane.path *= self.branches[lane.index];
                 }
                 if !busy {
                     break;
@@ -185,7 +194,7 @@ impl ProductSampler<'_, '_> {
             }
             for ((o, l), uv) in os.iter_mut().zip(&lanes[..n]).zip(us) {
                 let texel = self.env.texel_relative(*uv);
-                *o = self.mixture(self.leaf_density(self.paths[l.index], l.cell, texel), texel);
+                *o = self.mixture(self.leaf_density(l.path, l.cell, texel), texel);
             }
         }
     }

@@ -8,6 +8,7 @@
 mod arena;
 pub mod bilinear;
 mod bilinear_walk;
+mod keys;
 mod lanes;
 mod params;
 pub mod quadtree;

@@ -15,10 +15,14 @@
 //!   the product's mass are split further, B probed at each new child's centre: the samples
 //!   place leaves where B is large, the refinement where B̃·L is (a sun in a lobe's tail).
 //! * Each node stores B̃'s mean and the product's mean, with the environment taken relative to its
-//!   own mean; the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
+//!   own mean, and beside it (in `branches`) the probability that the warp picks it among its
+//!   siblings, computed where the siblings' products are (a descent multiplies them); the combine rule is the plain average ([`ProductKind::Quadtree`]) or the Haar
 //!   wavelet product ([`ProductKind::Wavelet`], see `wavelet.rs`). What B̃ is in a leaf is
 //!   [`Leaves`]; the combinations that exist are the variants of [`ProductKind`].
 
+use super::arena::branch_probabilities;
+use super::keys::digit;
+pub use super::keys::{COORD_BITS, morton, quantize, sort_key};
 pub use super::params::{Leaves, ProductKind};
 use crate::bilinear::{self, Corners};
 use crate::cell::Cell;
@@ -35,11 +39,14 @@ pub const FILL_PRIOR: f32 = 2.0;
 /// Samples in a parent from which an empty child's B̃ also looks at B at its centre.
 pub const EVAL_EMPTY_FROM: usize = 4;
 
+/// More than the rounding error that subnormal products can add to a subtree's mass over the
+/// depth cap's levels (each ≤ 2⁻¹⁴⁹): `refine` passes by a subtree only when its mass is this
+/// far below the limit.
+const SUBNORMAL_SLACK: f32 = 1e-36;
+
 /// Samples in a node from which its split searches for its children's bounds instead of counting.
 const SEARCH_FROM: usize = 32;
-
-/// Bits per axis of the quantised square coordinates; also the largest possible depth.
-pub const COORD_BITS: u32 = 24;
+const _: () = assert!(SEARCH_FROM <= 255, "split packs its counts in bytes");
 
 /// One node of the product tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -61,57 +68,6 @@ impl Node {
     }
 }
 
-/// 24-bit fixed-point coordinates of a point of the square.
-#[inline]
-#[must_use]
-pub fn quantize(u: f32) -> u32 {
-    let max = (1u32 << COORD_BITS) - 1;
-    ((u * (1u32 << COORD_BITS) as f32) as u32).min(max)
-}
-
-/// Interleaves two 24-bit coordinates (x in the even bits).
-#[inline]
-#[must_use]
-pub fn morton(x: u32, y: u32) -> u64 {
-    spread(x) | (spread(y) << 1)
-}
-
-/// The bits of a 24-bit value spread to the even bits, a byte at a time by table (a third
-/// of the shifts and masks of spreading the whole word).
-#[inline]
-fn spread(v: u32) -> u64 {
-    let byte = |k: u32| u64::from(SPREAD_BYTE[((v >> (8 * k)) & 0xFF) as usize]) << (16 * k);
-    byte(0) | byte(1) | byte(2)
-}
-
-/// Each byte's bits spread to the even bits of 16.
-const SPREAD_BYTE: [u16; 256] = {
-    let mut table = [0u16; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut bit = 0;
-        while bit < 8 {
-            table[b] |= (((b >> bit) & 1) << (2 * bit)) as u16;
-            bit += 1;
-        }
-        b += 1;
-    }
-    table
-};
-
-/// Sort key: Morton code in the high 48 bits, sample index in the low 16.
-#[inline]
-#[must_use]
-pub fn sort_key(u: f32, v: f32, index: usize) -> u64 {
-    (morton(quantize(u), quantize(v)) << 16) | index as u64
-}
-
-/// The child digit (dx + 2·dy) of a key at `depth` (the split from depth to depth + 1).
-#[inline]
-fn digit(key: u64, depth: u32) -> usize {
-    ((key >> (16 + 2 * (COORD_BITS - 1 - depth))) & 3) as usize
-}
-
 /// Builds the tree over `keys` (sorted) whose sample values are `values[key & 0xFFFF]`;
 /// `eval(uv)` gives B·cos (luminance) at a point of the square, for empty cells where the
 /// sample counts say B is small.
@@ -120,6 +76,9 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     pub values: &'b [f32],
     pub env: &'b EnvHierarchy<'e>,
     pub nodes: &'b mut Vec<Node, NODES>,
+    /// Per node, its branch probability among its siblings (`branch_probabilities`; at least
+    /// NODES long).
+    pub branches: &'b mut [f64],
     pub max_depth: u32,
     /// Internal nodes by the Haar wavelet product instead of the average.
     pub wavelet: bool,
@@ -168,6 +127,14 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let (node, depth) = (self.nodes[index], cell.level);
         // A node's mass: its mean over the cell times the cell's area 4^-depth.
         let mass = node.product * f32::from_bits((127 - 2 * depth.min(63)) << 23);
+        // A subtree no heavier than the limit holds no leaf above it, and passing it by leaves
+        // its products as they are: a node's mass is the sum of its children's (non-negative
+        // terms, whose float sum is never below any one of them, scaled by powers of two),
+        // up to the rounding of subnormal products, which `SUBNORMAL_SLACK` covers. NaN and ∞
+        // never pass, and reach their leaves.
+        if mass + SUBNORMAL_SLACK <= limit {
+            return node.product;
+        }
         // Not below the map's finest level: there L is one texel's, and where B varies faster
         // than that the samples have split already.
         let deepest = self.max_depth.min(self.env.finest_level());
@@ -197,6 +164,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         }
         let product = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
         set(&mut self.nodes[index], first as u32, product);
+        self.branches[first..first + 4].copy_from_slice(&branch_probabilities(p));
         product
     }
 
@@ -263,6 +231,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let mean_b = 0.25 * ((b[0] + b[1]) + (b[2] + b[3]));
         let product = if self.wavelet { haar_product_mean(b, l, p) } else { 0.25 * ((p[0] + p[1]) + (p[2] + p[3])) };
         set(&mut self.nodes[index], first as u32, product);
+        self.branches[first..first + 4].copy_from_slice(&branch_probabilities(p));
         (mean_b, product)
     }
 
@@ -302,7 +271,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
 
     /// The bounds of the four children's runs within `lo..hi` (a node at `depth`): the run is
     /// sorted by the next two Morton bits' digit, so three binary searches find them in a long
-    /// run, and counting each digit in a short one (most of the tree's runs, where a scan costs
+    /// run, and counting the digits in a short one (most of the tree's runs, where a scan costs
     /// less than the searches' unpredictable branches).
     fn split(&self, depth: u32, lo: usize, hi: usize) -> [usize; 5] {
         if hi - lo >= SEARCH_FROM {
@@ -310,14 +279,15 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
             let below = |d: usize| lo + run.partition_point(|&k| digit(k, depth) < d);
             return [lo, below(1), below(2), below(3), hi];
         }
-        // Register accumulators (an array of counters would chain through memory).
-        let (mut below1, mut below2, mut below3) = (0usize, 0usize, 0usize);
+        // Three counters packed in the bytes of one register (a run here is shorter than
+        // `SEARCH_FROM` ≤ 255):
+        // digit d adds one to the counts of "below d + 1", …, "below 3", i.e. 0x010101 >> 8d.
+        let mut packed = 0u32;
         for &k in &self.keys[lo..hi] {
-            let d = digit(k, depth);
-            below1 += usize::from(d < 1);
-            below2 += usize::from(d < 2);
-            below3 += usize::from(d < 3);
+            packed += 0x01_0101 >> (8 * digit(k, depth));
         }
+        let count = |byte: u32| ((packed >> (8 * byte)) & 0xFF) as usize;
+        let (below1, below2, below3) = (count(2), count(1), count(0));
         [lo, lo + below1, lo + below2, lo + below3, hi]
     }
 }
@@ -372,35 +342,4 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
 fn set(n: &mut Node, child: u32, product: f32) {
     n.child = child;
     n.product = product;
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn morton_interleaves_x_in_even_bits() {
-        assert_eq!(morton(1, 0), 1);
-        assert_eq!(morton(0, 1), 2);
-        assert_eq!(morton(0b11, 0b01), 0b0111);
-        let top = 1u32 << 23;
-        let k = sort_key(0.75, 0.25, 5);
-        assert_eq!(digit(k, 0), 1); // right, bottom
-        assert_eq!(digit(k, 1), 3); // 0.75 = 0.11b, 0.25 = 0.01b
-        assert_eq!(morton(top, top) >> 46, 3);
-        // Every bit of both coordinates lands where interleaving puts it.
-        for bit in 0..COORD_BITS {
-            assert_eq!(morton(1 << bit, 0), 1 << (2 * bit));
-            assert_eq!(morton(0, 1 << bit), 1 << (2 * bit + 1));
-        }
-        assert_eq!(morton(0xFF_FFFF, 0xFF_FFFF), (1 << 48) - 1);
-    }
-
-    #[test]
-    fn quantize_clamps() {
-        assert_eq!(quantize(1.0), (1 << 24) - 1);
-        assert_eq!(quantize(-0.5), 0);
-        assert_eq!(quantize(f32::NAN), 0);
-        assert_eq!(quantize(0.5), 1 << 23);
-    }
 }

@@ -35,8 +35,9 @@ pub use crate::direction::DirectionSample;
 pub struct ProductSampler<'a, 'e> {
     pub(crate) env: &'a EnvHierarchy<'e>,
     pub(crate) nodes: &'a [Node],
-    /// Per node, the probability that the warp reaches it.
-    pub(crate) paths: &'a [f64],
+    /// Per node, the probability that the warp picks it among its siblings; a descent's product
+    /// of them from the root down is its path probability.
+    pub(crate) branches: &'a [f64],
     /// Per node, B̃ at its corners; empty unless B̃ is bilinear.
     pub(crate) corners: &'a [Corners],
     pub(crate) defensive: f32,
@@ -112,14 +113,14 @@ impl<'e> ProductSampler<'_, 'e> {
     /// Returns the point, the product's density per unit square area there and the relative
     /// importance of its texel (the env's density per unit square area).
     fn warp_product(&self, xi: &mut DVec2) -> Option<(Vec2, f64, f32)> {
-        let (mut i, mut leaf) = (0usize, Cell::ROOT);
+        let (mut i, mut leaf, mut path) = (0usize, Cell::ROOT, 1.0f64);
         while !self.nodes[i].is_leaf() {
             let first = self.nodes[i].child as usize;
             let c = &self.nodes[first..first + 4];
             let child = choose_child([c[0].product, c[1].product, c[2].product, c[3].product], xi)?;
             (i, leaf) = (first + child, leaf.child(child));
+            path *= self.branches[i];
         }
-        let path = self.paths[i];
         if !self.corners.is_empty() {
             return self.warp_bilinear(i, path, leaf, xi);
         }
@@ -166,15 +167,15 @@ impl<'e> ProductSampler<'_, 'e> {
     fn product_density(&self, uv: Vec2, texel: f32) -> f64 {
         let Some(root) = self.nodes.first() else { return 0.0 };
         let (qx, qy) = (quantize(uv.x), quantize(uv.y));
-        let (mut node, mut index, mut leaf) = (*root, 0usize, Cell::ROOT);
+        let (mut node, mut index, mut leaf, mut path) = (*root, 0usize, Cell::ROOT, 1.0f64);
         while !node.is_leaf() {
             let shift = COORD_BITS - 1 - leaf.level;
             let k = (((qx >> shift) & 1) + 2 * ((qy >> shift) & 1)) as usize;
             index = node.child as usize + k;
             node = self.nodes[index];
             leaf = leaf.child(k);
+            path *= self.branches[index];
         }
-        let path = self.paths[index];
         if !self.corners.is_empty() {
             return self.bilinear_density(index, path, leaf, uv);
         }
