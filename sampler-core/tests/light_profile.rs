@@ -289,3 +289,38 @@ fn a_tilted_profiled_triangle_has_the_power_of_its_profile() {
         }
     }
 }
+
+/// A face of a mesh light shaped by a 30° cone about an axis tilted 50° from its normal: the
+/// tree's bounds narrow to the cone (most points outside it are culled; the face's two-sided
+/// hemisphere bounds cull about half as many) and never cull a point the face lights.
+#[test]
+fn bounds_of_a_shaped_tilted_face_cull_only_where_it_is_dark() {
+    use sampler_core::light::TriangleLight;
+    let axis = Vec3::new(50f32.to_radians().sin(), 0.0, -50f32.to_radians().cos());
+    let shaping = Shaping::new(axis, 30f32.to_radians(), 0.5, 0.0, Vec3::ONE).unwrap();
+    let c = Vec3::new(0.0, 0.0, 3.0);
+    let face = TriangleLight::new([c, c + Vec3::new(0.0, 0.5, 0.0), c + Vec3::new(0.5, 0.0, 0.0)], Vec3::ONE)
+        .unwrap()
+        .with_two_sided(true)
+        .with_shaping(shaping);
+    let face: SceneLight = face.into();
+    let b = LightBounds::of(&face).unwrap();
+    let mut rng = Pcg32::new(9, 4);
+    let (mut lit, mut culled_dark) = (0, 0);
+    for _ in 0..20_000 {
+        let q = Vec3::new(rng.next_f32() * 12.0 - 6.0, rng.next_f32() * 12.0 - 6.0, rng.next_f32() * 2.0);
+        let n = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE).normalize();
+        let reaches = (0..16).any(|k| {
+            let u = Vec2::new((k % 4) as f32 / 4.0 + 0.1, (k / 4) as f32 / 4.0 + 0.1);
+            face.sample(q, u).is_some_and(|s| s.radiance.x > 0.0 && s.dir.dot(n) > 0.0)
+        });
+        let importance = b.importance(q, n);
+        if reaches {
+            lit += 1;
+            assert!(importance > 0.0, "{q} (normal {n}) is lit but culled");
+        } else {
+            culled_dark += usize::from(importance == 0.0);
+        }
+    }
+    assert!(lit > 500 && culled_dark > 15_000, "{lit} lit, {culled_dark} dark points culled");
+}
