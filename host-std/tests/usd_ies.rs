@@ -111,11 +111,13 @@ fn profiles_on_cylinder_and_mesh_lights_follow_their_tables() {
     assert!(converted.notes.is_empty(), "{:?}", converted.notes);
     let faces = |x: std::ops::Range<f32>| -> Vec<sampler_core::light::TriangleLight> {
         let lights = converted.scene.lights.iter();
-        lights.filter_map(|l| if let SceneLight::Triangle(t) = l { Some(*t) } else { None }).filter(|t| {
-            let sampler_core::light::LightSurface::Triangle(v) = t.surface() else { return false };
-            x.contains(&v[0].x)
-        })
-        .collect()
+        lights
+            .filter_map(|l| if let SceneLight::Triangle(t) = l { Some(*t) } else { None })
+            .filter(|t| {
+                let sampler_core::light::LightSurface::Triangle(v) = t.surface() else { return false };
+                x.contains(&v[0].x)
+            })
+            .collect()
     };
     let (tube, panel) = (faces(-6.0..-4.0), faces(9.0..11.0));
     assert_eq!((tube.len(), panel.len()), (128, 2));
@@ -137,7 +139,11 @@ fn profiles_on_cylinder_and_mesh_lights_follow_their_tables() {
                 let Some(s) = t.sample(q, Vec2::new(0.3, 0.6)) else { continue };
                 let (theta, phi) = angles(s.dir);
                 let expected = intensity * profile.eval(theta, phi);
-                assert!((s.radiance.x - expected).abs() <= 1e-4 * expected.max(1e-3), "{q}: {} against {expected}", s.radiance.x);
+                assert!(
+                    (s.radiance.x - expected).abs() <= 1e-4 * expected.max(1e-3),
+                    "{q}: {} against {expected}",
+                    s.radiance.x
+                );
                 checked += 1;
             }
         }
@@ -154,7 +160,8 @@ fn profiles_on_cylinder_and_mesh_lights_follow_their_tables() {
             let theta = std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
             for j in 0..2 * n {
                 let phi = std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
-                let w = Vec3::new((theta.sin() * phi.cos()) as f32, theta.cos() as f32, (theta.sin() * phi.sin()) as f32);
+                let w =
+                    Vec3::new((theta.sin() * phi.cos()) as f32, theta.cos() as f32, (theta.sin() * phi.sin()) as f32);
                 let cos = f64::from(w.dot(normal).max(0.0));
                 total += f64::from(t.shaping().factor(w).x) * cos * theta.sin();
             }
@@ -167,7 +174,9 @@ fn profiles_on_cylinder_and_mesh_lights_follow_their_tables() {
     let info = ppis().arg("info").arg(&file).output().unwrap();
     let text = String::from_utf8_lossy(&info.stdout);
     assert!(info.status.success(), "{}", String::from_utf8_lossy(&info.stderr));
-    for needle in ["/World/ProfiledTube", "downlight_2002.ies (LM-63-2002", "/World/ProfiledPanel", "bilateral_1995.ies (LM-63"] {
+    for needle in
+        ["/World/ProfiledTube", "downlight_2002.ies (LM-63-2002", "/World/ProfiledPanel", "bilateral_1995.ies (LM-63"]
+    {
         assert!(text.contains(needle), "{needle:?} not in {text}");
     }
     assert!(!text.contains("not rendered"), "{text}");

@@ -14,7 +14,7 @@ use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Scene, json, usd};
 use host_std::trace::bvh::Bvh;
 use sampler_core::glam::Mat3;
-use sampler_core::light::Light;
+use sampler_core::light::{Light, SceneLight};
 use std::path::PathBuf;
 
 const KINDS: [&str; 6] = ["point", "sphere", "rectangle", "disk", "distant", "mesh"];
@@ -104,6 +104,38 @@ fn usd_light_twins_render_like_their_json_originals() {
 #[test]
 fn usd_twin_of_every_light_under_an_environment_renders_like_its_json_original() {
     twin_renders_like_its_original("lights_env");
+}
+
+/// The scene format's `shaping` (cone, focus, IES profiles on a point, a rectangle and a mesh
+/// light) and ShapingAPI in USD give the same lights: same power, same image within noise.
+#[test]
+fn usd_twin_of_shaped_lights_renders_like_its_json_original() {
+    let original = json::load(&root().join("docs/scenes/lights_shaped.json")).unwrap();
+    // Shaped: each kind emits less than it would unshaped.
+    let point = original.lights.iter().find_map(|l| if let SceneLight::Point(p) = l { Some(*p) } else { None });
+    let point = point.unwrap();
+    assert!(point.shaping().profile().is_some() && point.power(1.0).x < 0.9 * 4.0 * std::f32::consts::PI * 12.0);
+    twin_renders_like_its_original("lights_shaped");
+    // Light by light, the same radiance towards floor points: the profiles sit the same way.
+    let twin = usd::load(&root().join("host-usd/tests/fixtures/lights_shaped.usda"), &usd::Options::default());
+    let twin = twin.unwrap().scene;
+    let mut compared = 0;
+    for q in [[0.3, 0.0, 1.2], [-1.0, 0.0, 0.4], [1.4, 0.0, -0.5], [0.2, 0.0, 2.6]] {
+        let q = sampler_core::glam::Vec3::from_array(q);
+        for (a, b) in original.lights.iter().zip(&twin.lights) {
+            let u = sampler_core::glam::Vec2::new(0.4, 0.7);
+            let (Some(a), Some(b)) = (a.sample(q, u), b.sample(q, u)) else { continue };
+            let tolerance = 1e-3 * a.radiance.max_element() + 1e-6;
+            assert!(
+                (a.radiance - b.radiance).abs().max_element() <= tolerance,
+                "{q}: {} against {}",
+                b.radiance,
+                a.radiance
+            );
+            compared += usize::from(a.radiance.max_element() > 0.0);
+        }
+    }
+    assert!(compared > 50, "{compared} lit samples compared");
 }
 
 /// ShapingAPI reaches the renderer's lights (`lights_shaping.usda`): the RectLight facing down
