@@ -6,17 +6,25 @@ a camera looking down at the floor. The scene of docs/perf.md, "Shaped and IES l
 measures the light tree's bounds of shaped mesh-light faces.
 
     pip install usd-core
-    python3 docs/reference/shaped_ceiling.py /tmp/shaped_ceiling.usda [N]
+    python3 docs/reference/shaped_ceiling.py /tmp/shaped_ceiling.usda [N] [--ies]
+
+With `--ies`, each quad is tilted 30° from the light's axis and the light carries the bilateral
+IES profile of docs/scenes/ies/ (copied beside the output): the load cost of the faces' power
+from the profile's grid (docs/perf.md, "Shaped and IES lights").
 """
 import math
+import os
+import shutil
 import sys
 
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
 
 
 def main():
-    path = sys.argv[1] if len(sys.argv) > 1 else "shaped_ceiling.usda"
-    n = int(sys.argv[2]) if len(sys.argv) > 2 else 60
+    args = [a for a in sys.argv[1:] if a != "--ies"]
+    ies = "--ies" in sys.argv[1:]
+    path = args[0] if args else "shaped_ceiling.usda"
+    n = int(args[1]) if len(args) > 1 else 60
     stage = Usd.Stage.CreateNew(path)
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
     UsdGeom.Xform.Define(stage, "/World")
@@ -41,7 +49,9 @@ def main():
             x, y = -half + pitch * (i + 0.5), -half + pitch * (j + 0.5)
             k = len(points)
             # Counter-clockwise seen from below (local −Z): the front faces the floor.
-            points += [(x - side, y - side, 0), (x - side, y + side, 0), (x + side, y + side, 0), (x + side, y - side, 0)]
+            dz = side * math.tan(math.radians(30.0)) if ies else 0.0
+            points += [(x - side, y - side, dz), (x - side, y + side, 0.0 - dz), (x + side, y + side, 0.0 - dz),
+                       (x + side, y - side, dz)]
             counts.append(4)
             indices += [k, k + 1, k + 2, k + 3]
     ceiling = UsdGeom.Mesh.Define(stage, "/World/Ceiling")
@@ -56,6 +66,12 @@ def main():
     s = UsdLux.ShapingAPI.Apply(ceiling.GetPrim())
     s.CreateShapingConeAngleAttr(20.0)
     s.CreateShapingConeSoftnessAttr(0.2)
+    if ies:
+        here = os.path.dirname(os.path.abspath(__file__))
+        folder = os.path.join(os.path.dirname(os.path.abspath(path)), "ies")
+        os.makedirs(folder, exist_ok=True)
+        shutil.copy(os.path.join(here, "..", "scenes", "ies", "bilateral_1995.ies"), folder)
+        s.CreateShapingIesFileAttr(Sdf.AssetPath("ies/bilateral_1995.ies"))
     cam = UsdGeom.Camera.Define(stage, "/World/Camera")
     o, t = Gf.Vec3d(0, 9, 9), Gf.Vec3d(0, 0, 0)
     back = (o - t).GetNormalized()
