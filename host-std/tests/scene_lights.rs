@@ -150,3 +150,16 @@ fn shapings_that_cannot_exist_are_refused_in_one_line() {
         ppis_fails(dir, file, &[file, light_name, needle]);
     }
 }
+
+/// `ppis info` counts a JSON scene's shaped lights and those with an IES profile.
+#[test]
+fn info_counts_shaped_lights() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes/lights_shaped.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_ppis")).arg("info").arg(&scene).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("(1 point, 1 rectangle, 384 mesh triangle; 386 shaped, 386 of them by an IES profile)"),
+        "{text}"
+    );
+}

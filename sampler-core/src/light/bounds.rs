@@ -99,14 +99,7 @@ impl LightBounds {
     /// light is shaped about the light's axis, not its normal: the cone about that axis holds
     /// all it emits on either side, so it replaces the face's hemisphere.
     fn shaped(self, light: &SceneLight) -> Self {
-        let shaping = match light {
-            SceneLight::Point(l) => l.shaping(),
-            SceneLight::Sphere(l) => l.shaping(),
-            SceneLight::Rect(l) => l.shaping(),
-            SceneLight::Disk(l) => l.shaping(),
-            SceneLight::Triangle(l) => l.shaping(),
-            _ => return self,
-        };
+        let Some(shaping) = light.shaping() else { return self };
         let cutoff = shaping.emission_extent();
         if cutoff >= core::f32::consts::FRAC_PI_2 {
             return self;
