@@ -69,6 +69,9 @@ def light_dict(l, base_dir, override=None):
     import mitsuba as mi
     T = mi.ScalarTransform4f
     t = l['type']
+    if 'shaping' in l:
+        # Mitsuba has no IES profile and its spot's soft band is linear, not the schema's smoothstep.
+        raise SystemExit(f"mitsuba_ref.py: a {t} light with `shaping` has no Mitsuba equivalent")
     black = {'type': 'diffuse', 'reflectance': rgb([0, 0, 0])}
     area = lambda: {'type': 'area', 'radiance': rgb([0, 0, 0] if override == 'coverage' else l['radiance'])}
     zero = override == 'coverage'

@@ -8,7 +8,8 @@ written here as OBJ. Run from the repository root:
 Renders of them are compared with Mitsuba 3 in docs/stability.md, "Lights against Mitsuba 3"; sun_env.json
 (a sun over the map) and lights_env.json are measured at equal time in docs/perf.md, "An
 environment, a sun and lights at equal time" (docs/env_and_lights.py); lights_env.json's USD twin
-is host-usd/tests/fixtures/lights_env.usda.
+is host-usd/tests/fixtures/lights_env.usda. lights_shaped.json holds shaped lights (cone, focus and
+IES profiles from docs/scenes/ies/); its USD twin is host-usd/tests/fixtures/lights_shaped.usda.
 With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
 DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
 spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).
@@ -43,6 +44,19 @@ LIGHTS = {
     "mesh": {"type": "mesh", "file": "meshes/torus_lamp.obj", "radiance": [6, 8, 10]},
     "distant": {"type": "distant", "direction": [0.3, 1, 0.4], "irradiance": [1.5, 1.4, 1.2], "angle_deg": 2},
 }
+# Shaped lights (ShapingAPI's cone, focus and IES profile): a spot with a bilateral profile and a
+# soft cone, a rectangle with a normalised, rescaled downlight profile about its normal, and the
+# torus lamp under a focused cone and a profile about the world's −Y (its faces tilted from it).
+SHAPED = [
+    {"type": "point", "position": [0, 3, 1.5], "intensity": [12, 12, 12],
+     "shaping": {"axis": [0, -1, 0], "cone_angle_deg": 60, "cone_softness": 0.3,
+                 "ies": {"file": "ies/bilateral_1995.ies", "x": [1, 0, 0], "normalize": True}}},
+    dict(LIGHTS["rectangle"], shaping={"ies": {"file": "ies/downlight_2002.ies", "x": [0, 0, 1],
+                                                "angle_scale": 0.8, "normalize": True}}),
+    dict(LIGHTS["mesh"], shaping={"axis": [0, -1, 0], "cone_angle_deg": 70, "cone_softness": 0.2, "focus": 2,
+                                   "focus_tint": [0.2, 0.3, 0.4],
+                                   "ies": {"file": "ies/bilateral_1995.ies", "x": [1, 0, 0], "normalize": True}}),
+]
 
 
 def torus(path, major=0.45, minor=0.08, center=(0.0, 2.4, 1.2), n_major=24, n_minor=8):
@@ -120,6 +134,7 @@ def main():
                       "lights": [{"type": "distant", "direction": [0.3, 1, 0.4], "irradiance": [3, 2.8, 2.4],
                                   "angle_deg": 0.53}],
                       "shapes": SHAPES})
+    write("lights_shaped", {"name": "lights_shaped", "camera": CAMERA, "lights": SHAPED, "shapes": SHAPES})
 
 
 if __name__ == "__main__":

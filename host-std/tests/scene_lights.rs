@@ -108,3 +108,58 @@ fn lights_that_cannot_exist_are_refused_in_one_line() {
         ppis_fails(dir, file, &[file, light_name, needle]);
     }
 }
+
+/// A shaping that cannot exist, or an IES file that cannot be read or is not a profile, stops
+/// the render with one line naming the scene file, the light and the field (or the IES file);
+/// shaping on a distant light is the JSON reader's unknown field.
+#[test]
+fn shapings_that_cannot_exist_are_refused_in_one_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("not.ies"), "this is no photometric file\n").unwrap();
+    let ies = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes/ies/bilateral_1995.ies");
+    std::fs::copy(ies, dir.join("ok.ies")).unwrap();
+    let point = |shaping: &str| {
+        format!(r#"{{"type": "point", "position": [0, 2, 0], "intensity": [1, 1, 1], "shaping": {shaping}}}"#)
+    };
+    let cases = [
+        ("no_axis.json", point(r#"{"cone_angle_deg": 30}"#), "shaping.axis is required"),
+        ("zero_axis.json", point(r#"{"axis": [0, 0, 0]}"#), "shaping.axis has no direction"),
+        ("cone.json", point(r#"{"axis": [0, -1, 0], "cone_angle_deg": -5}"#), "shaping.cone_angle_deg"),
+        ("softness.json", point(r#"{"axis": [0, -1, 0], "cone_softness": 1.5}"#), "shaping.cone_softness"),
+        ("focus.json", point(r#"{"axis": [0, -1, 0], "focus": -1}"#), "shaping.focus must"),
+        ("tint.json", point(r#"{"axis": [0, -1, 0], "focus_tint": [1, -1, 0]}"#), "shaping.focus_tint"),
+        ("missing.json", point(r#"{"axis": [0, -1, 0], "ies": {"file": "nowhere.ies"}}"#), "nowhere.ies"),
+        ("bad.json", point(r#"{"axis": [0, -1, 0], "ies": {"file": "not.ies"}}"#), "not.ies: no TILT= line"),
+        (
+            "parallel.json",
+            point(r#"{"axis": [0, -1, 0], "ies": {"file": "ok.ies", "x": [0, 2, 0]}}"#),
+            "shaping.ies.x is parallel to the axis",
+        ),
+        (
+            "distant.json",
+            r#"{"type": "distant", "direction": [0, 1, 0], "irradiance": [1, 1, 1], "shaping": {}}"#.to_string(),
+            "unknown field `shaping`",
+        ),
+    ];
+    for (file, light, needle) in &cases {
+        let scene =
+            scene_with(&format!("{{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": [1, 1, 1]}}, {light}"));
+        std::fs::write(dir.join(file), scene).unwrap();
+        let light_name = if *file == "distant.json" { "shaping" } else { "lights[1]" };
+        ppis_fails(dir, file, &[file, light_name, needle]);
+    }
+}
+
+/// `ppis info` counts a JSON scene's shaped lights and those with an IES profile.
+#[test]
+fn info_counts_shaped_lights() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes/lights_shaped.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_ppis")).arg("info").arg(&scene).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("(1 point, 1 rectangle, 384 mesh triangle; 386 shaped, 386 of them by an IES profile)"),
+        "{text}"
+    );
+}

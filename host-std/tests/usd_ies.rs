@@ -97,3 +97,87 @@ fn a_bad_or_missing_profile_is_one_error_line() {
         assert!(!out.exists(), "{fixture}: an image was written");
     }
 }
+
+/// The IES profiles of `lights_shaped_meshes.usda` on a CylinderLight (the round downlight) and
+/// on a mesh light whose quad is tilted 30° from its axis (the bilateral wall washer): every
+/// face sends, along a sampled direction, the light's intensity times the file's table at the
+/// angles worked out by hand from the light's transform (about the light's axis, not the
+/// face's normal); each face's power (from the grid its mesh shares) matches brute-force
+/// quadrature of what it emits over the sphere; `ppis info` lists nothing as unrendered.
+#[test]
+fn profiles_on_cylinder_and_mesh_lights_follow_their_tables() {
+    let file = fixtures().join("lights_shaped_meshes.usda");
+    let converted = usd::load(&file, &usd::Options::default()).unwrap();
+    assert!(converted.notes.is_empty(), "{:?}", converted.notes);
+    let faces = |x: std::ops::Range<f32>| -> Vec<sampler_core::light::TriangleLight> {
+        let lights = converted.scene.lights.iter();
+        lights
+            .filter_map(|l| if let SceneLight::Triangle(t) = l { Some(*t) } else { None })
+            .filter(|t| {
+                let sampler_core::light::LightSurface::Triangle(v) = t.surface() else { return false };
+                x.contains(&v[0].x)
+            })
+            .collect()
+    };
+    let (tube, panel) = (faces(-6.0..-4.0), faces(9.0..11.0));
+    assert_eq!((tube.len(), panel.len()), (128, 2));
+    let table = |name: &str| {
+        let file = ies::parse(&std::fs::read(fixtures().join("ies").join(name)).unwrap()).unwrap();
+        file.profile()
+    };
+    let (round, wall) = (table("downlight_2002.ies"), table("bilateral_1995.ies"));
+    // Both lights: −Z turned down (world −Y), +X along world +X, +Y along world −Z. For the
+    // direction w back to the light, θ = acos(w.y) and φ = atan2(−w.z, w.x).
+    let angles = |w: Vec3| (w.y.clamp(-1.0, 1.0).acos(), (-w.z).atan2(w.x));
+    let mut checked = 0;
+    for (lights, centre, intensity, profile) in
+        [(&tube, Vec3::new(-5.0, 3.0, 0.0), 0.05, round), (&panel, Vec3::new(10.0, 3.0, 0.0), 0.02, wall)]
+    {
+        for q in [Vec3::new(0.4, 0.0, 0.3), Vec3::new(-1.5, 0.0, 0.8), Vec3::new(0.9, 0.0, -2.0)] {
+            let q = q + Vec3::new(centre.x, 0.0, centre.z);
+            for t in lights.iter() {
+                let Some(s) = t.sample(q, Vec2::new(0.3, 0.6)) else { continue };
+                let (theta, phi) = angles(s.dir);
+                let expected = intensity * profile.eval(theta, phi);
+                assert!(
+                    (s.radiance.x - expected).abs() <= 1e-4 * expected.max(1e-3),
+                    "{q}: {} against {expected}",
+                    s.radiance.x
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 20, "{checked} samples checked");
+    // Power: radiance × area × ∫ factor · max(0, ω·n) dω by a fine midpoint rule over the sphere.
+    let n = 400;
+    for t in panel.iter().chain(tube.iter().step_by(16)) {
+        let sampler_core::light::LightSurface::Triangle(v) = t.surface() else { panic!() };
+        let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+        let (normal, area) = (cross.normalize(), 0.5 * cross.length());
+        let mut total = 0.0f64;
+        for i in 0..n {
+            let theta = std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
+            for j in 0..2 * n {
+                let phi = std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
+                let w =
+                    Vec3::new((theta.sin() * phi.cos()) as f32, theta.cos() as f32, (theta.sin() * phi.sin()) as f32);
+                let cos = f64::from(w.dot(normal).max(0.0));
+                total += f64::from(t.shaping().factor(w).x) * cos * theta.sin();
+            }
+        }
+        let radiance = if t.surface() == panel[0].surface() || t.surface() == panel[1].surface() { 0.02 } else { 0.05 };
+        let expected = radiance * f64::from(area) * total * (std::f64::consts::PI / n as f64).powi(2);
+        let power = f64::from(t.power(1.0).x);
+        assert!((power - expected).abs() <= 5e-3 * expected + 1e-7, "{power} against {expected}");
+    }
+    let info = ppis().arg("info").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(info.status.success(), "{}", String::from_utf8_lossy(&info.stderr));
+    for needle in
+        ["/World/ProfiledTube", "downlight_2002.ies (LM-63-2002", "/World/ProfiledPanel", "bilateral_1995.ies (LM-63"]
+    {
+        assert!(text.contains(needle), "{needle:?} not in {text}");
+    }
+    assert!(!text.contains("not rendered"), "{text}");
+}

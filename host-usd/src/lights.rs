@@ -90,7 +90,7 @@ pub struct UsdLight {
     pub shaping: Option<crate::shaping::LightShaping>,
     /// A RectLight's `texture:file`, placed on the rectangle.
     pub texture: Option<RectTexture>,
-    /// Its ShapingAPI IES profile (the same kinds as `shaping`).
+    /// Its ShapingAPI IES profile (every kind but a DistantLight).
     pub ies: Option<crate::shaping::IesShaping>,
 }
 
@@ -181,16 +181,12 @@ fn linked(stage: &Stage, prim: &PrimPath, name: &str) -> Result<bool, String> {
     Ok(listed || root_off)
 }
 
-/// The light kinds whose ShapingAPI IES profile is rendered (their cone and focus too).
-pub const SHAPED_KINDS: [&str; 3] = ["SphereLight", "RectLight", "DiskLight"];
-
-/// The light kinds whose ShapingAPI cone and focus are not rendered (every other kind's are,
-/// a CylinderLight's and a mesh light's faces about the light's axis).
+/// The light kinds whose ShapingAPI cone, focus and IES profile are not rendered (every other
+/// kind's are, a CylinderLight's and a mesh light's faces about the light's axis).
 pub const UNSHAPED_KINDS: [&str; 1] = ["DistantLight"];
 
 /// What a light's prim authors that the renderer does not honour, one note each: ShapingAPI's
-/// cone and focus on [`UNSHAPED_KINDS`], its IES profile on kinds other than
-/// [`SHAPED_KINDS`], light filters, the
+/// cone, focus and IES profile on [`UNSHAPED_KINDS`], light filters, the
 /// diffuse and specular multipliers, shadow controls, and (for `type_name`) a CylinderLight's
 /// `treatAsLine`. A RectLight's texture renders (`RectTexture`).
 pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec<String>, String> {
@@ -207,7 +203,7 @@ pub fn unrendered(stage: &Stage, prim: &PrimPath, type_name: &str) -> Result<Vec
     }
     if let Some(Value::Asset { authored, .. }) = input(stage, prim, "shaping:ies:file")?
         && !authored.is_empty()
-        && !SHAPED_KINDS.contains(&type_name)
+        && UNSHAPED_KINDS.contains(&type_name)
     {
         notes.push(format!("IES profile {authored} not rendered on a {type_name}"));
     }

@@ -249,3 +249,78 @@ fn bounds_of_a_profiled_spot_cull_only_where_it_is_dark() {
     }
     assert!(lit > 500 && culled_dark > 10_000, "{lit} lit, {culled_dark} dark points culled");
 }
+
+/// A face of a profiled mesh light, tilted from the light's axis: its power, computed alone
+/// (`with_shaping`) or from the grid its mesh shares (`with_shaping_on_grid`), is radiance ×
+/// area × brute-force quadrature of factor · max(0, ω·n) (|ω·n| two-sided) over the sphere,
+/// at tilts 0°–150°, for a profile alone, and squeezed inside a narrow cone with a focus.
+#[test]
+fn a_tilted_profiled_triangle_has_the_power_of_its_profile() {
+    use sampler_core::light::{TILTED_GRID_CELLS, TiltedGrid, TriangleLight};
+    let axis = Vec3::new(0.0, 0.0, -1.0);
+    let shapings = [
+        Shaping::new(axis, std::f32::consts::PI, 0.0, 0.0, Vec3::ONE).unwrap(),
+        Shaping::new(axis, 25f32.to_radians(), 0.3, 2.0, Vec3::new(0.2, 0.6, 1.0)).unwrap(),
+    ]
+    .map(|s| s.with_profile(profile(), Vec3::X, Vec3::Y, 0.0, true).unwrap());
+    for (k, shaping) in shapings.iter().enumerate() {
+        let mut cells = vec![(Vec3::ZERO, Vec3::ZERO); TILTED_GRID_CELLS];
+        let grid = TiltedGrid::build(shaping, &mut cells);
+        for tilt_deg in [0.0f32, 20.0, 80.0, 150.0] {
+            let t = tilt_deg.to_radians();
+            let normal = Vec3::new(t.sin(), 0.0, -t.cos());
+            let (u, v) = (Vec3::Y, normal.cross(Vec3::Y));
+            let tri = TriangleLight::new([Vec3::ZERO, u, v], Vec3::splat(2.0)).unwrap();
+            for two_sided in [false, true] {
+                let tri = tri.with_two_sided(two_sided);
+                let cos = |d: Vec3| if two_sided { d.dot(normal).abs() } else { d.dot(normal).max(0.0) };
+                let quad = quadrature(|d| f64::from(shaping.factor(d).y) * f64::from(cos(d)), 700);
+                let expected = 2.0 * 0.5 * quad;
+                for (how, light) in
+                    [("alone", tri.with_shaping(*shaping)), ("on the grid", tri.with_shaping_on_grid(*shaping, &grid))]
+                {
+                    let power = f64::from(light.power(1.0).y);
+                    assert!(
+                        (power - expected).abs() <= 3e-3 * expected + 1e-6,
+                        "shaping {k}, tilt {tilt_deg}°, two-sided {two_sided}, {how}: {power} against {expected}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A face of a mesh light shaped by a 30° cone about an axis tilted 50° from its normal: the
+/// tree's bounds narrow to the cone (most points outside it are culled; the face's two-sided
+/// hemisphere bounds cull about half as many) and never cull a point the face lights.
+#[test]
+fn bounds_of_a_shaped_tilted_face_cull_only_where_it_is_dark() {
+    use sampler_core::light::TriangleLight;
+    let axis = Vec3::new(50f32.to_radians().sin(), 0.0, -50f32.to_radians().cos());
+    let shaping = Shaping::new(axis, 30f32.to_radians(), 0.5, 0.0, Vec3::ONE).unwrap();
+    let c = Vec3::new(0.0, 0.0, 3.0);
+    let face = TriangleLight::new([c, c + Vec3::new(0.0, 0.5, 0.0), c + Vec3::new(0.5, 0.0, 0.0)], Vec3::ONE)
+        .unwrap()
+        .with_two_sided(true)
+        .with_shaping(shaping);
+    let face: SceneLight = face.into();
+    let b = LightBounds::of(&face).unwrap();
+    let mut rng = Pcg32::new(9, 4);
+    let (mut lit, mut culled_dark) = (0, 0);
+    for _ in 0..20_000 {
+        let q = Vec3::new(rng.next_f32() * 12.0 - 6.0, rng.next_f32() * 12.0 - 6.0, rng.next_f32() * 2.0);
+        let n = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE).normalize();
+        let reaches = (0..16).any(|k| {
+            let u = Vec2::new((k % 4) as f32 / 4.0 + 0.1, (k / 4) as f32 / 4.0 + 0.1);
+            face.sample(q, u).is_some_and(|s| s.radiance.x > 0.0 && s.dir.dot(n) > 0.0)
+        });
+        let importance = b.importance(q, n);
+        if reaches {
+            lit += 1;
+            assert!(importance > 0.0, "{q} (normal {n}) is lit but culled");
+        } else {
+            culled_dark += usize::from(importance == 0.0);
+        }
+    }
+    assert!(lit > 500 && culled_dark > 15_000, "{lit} lit, {culled_dark} dark points culled");
+}

@@ -11,12 +11,13 @@ use sampler_core::estimator::ShadingPoint;
 use sampler_core::estimator::lights::{FirstHit, LightRays, LightSet, light_pair};
 use sampler_core::frame::Frame;
 use sampler_core::light::{
-    DiskLight, Light, LightBounds, LightNode, LightTree, PointLight, PowerSelector, RectLight, SceneLight, SphereLight,
-    TriangleLight,
+    DiskLight, Light, LightBounds, LightNode, LightTree, PointLight, PowerSelector, RectLight, SceneLight, Shaping,
+    SphereLight, TriangleLight,
 };
 use sampler_core::rng::Pcg32;
 
-/// A few hundred lights of every kind with a position, scattered and turned every way.
+/// A few hundred lights of every kind with a position, scattered and turned every way (some
+/// faces shaped about an axis that is not their normal).
 fn lights(n: usize) -> Vec<SceneLight> {
     let mut rng = Pcg32::new(3, 1);
     let mut v = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
@@ -27,7 +28,12 @@ fn lights(n: usize) -> Vec<SceneLight> {
                 0 => PointLight::new(c, l).unwrap().into(),
                 1 => SphereLight::new(c, 0.2, l).unwrap().into(),
                 2 => DiskLight::new(c, d, 0.3, l).unwrap().with_two_sided(k % 2 == 0).into(),
-                3 => TriangleLight::new([c, c + d, c + d.cross(Vec3::Z) * 0.5], l).unwrap().into(),
+                3 => {
+                    // Every other face shaped as a mesh light's: a cone about an axis of its own.
+                    let face = TriangleLight::new([c, c + d, c + d.cross(Vec3::Z) * 0.5], l).unwrap();
+                    let cone = Shaping::new(v(), 0.7, 0.3, 1.0, Vec3::new(0.5, 0.2, 0.0)).unwrap();
+                    if k % 2 == 0 { face.with_two_sided(true).with_shaping(cone).into() } else { face.into() }
+                }
                 _ => {
                     let e1 = d.normalize() * 0.4;
                     let e2 = e1.cross(Vec3::new(0.3, 0.9, 0.1)).normalize() * 0.3;

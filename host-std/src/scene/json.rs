@@ -174,8 +174,8 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, path)
 }
 
-/// The files a scene file reads besides itself — its meshes, mesh lights and environment map — as
-/// [`load`] resolves them.
+/// The files a scene file reads besides itself — its meshes, mesh lights, IES profiles and
+/// environment map — as [`load`] resolves them.
 pub fn files_read(path: &Path) -> Result<Vec<PathBuf>, SceneError> {
     let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io { path: path.to_owned(), error })?;
     let json: JsonScene =
@@ -185,7 +185,7 @@ pub fn files_read(path: &Path) -> Result<Vec<PathBuf>, SceneError> {
         JsonShape::Mesh { file, .. } => Some(dir.join(file)),
         _ => None,
     });
-    let mesh_lights: Vec<PathBuf> = json.lights.iter().filter_map(|l| l.file().map(|f| dir.join(f))).collect();
+    let mesh_lights: Vec<PathBuf> = json.lights.iter().flat_map(|l| l.files().map(|f| dir.join(f))).collect();
     Ok(meshes.chain(mesh_lights).chain(json.envmap.map(|e| dir.join(e.file))).collect())
 }
 

@@ -6,6 +6,7 @@ pub mod builtin;
 pub mod ies;
 pub mod json;
 mod json_lights;
+mod json_shaping;
 pub mod mesh;
 mod mesh_light;
 mod model;

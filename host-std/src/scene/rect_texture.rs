@@ -1,7 +1,8 @@
 //! A UsdLux RectLight's `texture:file` as emitters: the rectangle cut into one rectangle per
 //! cell of the image, each emitting the light's radiance times its cell's mean texel. Up to
 //! [`MAX_CELLS`] texels along a side a cell is one texel, so the light emits the image exactly
-//! (nearest texel); a larger image is box-filtered down to that many cells. Each cell is an
+//! (nearest texel, as Pixar's HdEmbree looks it up; why not bilinear: docs/usd.md, "RectLight");
+//! a larger image is box-filtered down to that many cells. Each cell is an
 //! ordinary rectangle light, sampled by solid angle and picked by its power, so the texture
 //! steers light selection and the estimates stay unbiased; cells of a black texel emit
 //! nothing and are left out.

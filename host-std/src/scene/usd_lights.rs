@@ -1,10 +1,10 @@
 //! A USD stage's UsdLux lights (host-usd's [`host_usd::lights::UsdLight`], radiometry already
 //! per the schema) as the core's lights: a mesh light or a CylinderLight becomes one triangle
-//! light per face with an area; a ShapingAPI cone and focus shape any of them but a distant
-//! light (a mesh's faces about the light's axis), and an IES profile a point, sphere, rectangle
-//! or disk (`shaping:ies:file`, parsed by `scene/ies.rs`); a RectLight's
-//! `texture:file` cuts it into one rectangle per texel (`scene/rect_texture.rs`). A light the core
-//! cannot build is a note naming its prim; an IES file that is not one is an error naming it.
+//! light per face with an area; a ShapingAPI cone, focus and IES profile (`shaping:ies:file`,
+//! parsed by `scene/ies.rs`) shape any of them but a distant light (a mesh's faces about the
+//! light's axis); a RectLight's `texture:file` cuts it into one rectangle per texel
+//! (`scene/rect_texture.rs`). A light the core cannot build is a note naming its prim; an IES
+//! file that is not one is an error naming it.
 
 use crate::scene::mesh_light::push_triangle_lights;
 use crate::scene::rect_texture;

@@ -1,8 +1,8 @@
 //! UsdLux lights into the scene, each under its world transform (the up-axis conversion
 //! included): DistantLight, SphereLight (a point with `treatAsPoint`), RectLight, DiskLight,
 //! CylinderLight (its side tessellated into emitting triangles) and meshes with MeshLightAPI.
-//! Every light but a DistantLight carries its ShapingAPI cone and focus (a CylinderLight's and a
-//! mesh light's about the light's −Z); spheres (points too), rectangles and disks its IES profile. A light
+//! Every light but a DistantLight carries its ShapingAPI cone, focus and IES profile (a
+//! CylinderLight's and a mesh light's about the light's −Z, not each face's normal). A light
 //! that emits nothing (zero intensity, colour or size) is a note, as the schema makes it dark;
 //! a value that cannot be a light (not finite, negative) is an error naming the prim.
 
@@ -65,8 +65,11 @@ impl Importer<'_> {
             "CylinderLight" => cylinder(size("radius", 0.5)?, size("length", 1.0)?, &m, &emission),
             _ => return Err(format!("{type_name} is not a light kind read here")),
         };
-        let shaping = if lights::UNSHAPED_KINDS.contains(&type_name) { None } else { shaping::read(stage, prim, &m)? };
-        let ies = if lights::SHAPED_KINDS.contains(&type_name) { shaping::read_ies(stage, prim, &m)? } else { None };
+        let (shaping, ies) = if lights::UNSHAPED_KINDS.contains(&type_name) {
+            (None, None)
+        } else {
+            (shaping::read(stage, prim, &m)?, shaping::read_ies(stage, prim, &m)?)
+        };
         self.add_light(prim, label, type_name, built, Shaped { shaping, ies, texture });
         Ok(())
     }
@@ -99,8 +102,8 @@ impl Importer<'_> {
         };
         let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        let shaping = shaping::read(stage, prim, &m)?;
-        self.add_light(prim, label, type_name, built, Shaped { shaping, ..Shaped::default() });
+        let (shaping, ies) = (shaping::read(stage, prim, &m)?, shaping::read_ies(stage, prim, &m)?);
+        self.add_light(prim, label, type_name, built, Shaped { shaping, ies, texture: None });
         Ok(())
     }
 

@@ -93,16 +93,13 @@ impl LightBounds {
 
     /// These bounds narrowed to a shaped light's cone when it is narrower than a hemisphere:
     /// the emission leaves within `cutoff` of the shaping axis (the cone's, or an IES profile's
-    /// last lit angle where that is less), and at full strength within its soft start, so the importance stays positive wherever the light can shine (the soft band
-    /// is the emission spread θe beyond the normals' cone θo, as pbrt-v4 bounds a spot light).
+    /// last lit angle where that is less), and at full strength within its soft start, so the
+    /// importance stays positive wherever the light can shine (the soft band is the emission
+    /// spread θe beyond the normals' cone θo, as pbrt-v4 bounds a spot light). A face of a mesh
+    /// light is shaped about the light's axis, not its normal: the cone about that axis holds
+    /// all it emits on either side, so it replaces the face's hemisphere.
     fn shaped(self, light: &SceneLight) -> Self {
-        let shaping = match light {
-            SceneLight::Point(l) => l.shaping(),
-            SceneLight::Sphere(l) => l.shaping(),
-            SceneLight::Rect(l) => l.shaping(),
-            SceneLight::Disk(l) => l.shaping(),
-            _ => return self,
-        };
+        let Some(shaping) = light.shaping() else { return self };
         let cutoff = shaping.emission_extent();
         if cutoff >= core::f32::consts::FRAC_PI_2 {
             return self;

@@ -50,6 +50,7 @@ pub use scene_light::{LightSurface, SceneLight};
 pub use select::{PowerSelector, SelectedLight};
 pub use shaping::Shaping;
 pub use sphere::SphereLight;
+pub use tilted_integral::{TILTED_GRID_CELLS, TiltedGrid};
 pub use tree::{LightNode, LightTree, MAX_DEPTH, TreeError};
 pub use triangle::{TriangleLight, TriangleSampling};
 

@@ -1,6 +1,8 @@
 //! Any light of a scene behind one type, so that a host keeps its lights in one slice.
 
-use super::{DiskLight, DistantLight, Light, LightHit, LightSample, PointLight, RectLight, SphereLight, TriangleLight};
+use super::{
+    DiskLight, DistantLight, Light, LightHit, LightSample, PointLight, RectLight, Shaping, SphereLight, TriangleLight,
+};
 use glam::{Vec2, Vec3};
 
 /// The surface of an area light, for a host that makes it visible to camera rays and lets it
@@ -76,6 +78,20 @@ impl SceneLight {
             SceneLight::Rect(l) => Some(l.surface()),
             SceneLight::Disk(l) => Some(l.surface()),
             SceneLight::Triangle(l) => Some(l.surface()),
+        }
+    }
+
+    /// How the light's emission falls off from its shaping axis; `None` for a distant light,
+    /// which has no shaping.
+    #[must_use]
+    pub fn shaping(&self) -> Option<&Shaping> {
+        match self {
+            SceneLight::Point(l) => Some(l.shaping()),
+            SceneLight::Sphere(l) => Some(l.shaping()),
+            SceneLight::Rect(l) => Some(l.shaping()),
+            SceneLight::Disk(l) => Some(l.shaping()),
+            SceneLight::Triangle(l) => Some(l.shaping()),
+            SceneLight::Distant(_) => None,
         }
     }
 

@@ -5,7 +5,9 @@
 //! cosine has a closed form (with A = cos θ cos α, B = sin θ sin α, α the tilt of the normal:
 //! 2πA where A ≥ B, 0 where A ≤ −B, else 2(Aφ₀ + B sin φ₀) with φ₀ = acos(−A/B)), leaving one
 //! integral in θ, by Simpson's rule between its kinks; with an IES profile, which depends on φ
-//! too, a midpoint rule over the sphere.
+//! too, a midpoint rule over the cap of directions that emit, in the axis's frame (so that a
+//! narrow beam still spans every row). A mesh light's faces share one shaping: a host computes
+//! that grid once ([`TiltedGrid`]) and each face's integral is then a sum of products.
 
 use super::Shaping;
 use core::f32::consts::{FRAC_PI_2, PI};
@@ -13,7 +15,7 @@ use glam::Vec3;
 
 /// Simpson intervals per smooth piece in θ.
 const STEPS: usize = 64;
-/// The midpoint grid over the sphere for a profiled emitter: θ rows (twice as many in φ).
+/// The midpoint grid over the emitting cap for a profiled emitter: θ rows (twice as many in φ).
 const PROFILE_ROWS: usize = 128;
 
 /// ∫ max(0, A + B cos φ) dφ over [0, 2π], for B ≥ 0.
@@ -74,24 +76,82 @@ impl Shaping {
         total
     }
 
-    /// The midpoint rule over the sphere for a profiled emitter tilted from its axis.
+    /// The midpoint rule over the cap within [`Shaping::emission_extent`] of the axis (all the
+    /// sphere that emits) for a profiled emitter tilted from its axis.
     fn profiled_integral_about(&self, normal: Vec3, two_sided: bool) -> Vec3 {
-        let (rows, cols) = (PROFILE_ROWS, 2 * PROFILE_ROWS);
         let mut total = Vec3::ZERO;
-        for i in 0..rows {
-            let theta = PI * (i as f32 + 0.5) / rows as f32;
-            let (st, ct) = (libm::sinf(theta), libm::cosf(theta));
-            for j in 0..cols {
-                let phi = 2.0 * PI * (j as f32 + 0.5) / cols as f32;
-                let w = Vec3::new(st * libm::cosf(phi), st * libm::sinf(phi), ct);
-                let c = w.dot(normal);
-                let cos = if two_sided { c.abs() } else { c.max(0.0) };
-                if cos > 0.0 {
-                    total += self.factor(w) * (cos * st);
-                }
+        for k in 0..TILTED_GRID_CELLS {
+            let (w, weight) = self.tilted_grid_cell(k);
+            total += weight * clipped(w.dot(normal), two_sided);
+        }
+        total
+    }
+
+    /// Cell `k` of the midpoint grid over the emitting cap that [`Shaping::integral_about`]
+    /// sums for a profiled emitter: its direction, and the factor there times its solid angle.
+    #[must_use]
+    pub fn tilted_grid_cell(&self, k: usize) -> (Vec3, Vec3) {
+        let (rows, cols) = (PROFILE_ROWS, 2 * PROFILE_ROWS);
+        let (i, j) = (k / cols, k % cols);
+        let extent = self.emission_extent();
+        let d_theta = extent / rows as f32;
+        let theta = d_theta * (i as f32 + 0.5);
+        let (st, ct) = (libm::sinf(theta), libm::cosf(theta));
+        let phi = 2.0 * PI * (j as f32 + 0.5) / cols as f32;
+        let local = Vec3::new(st * libm::cosf(phi), st * libm::sinf(phi), ct);
+        let w = self.axis_frame_to_world(local);
+        (w, self.factor(w) * (st * d_theta * (2.0 * PI / cols as f32)))
+    }
+
+    /// The world direction of `local`, given in a frame whose +Z is the axis.
+    fn axis_frame_to_world(&self, local: Vec3) -> Vec3 {
+        let a = self.axis();
+        // Duff et al.'s branchless orthonormal basis about the axis.
+        let sign = if a.z >= 0.0 { 1.0 } else { -1.0 };
+        let p = -1.0 / (sign + a.z);
+        let q = a.x * a.y * p;
+        let t = Vec3::new(1.0 + sign * a.x * a.x * p, sign * q, -sign * a.x);
+        let b = Vec3::new(q, sign + a.y * a.y * p, -a.y);
+        t * local.x + b * local.y + a * local.z
+    }
+}
+
+/// The cells of the grid [`Shaping::tilted_grid_cell`] numbers.
+pub const TILTED_GRID_CELLS: usize = 2 * PROFILE_ROWS * PROFILE_ROWS;
+
+/// The cosine weight of a direction whose cosine with a face's normal is `cos`.
+#[inline]
+fn clipped(cos: f32, two_sided: bool) -> f32 {
+    if two_sided { cos.abs() } else { cos.max(0.0) }
+}
+
+/// The grid of [`Shaping::tilted_grid_cell`] computed once for the many faces of one light (a
+/// host keeps it): the cells where the emission is not zero.
+#[derive(Clone, Copy, Debug)]
+pub struct TiltedGrid<'a> {
+    cells: &'a [(Vec3, Vec3)],
+}
+
+impl<'a> TiltedGrid<'a> {
+    /// Fills `cells` (at least [`TILTED_GRID_CELLS`] long) with the grid of `shaping`, keeping
+    /// the cells that emit; the grid over them.
+    pub fn build(shaping: &Shaping, cells: &'a mut [(Vec3, Vec3)]) -> Self {
+        let mut used = 0;
+        for k in 0..TILTED_GRID_CELLS.min(cells.len()) {
+            let cell = shaping.tilted_grid_cell(k);
+            if cell.1 != Vec3::ZERO {
+                cells[used] = cell;
+                used += 1;
             }
         }
-        total * (PI / rows as f32) * (2.0 * PI / cols as f32)
+        Self { cells: &cells[..used] }
+    }
+
+    /// [`Shaping::integral_about`] for a profiled shaping whose axis is not `normal`, from the
+    /// grid: the same midpoint sum, without evaluating the profile again.
+    #[must_use]
+    pub fn integral_about(&self, normal: Vec3, two_sided: bool) -> Vec3 {
+        self.cells.iter().fold(Vec3::ZERO, |total, (w, weight)| total + *weight * clipped(w.dot(normal), two_sided))
     }
 }
 

@@ -3,6 +3,7 @@
 //! converted to solid angle. [`TriangleSampling::default`] is the measured choice.
 
 use super::spherical_triangle::SphericalTriangle;
+use super::tilted_integral::TiltedGrid;
 use super::{
     Emission, Light, LightError, LightHit, LightSample, Shaping, area_sample, area_to_solid_angle, checked_rgb,
     emitted, finite,
@@ -40,6 +41,8 @@ pub struct TriangleLight {
     area: f32,
     emission: Emission,
     sampling: TriangleSampling,
+    /// The emitted power, computed with the emission (a shaped face's is an integral).
+    power: Vec3,
 }
 
 /// Slack of the barycentric hit test that admits the rounding of points drawn on the edges.
@@ -57,7 +60,9 @@ impl TriangleLight {
             return Err(LightError::ZeroArea);
         }
         let emission = Emission { radiance: checked_rgb(radiance)?, two_sided: false, shaping: Shaping::NONE };
-        Ok(Self { v, normal: cross / len, area: 0.5 * len, emission, sampling: TriangleSampling::default() })
+        let (normal, area) = (cross / len, 0.5 * len);
+        let power = emission.power_facing(area, normal);
+        Ok(Self { v, normal, area, emission, sampling: TriangleSampling::default(), power })
     }
 
     /// Both sides emit.
@@ -75,14 +80,32 @@ impl TriangleLight {
     /// The same triangle, emitting on both sides when `two_sided`.
     #[must_use]
     pub fn with_two_sided(self, two_sided: bool) -> Self {
-        Self { emission: Emission { two_sided, ..self.emission }, ..self }
+        self.with_emission(Emission { two_sided, ..self.emission })
+    }
+
+    /// The same triangle emitting `emission`, its power recomputed.
+    fn with_emission(self, emission: Emission) -> Self {
+        Self { emission, power: emission.power_facing(self.area, self.normal), ..self }
     }
 
     /// The same triangle, its radiance shaped by `shaping` about the shaping's own axis (for a
     /// mesh light, the light's primary axis rather than this face's normal).
     #[must_use]
     pub fn with_shaping(self, shaping: Shaping) -> Self {
-        Self { emission: Emission { shaping, ..self.emission }, ..self }
+        self.with_emission(Emission { shaping, ..self.emission })
+    }
+
+    /// [`TriangleLight::with_shaping`] for a profiled `shaping` whose integrals over the faces of
+    /// one mesh come from its `grid` (built once for them all) rather than from the profile.
+    #[must_use]
+    pub fn with_shaping_on_grid(self, shaping: Shaping, grid: &TiltedGrid<'_>) -> Self {
+        let emission = Emission { shaping, ..self.emission };
+        let tilted = shaping.profile().is_some() && shaping.axis().dot(self.normal) < 1.0 - 1e-7;
+        if !tilted {
+            return self.with_emission(emission);
+        }
+        let power = emission.radiance * self.area * grid.integral_about(self.normal, emission.two_sided);
+        Self { emission, power, ..self }
     }
 
     /// How its radiance falls off away from the shaping axis.
@@ -177,7 +200,7 @@ impl Light for TriangleLight {
     }
 
     fn power(&self, _scene_radius: f32) -> Vec3 {
-        self.emission.power_facing(self.area, self.normal)
+        self.power
     }
 }
 

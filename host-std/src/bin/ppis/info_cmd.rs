@@ -120,8 +120,15 @@ fn print_lights(scene: &Scene) {
         }
     }
     let list: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} {k}")).collect();
+    let shapings = || scene.lights.iter().filter_map(SceneLight::shaping).filter(|s| !s.is_none());
+    let (shaped, profiled) = (shapings().count(), shapings().filter(|s| s.profile().is_some()).count());
+    let shaped = match (shaped, profiled) {
+        (0, _) => String::new(),
+        (n, 0) => format!("; {n} shaped (cone or focus)"),
+        (n, p) => format!("; {n} shaped, {p} of them by an IES profile"),
+    };
     println!(
-        "lights: {} ({}); a render picks one per sample by a light tree (--light-selection), samples it by solid angle, MIS with BRDF samples",
+        "lights: {} ({}{shaped}); a render picks one per sample by a light tree (--light-selection), samples it by solid angle, MIS with BRDF samples",
         scene.lights.len(),
         list.join(", ")
     );
