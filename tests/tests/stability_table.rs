@@ -208,7 +208,8 @@ fn table_header() -> String {
 
 /// The asserts of one case (`z` against the reference, `se` the combined standard error): albedo
 /// 0 is black, the white furnace reflects 1, and the mean is within 5 SE of the reference
-/// (one-sided for the single techniques); a failure is pushed onto `failures`.
+/// (one-sided for the single techniques) or within f32's resolution of it; a failure is pushed
+/// onto `failures`.
 fn check(row: &Row, z: f64, se: f64, failures: &mut Vec<String>) {
     let label = format!("{} / {} / {}", row.lighting, row.material, row.method);
     if row.material == "lambert ρ=0" && row.mean != 0.0 {
@@ -221,9 +222,12 @@ fn check(row: &Row, z: f64, se: f64, failures: &mut Vec<String>) {
         }
     }
     // Against the MIS reference (whose own SE is far smaller): 5 SE, one-sided for the
-    // single techniques.
+    // single techniques, and only where the two differ by more than f32's resolution (the
+    // pixels are f32): a needle lobe's far tail under a one-texel sun, which compensated MIS
+    // leaves to rare BRDF samples, otherwise trips a test whose SE rests on 64 images.
     let single = matches!(row.method, Method::Env | Method::Brdf | Method::TwoStage | Method::TwoLevel);
-    if se > 0.0 && (z > 5.0 || (!single && z < -5.0)) {
+    let resolved = (row.mean - row.reference.0).abs() > f64::from(f32::EPSILON) * row.reference.0.abs();
+    if se > 0.0 && resolved && (z > 5.0 || (!single && z < -5.0)) {
         failures.push(format!("{label}: mean {} vs reference {} (z = {z:.2})", row.mean, row.reference.0));
     }
 }
