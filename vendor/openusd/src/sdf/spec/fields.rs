@@ -288,10 +288,15 @@ impl Fields {
 
     /// Appends a field not yet authored, in one allocation of exactly the new length.
     fn push(&mut self, name: FieldName, value: Value) {
-        let mut fields = into_vec(std::mem::take(self).0);
-        fields.reserve_exact(1);
-        fields.push(Field { name, value });
-        self.0 = List::Whole(fields.into());
+        let field = std::iter::once(Field { name, value });
+        let fields: Arc<[Field]> = match &mut self.0 {
+            List::Whole(fields) => match Arc::get_mut(fields) {
+                Some(own) => own.iter_mut().map(take_field).chain(field).collect(),
+                None => fields.iter().cloned().chain(field).collect(),
+            },
+            List::Split(split) => split.head.iter().chain(std::iter::once(&split.last)).cloned().chain(field).collect(),
+        };
+        self.0 = List::Whole(fields);
     }
 
     /// Removes the field named `key`, returning its value; the others keep their order.
