@@ -119,8 +119,8 @@ fn main() {
     let mesh = Shape::Mesh {
         positions: tris.iter().flatten().copied().collect(),
         triangles: (0..tris.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect(),
-        normals: Vec::new(),
-        uvs: Vec::new(),
+        normals: Box::new([]),
+        uvs: Box::new([]),
     };
     let tri_scene = Scene { objects: vec![Object { shape: mesh, material: 0 }], ..scene.clone() };
 

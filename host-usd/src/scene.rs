@@ -23,20 +23,24 @@ pub struct Mesh {
     /// its prim path, with `[i]` for the instance).
     pub path: String,
     /// Points in world space.
-    pub positions: Vec<Vec3>,
+    pub positions: Box<[Vec3]>,
     /// Counter-clockwise front faces (USD's `orientation` and negative-determinant
     /// transforms already applied).
-    pub triangles: Vec<[u32; 3]>,
+    pub triangles: Box<[[u32; 3]]>,
     /// Per-triangle corner shading normals, or empty for face normals.
-    pub normals: Vec<[Vec3; 3]>,
+    pub normals: Box<[[Vec3; 3]]>,
     /// Per-triangle corner texture coordinates (read only when a material on the mesh is
     /// textured), or empty.
-    pub uvs: Vec<[Vec2; 3]>,
+    pub uvs: Box<[[Vec2; 3]]>,
     /// Index into [`UsdScene::materials`].
     pub material: usize,
     /// `doubleSided`: back faces shade like front faces.
     pub double_sided: bool,
 }
+
+// A stage of many small meshes holds one record per mesh until the renderer takes them:
+// its lists are exactly their length, with no capacity word.
+const _: () = assert!(std::mem::size_of::<Mesh>() == 104);
 
 /// An exact sphere (a UsdGeomSphere under a similarity transform).
 #[derive(Clone, Debug, PartialEq)]

@@ -152,10 +152,10 @@ fn back_faces_grazing_views_and_degenerate_triangles() {
                 },
                 objects: vec![Object {
                     shape: Shape::Mesh {
-                        positions: positions.clone(),
-                        triangles: triangles.clone(),
-                        normals: Vec::new(),
-                        uvs: Vec::new(),
+                        positions: positions.clone().into(),
+                        triangles: triangles.clone().into(),
+                        normals: Box::new([]),
+                        uvs: Box::new([]),
                     },
                     material: 0,
                 }],

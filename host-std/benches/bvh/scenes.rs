@@ -82,7 +82,12 @@ pub fn displaced_sphere_scene(rings: u32, segments: u32) -> Scene {
             triangles.push([a, d, c]);
         }
     }
-    let mesh = Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() };
+    let mesh = Shape::Mesh {
+        positions: positions.into(),
+        triangles: triangles.into(),
+        normals: Box::new([]),
+        uvs: Box::new([]),
+    };
     let ground = Shape::Rectangle {
         p0: Vec3::new(-20.0, 0.0, -20.0),
         e1: Vec3::new(0.0, 0.0, 40.0),

@@ -242,7 +242,13 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     return Err(invalid(format!("shapes[{k}]: only face normals are supported (face_normals: true)")));
                 }
                 let (positions, triangles) = mesh::load_placed(&dir.join(file), to_world)?;
-                (Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() }, material)
+                let shape = Shape::Mesh {
+                    positions: positions.into(),
+                    triangles: triangles.into(),
+                    normals: Box::new([]),
+                    uvs: Box::new([]),
+                };
+                (shape, material)
             }
         };
         materials.push(material_of(material).map_err(|m| invalid(format!("shapes[{k}].material: {m}")))?);

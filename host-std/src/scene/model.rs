@@ -51,13 +51,13 @@ pub enum Shape {
     /// (empty: face normals) and texture coordinates (empty: none).
     Mesh {
         /// Vertex positions.
-        positions: Vec<Vec3>,
+        positions: Box<[Vec3]>,
         /// Vertex indices per triangle.
-        triangles: Vec<[u32; 3]>,
+        triangles: Box<[[u32; 3]]>,
         /// Per triangle, its corners' shading normals (empty: face normals).
-        normals: Vec<[Vec3; 3]>,
+        normals: Box<[[Vec3; 3]]>,
         /// Per triangle, its corners' texture coordinates (empty: none).
-        uvs: Vec<[Vec2; 3]>,
+        uvs: Box<[[Vec2; 3]]>,
     },
 }
 

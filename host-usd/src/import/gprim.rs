@@ -127,9 +127,16 @@ fn transform(
     if uvs.len() != triangles.len() {
         uvs.clear();
     }
-    positions.shrink_to_fit();
     if positions.iter().any(|p: &Vec3| !p.is_finite()) {
         return Err("a transformed point is not finite".into());
     }
-    Ok(Mesh { path: label.to_string(), positions, triangles, normals, uvs, material, double_sided })
+    Ok(Mesh {
+        path: label.to_string(),
+        positions: positions.into_boxed_slice(),
+        triangles: triangles.into_boxed_slice(),
+        normals: normals.into_boxed_slice(),
+        uvs: uvs.into_boxed_slice(),
+        material,
+        double_sided,
+    })
 }

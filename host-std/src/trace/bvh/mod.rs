@@ -258,7 +258,12 @@ mod tests {
         // Two triangles with an area, one with two equal corners, one on a line.
         let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE, 2.0 * Vec3::ONE];
         let triangles = vec![[0, 1, 2], [1, 2, 3], [0, 0, 1], [0, 3, 4]];
-        let mesh = Shape::Mesh { positions, triangles, normals: Vec::new(), uvs: Vec::new() };
+        let mesh = Shape::Mesh {
+            positions: positions.into(),
+            triangles: triangles.into(),
+            normals: Box::new([]),
+            uvs: Box::new([]),
+        };
         let objects = vec![
             Object { shape: mesh, material: 0 },
             Object { shape: Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, material: 0 },

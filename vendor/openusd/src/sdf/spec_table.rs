@@ -16,62 +16,124 @@ use crate::tf;
 #[derive(Debug, Default, Clone)]
 struct Entry {
     spec: Option<SpecData>,
-    /// In the order they were added, names unique; each names itself by its
-    /// [`SpecData::name`], an index into the table's [`Names`].
-    properties: Vec<SpecData>,
-    /// Each property's slot by name, once there are more than [`SCAN_LIMIT`]: a scan (or a
-    /// sorted insertion) per property made a prim of `n` properties cost `n²`.
-    index: Option<Box<HashMap<tf::Token, u32>>>,
+    properties: Properties,
 }
 
 /// How many properties an entry scans before it indexes them: most prims own a handful.
 const SCAN_LIMIT: usize = 16;
 
-impl Entry {
-    /// The slot of `name` among the properties.
+/// An entry's property specs, in the order they were added, names unique; each names
+/// itself by its [`SpecData::name`], an index into the table's [`Names`].
+///
+/// A layer holds one per prim for its life, so the common case is small: a prim's first
+/// [`SCAN_LIMIT`] properties are a list of exactly their number, found by a scan. Past
+/// that the list grows by doubling (a prim of `n` properties would otherwise copy it `n`
+/// times) beside an index by name (a scan per property made such a prim cost `n²`).
+#[derive(Debug, Clone)]
+enum Properties {
+    Few(Box<[SpecData]>),
+    Many(Box<Indexed>),
+}
+
+#[derive(Debug, Clone)]
+struct Indexed {
+    specs: Vec<SpecData>,
+    slots: HashMap<tf::Token, u32>,
+}
+
+// The few-properties list and the boxed index share the list's 16 bytes.
+const _: () = assert!(std::mem::size_of::<Properties>() == 16);
+
+impl Default for Properties {
+    fn default() -> Self {
+        Properties::Few(Box::default())
+    }
+}
+
+impl Properties {
+    fn specs(&self) -> &[SpecData] {
+        match self {
+            Properties::Few(specs) => specs,
+            Properties::Many(many) => &many.specs,
+        }
+    }
+
+    fn specs_mut(&mut self) -> &mut [SpecData] {
+        match self {
+            Properties::Few(specs) => specs,
+            Properties::Many(many) => &mut many.specs,
+        }
+    }
+
+    /// The slot of `name`.
     fn find(&self, names: &Names, name: &str) -> Option<usize> {
-        match &self.index {
-            Some(index) => index.get(name).map(|&at| at as usize),
-            None => self.properties.iter().position(|spec| names.text(spec.name).as_str() == name),
+        match self {
+            Properties::Few(specs) => specs.iter().position(|spec| names.text(spec.name).as_str() == name),
+            Properties::Many(many) => many.slots.get(name).map(|&at| at as usize),
         }
     }
 
     /// Appends a property not yet here (named by its `name`), returning its slot.
     fn push(&mut self, names: &Names, spec: SpecData) -> usize {
-        let at = self.properties.len();
-        if let Some(index) = &mut self.index {
-            index.insert(names.text(spec.name).clone(), slot(at));
+        match self {
+            Properties::Few(specs) => {
+                let at = specs.len();
+                // The new list is exactly one longer: shrinking a doubled list once the
+                // layer is parsed would leave its tail as a hole in the heap that the
+                // import's later, differently sized blocks do not fill.
+                let mut list = std::mem::take(specs).into_vec();
+                list.reserve_exact(1);
+                list.push(spec);
+                if list.len() <= SCAN_LIMIT {
+                    *specs = list.into_boxed_slice();
+                } else {
+                    let slots = list.iter().enumerate().map(|(at, spec)| (names.text(spec.name).clone(), slot(at)));
+                    let slots = slots.collect();
+                    *self = Properties::Many(Box::new(Indexed { specs: list, slots }));
+                }
+                at
+            }
+            Properties::Many(many) => {
+                let at = many.specs.len();
+                many.slots.insert(names.text(spec.name).clone(), slot(at));
+                many.specs.push(spec);
+                at
+            }
         }
-        // A prim's few properties are held for the layer's life in a list of exactly their
-        // number. Shrinking a doubled list once the layer is parsed (`shrink_to_fit`) leaves
-        // its tail as a hole in the heap that the import's later, differently sized blocks
-        // do not fill. Past the scan limit the list grows by doubling, as a prim of `n`
-        // properties would otherwise copy it `n` times.
-        if self.properties.len() < SCAN_LIMIT {
-            self.properties.reserve_exact(1);
-        }
-        self.properties.push(spec);
-        if self.index.is_none() && self.properties.len() > SCAN_LIMIT {
-            let index = self.properties.iter().enumerate().map(|(at, spec)| (names.text(spec.name).clone(), slot(at)));
-            self.index = Some(Box::new(index.collect()));
-        }
-        at
     }
 
     /// Removes the property at slot `at`; the last property takes its slot.
     fn remove(&mut self, names: &Names, at: usize) -> SpecData {
-        let spec = self.properties.swap_remove(at);
-        if let Some(index) = &mut self.index {
-            index.remove(names.text(spec.name).as_str());
-            if let Some(moved) = self.properties.get(at) {
-                index.insert(names.text(moved.name).clone(), slot(at));
+        match self {
+            Properties::Few(specs) => {
+                let mut list = std::mem::take(specs).into_vec();
+                let spec = list.swap_remove(at);
+                *specs = list.into_boxed_slice();
+                spec
+            }
+            Properties::Many(many) => {
+                let spec = many.specs.swap_remove(at);
+                many.slots.remove(names.text(spec.name).as_str());
+                if let Some(moved) = many.specs.get(at) {
+                    many.slots.insert(names.text(moved.name).clone(), slot(at));
+                }
+                spec
             }
         }
-        spec
     }
 
+    /// Frees a grown list's spare capacity.
+    fn shrink_to_fit(&mut self) {
+        if let Properties::Many(many) = self {
+            many.specs.shrink_to_fit();
+            many.slots.shrink_to_fit();
+        }
+    }
+}
+
+impl Entry {
     fn is_empty(&self) -> bool {
-        self.spec.is_none() && self.properties.is_empty()
+        self.spec.is_none() && self.properties.specs().is_empty()
     }
 }
 
@@ -135,7 +197,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get(key)?;
         match name {
-            Some(name) => entry.find(&self.names, name).map(|at| &entry.properties[at]),
+            Some(name) => entry.properties.find(&self.names, name).map(|at| &entry.properties.specs()[at]),
             None => entry.spec.as_ref(),
         }
     }
@@ -144,7 +206,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         match name {
-            Some(name) => entry.find(&self.names, name).map(|at| &mut entry.properties[at]),
+            Some(name) => entry.properties.find(&self.names, name).map(|at| &mut entry.properties.specs_mut()[at]),
             None => entry.spec.as_mut(),
         }
     }
@@ -192,16 +254,16 @@ impl SpecTable {
         make: impl FnOnce() -> SpecData,
     ) -> &mut SpecData {
         let entry = self.entries.entry(owner.clone()).or_default();
-        let at = match entry.find(&self.names, name) {
+        let at = match entry.properties.find(&self.names, name) {
             Some(at) => at,
             None => {
                 self.len += 1;
                 let mut spec = make();
                 spec.name = self.names.id(name, token);
-                entry.push(&self.names, spec)
+                entry.properties.push(&self.names, spec)
             }
         };
-        &mut entry.properties[at]
+        &mut entry.properties.specs_mut()[at]
     }
 
     /// Puts `spec` at `path`, returning the spec it replaces.
@@ -218,7 +280,7 @@ impl SpecTable {
         let (key, name) = split(path);
         let entry = self.entries.get_mut(key)?;
         let removed = match name {
-            Some(name) => entry.find(&self.names, name).map(|at| entry.remove(&self.names, at)),
+            Some(name) => entry.properties.find(&self.names, name).map(|at| entry.properties.remove(&self.names, at)),
             None => entry.spec.take(),
         };
         if entry.is_empty() {
@@ -233,7 +295,7 @@ impl SpecTable {
     /// (see [`FieldTable`]).
     pub(crate) fn share_fields(&mut self, path: &Path, table: &mut FieldTable) {
         let Some(entry) = self.entries.get_mut(path) else { return };
-        for spec in entry.spec.iter_mut().chain(entry.properties.iter_mut()) {
+        for spec in entry.spec.iter_mut().chain(entry.properties.specs_mut()) {
             table.share(&mut spec.fields);
         }
     }
@@ -242,7 +304,7 @@ impl SpecTable {
         let names = &self.names;
         self.entries.iter().flat_map(move |(path, entry)| {
             let own = entry.spec.as_ref().map(|spec| (path.clone(), spec));
-            let properties = entry.properties.iter().map(move |spec| {
+            let properties = entry.properties.specs().iter().map(move |spec| {
                 let name = names.text(spec.name);
                 let property = path.append_property(name).expect("a structured owner takes its property");
                 (property, spec)
@@ -255,9 +317,6 @@ impl SpecTable {
     pub(crate) fn shrink_to_fit(&mut self) {
         for entry in self.entries.values_mut() {
             entry.properties.shrink_to_fit();
-            if let Some(index) = &mut entry.index {
-                index.shrink_to_fit();
-            }
         }
     }
 }

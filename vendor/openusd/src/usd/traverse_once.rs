@@ -31,12 +31,22 @@ impl Stage {
         enum Step {
             Enter(sdf::Path, Inherited),
             Leave(sdf::Path, bool),
+            /// The children of a prim not yet entered, in order: a prim of many children
+            /// holds a list of exactly their paths, not a step per child.
+            Children(std::vec::IntoIter<sdf::Path>, Inherited),
         }
         let needed = predicate.consulted_bits();
         let mut stack = vec![Step::Enter(sdf::Path::abs_root(), Inherited::ROOT)];
         while let Some(step) = stack.pop() {
             let (path, above) = match step {
                 Step::Enter(path, above) => (path, above),
+                Step::Children(mut children, below) => {
+                    if let Some(child) = children.next() {
+                        stack.push(Step::Children(children, below));
+                        stack.push(Step::Enter(child, below));
+                    }
+                    continue;
+                }
                 Step::Leave(path, visited) => {
                     if visited && visitor(Visit::Leave(&path)).is_break() {
                         return Ok(());
@@ -63,12 +73,10 @@ impl Stage {
                 }
             }
             let names = self.masked(&path, |g, cache| cache.prim_children(g, &path))?;
-            let children = self.filter_child_names(&path, names);
-            for name in children.iter().rev() {
-                if let Ok(child) = path.append_path(name.as_str()) {
-                    stack.push(Step::Enter(child, below));
-                }
-            }
+            let names = self.filter_child_names(&path, names);
+            let mut children = Vec::with_capacity(names.len());
+            children.extend(names.iter().filter_map(|name| path.append_path(name.as_str()).ok()));
+            stack.push(Step::Children(children.into_iter(), below));
         }
         Ok(())
     }

@@ -16,33 +16,64 @@ use std::sync::Arc;
 
 use bytemuck::{bytes_of, cast_slice};
 
-use super::fields::{Field, Fields};
+use super::fields::{take_field, Field, Fields, List, Split};
 use crate::sdf::Value;
 use crate::tf::Token;
 
-/// The distinct field lists a reader has finished so far. It lives while its layer is
-/// read: a list held only by the table afterwards would be held for nothing.
+/// The distinct field lists a reader has finished so far, and the heads (every field but
+/// the last) of those lists. It lives while its layer is read: a list held only by the
+/// table afterwards would be held for nothing.
 /// Its hash is aHash, keyed at random per table as the standard map's SipHash is (a
 /// file cannot be made of lists that collide), at a fraction of SipHash's cost for the
 /// many short writes a list makes.
 #[derive(Default)]
 pub struct FieldTable {
     lists: HashMap<Key, (), ahash::RandomState>,
+    /// Heads by their hash (under `lists`' hasher), each equal head once.
+    heads: HashMap<u64, Vec<Arc<[Field]>>>,
 }
 
 impl FieldTable {
     /// Replaces `fields` by the equal list the table holds, or makes the table hold it.
+    /// A list the table does not hold whose head an earlier list had keeps only its
+    /// last field and shares that head (a list of a value seen once then costs the
+    /// value's field, not its whole list).
     pub fn share(&mut self, fields: &mut Fields) {
-        let Some(list) = fields.shared() else { return };
-        if !list.iter().all(|field| bits(&field.value).is_some()) {
+        let List::Whole(list) = &fields.0 else { return };
+        if list.is_empty() || !list.iter().all(|field| bits(&field.value).is_some()) {
             return;
         }
-        match self.lists.entry(Key(list.clone())) {
-            std::collections::hash_map::Entry::Occupied(held) => *list = held.key().0.clone(),
-            std::collections::hash_map::Entry::Vacant(new) => {
-                new.insert(());
-            }
+        let key = Key(fields.0.clone());
+        if let Some((held, ())) = self.lists.get_key_value(&key) {
+            fields.0 = held.0.clone();
+            return;
         }
+        drop(key);
+        if let Some(head) = self.head(list) {
+            let List::Whole(mut list) = std::mem::take(fields).0 else { unreachable!("a whole list") };
+            let last = match Arc::get_mut(&mut list) {
+                Some(own) => own.last_mut().map(take_field),
+                None => list.last().cloned(),
+            };
+            fields.0 = List::Split(Arc::new(Split { head, last: last.expect("a list of two or more") }));
+        }
+        self.lists.insert(Key(fields.0.clone()), ());
+    }
+
+    /// The held head equal to `list`'s, if an earlier list had it; else the table holds
+    /// a copy of it for later lists. A list of one field has no head.
+    fn head(&mut self, list: &[Field]) -> Option<Arc<[Field]>> {
+        let (_, head) = list.split_last()?;
+        if head.is_empty() {
+            return None;
+        }
+        let hash = self.lists.hasher().hash_one(HashFields(head.iter()));
+        let bucket = self.heads.entry(hash).or_default();
+        if let Some(held) = bucket.iter().find(|held| equal(held.iter(), head.iter())) {
+            return Some(held.clone());
+        }
+        bucket.push(head.into());
+        None
     }
 
     /// The number of distinct lists held.
@@ -57,22 +88,35 @@ impl FieldTable {
 }
 
 /// A field list whose every value has [`bits`].
-struct Key(Arc<[Field]>);
+struct Key(List);
 
-impl Hash for Key {
+/// Fields hashed by their names and bits, in order.
+struct HashFields<I>(I);
+
+impl<'a, I: Iterator<Item = &'a Field> + Clone> Hash for HashFields<I> {
     fn hash<H: Hasher>(&self, state: &mut H) {
-        state.write_usize(self.0.len());
-        for field in self.0.iter() {
+        state.write_usize(self.0.clone().count());
+        for field in self.0.clone() {
             field.name.as_str().hash(state);
             bits(&field.value).hash(state);
         }
     }
 }
 
+/// Whether two field sequences have the same names and bits, in order.
+fn equal<'a>(a: impl ExactSizeIterator<Item = &'a Field>, b: impl ExactSizeIterator<Item = &'a Field>) -> bool {
+    a.len() == b.len() && a.zip(b).all(|(a, b)| a.name.as_str() == b.name.as_str() && bits(&a.value) == bits(&b.value))
+}
+
+impl Hash for Key {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        HashFields(self.0.iter()).hash(state);
+    }
+}
+
 impl PartialEq for Key {
     fn eq(&self, other: &Self) -> bool {
-        self.0.len() == other.0.len()
-            && self.0.iter().zip(other.0.iter()).all(|(a, b)| a.name.as_str() == b.name.as_str() && bits(&a.value) == bits(&b.value))
+        equal(self.0.iter(), other.0.iter())
     }
 }
 
@@ -239,5 +283,40 @@ mod tests {
         assert_eq!(d.get("default"), Some(&Value::Int(2)));
         assert_eq!(d.remove("default"), Some(Value::Int(2)));
         assert_eq!(c.get("default"), Some(&Value::Int(1)));
+    }
+
+    #[test]
+    fn lists_of_distinct_values_share_their_heads() {
+        let mut table = FieldTable::default();
+        let points = |x: f32| {
+            fields(&[
+                ("typeName", Value::Token(Token::new("point3f[]"))),
+                ("variability", Value::Variability(Variability::Varying)),
+                ("default", Value::Vec3fVec(vec![crate::gf::vec3f(x, 0.0, 0.0)])),
+            ])
+        };
+        let (mut a, mut b, mut c, mut d) = (points(1.0), points(2.0), points(3.0), points(3.0));
+        for list in [&mut a, &mut b, &mut c, &mut d] {
+            table.share(list);
+        }
+        assert!(b.shares_head_with(&c) && !a.shares_head_with(&b), "the first keeps its whole list");
+        assert!(c.is_shared_with(&d), "an equal split list is one list");
+        assert_eq!(table.len(), 3);
+        let names: Vec<&str> = c.iter().map(|(name, _)| name).collect();
+        assert_eq!(names, ["typeName", "variability", "default"]);
+        assert_eq!(c.len(), 3);
+        assert_eq!(c.get("default"), Some(&Value::Vec3fVec(vec![crate::gf::vec3f(3.0, 0.0, 0.0)])));
+        assert_eq!(c.get("variability"), Some(&Value::Variability(Variability::Varying)));
+
+        // Editing a split list copies it: neither its head's other lists nor its equals see it.
+        c.set("default", Value::Vec3fVec(Vec::new()));
+        c.set("custom", Value::Bool(true));
+        assert_eq!(d.get("default"), Some(&Value::Vec3fVec(vec![crate::gf::vec3f(3.0, 0.0, 0.0)])));
+        assert_eq!(b.get("default"), Some(&Value::Vec3fVec(vec![crate::gf::vec3f(2.0, 0.0, 0.0)])));
+        assert_eq!(c.len(), 4);
+        assert_eq!(d.remove("variability"), Some(Value::Variability(Variability::Varying)));
+        assert_eq!(b.get("variability"), Some(&Value::Variability(Variability::Varying)));
+        let taken: Vec<String> = b.into_iter().map(|(name, _)| name.to_string()).collect();
+        assert_eq!(taken, ["typeName", "variability", "default"]);
     }
 }

@@ -154,49 +154,120 @@ pub(super) struct Field {
     pub(super) value: Value,
 }
 
-/// A spec's fields in authored order, names unique; no allocation when there are none.
-#[derive(Clone, Default)]
-pub struct Fields(Option<Arc<[Field]>>);
+/// A spec's fields in authored order, names unique.
+///
+/// A list is one allocation, which specs with equal lists share; a list whose last field
+/// is the spec's own (an attribute's `typeName` and `variability` are those of many
+/// others, its `default` its own) may instead share the fields before it and hold only
+/// the last, so that a layer of many distinct values does not repeat the fields around
+/// them ([`FieldTable`](super::FieldTable) decides). An empty list is one shared list.
+#[derive(Clone)]
+pub struct Fields(pub(super) List);
+
+#[derive(Clone)]
+pub(super) enum List {
+    /// Every field, in order.
+    Whole(Arc<[Field]>),
+    /// A shared head and the spec's own last field.
+    Split(Arc<Split>),
+}
+
+#[derive(Clone)]
+pub(super) struct Split {
+    pub(super) head: Arc<[Field]>,
+    pub(super) last: Field,
+}
+
+// A spec record holds its fields in two words, whichever way they are kept.
+const _: () = assert!(std::mem::size_of::<Fields>() == 16);
+
+/// The one empty list, so that a spec without fields allocates none.
+fn empty() -> Arc<[Field]> {
+    static EMPTY: std::sync::LazyLock<Arc<[Field]>> = std::sync::LazyLock::new(|| Arc::from(Vec::new()));
+    EMPTY.clone()
+}
+
+impl Default for Fields {
+    fn default() -> Self {
+        Fields(List::Whole(empty()))
+    }
+}
+
+impl List {
+    /// The fields as a leading slice and, for a split list, its last field.
+    pub(super) fn parts(&self) -> (&[Field], Option<&Field>) {
+        match self {
+            List::Whole(fields) => (fields, None),
+            List::Split(split) => (&split.head, Some(&split.last)),
+        }
+    }
+
+    /// The fields in order.
+    pub(super) fn iter(&self) -> FieldIter<'_> {
+        let (head, last) = self.parts();
+        FieldIter { head: head.iter(), last }
+    }
+}
+
+/// The fields of a [`List`] in order.
+#[derive(Clone)]
+pub(super) struct FieldIter<'a> {
+    head: std::slice::Iter<'a, Field>,
+    last: Option<&'a Field>,
+}
+
+impl<'a> Iterator for FieldIter<'a> {
+    type Item = &'a Field;
+
+    fn next(&mut self) -> Option<&'a Field> {
+        self.head.next().or_else(|| self.last.take())
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.head.len() + usize::from(self.last.is_some());
+        (n, Some(n))
+    }
+}
+
+impl ExactSizeIterator for FieldIter<'_> {}
 
 impl Fields {
     /// The number of fields.
     pub fn len(&self) -> usize {
-        self.slice().len()
+        let (head, last) = self.0.parts();
+        head.len() + usize::from(last.is_some())
     }
 
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
-        self.slice().is_empty()
+        self.len() == 0
     }
 
     /// The names and values in authored order.
     pub fn iter(&self) -> Iter<'_> {
-        Iter(self.slice().iter())
-    }
-
-    pub(super) fn slice(&self) -> &[Field] {
-        self.0.as_deref().unwrap_or_default()
-    }
-
-    /// The list itself, for [`FieldTable`](super::FieldTable) to share.
-    pub(super) fn shared(&mut self) -> Option<&mut Arc<[Field]>> {
-        self.0.as_mut()
+        Iter(self.0.iter())
     }
 
     fn position(&self, key: &str) -> Option<usize> {
-        self.slice().iter().position(|field| field.name.as_str() == key)
+        self.0.iter().position(|field| field.name.as_str() == key)
     }
 
     /// The value of the field named `key`.
     pub fn get(&self, key: &str) -> Option<&Value> {
-        self.position(key).map(|at| &self.slice()[at].value)
+        self.0.iter().find(|field| field.name.as_str() == key).map(|field| &field.value)
     }
 
     /// The value of the field named `key`, to edit in place (a shared list is copied first).
     pub fn get_mut(&mut self, key: &str) -> Option<&mut Value> {
         let at = self.position(key)?;
-        let fields = self.0.as_mut()?;
-        Some(&mut Arc::make_mut(fields)[at].value)
+        if let List::Split(split) = &self.0 {
+            let fields: Vec<Field> = split.head.iter().chain(std::iter::once(&split.last)).cloned().collect();
+            self.0 = List::Whole(fields.into());
+        }
+        match &mut self.0 {
+            List::Whole(fields) => Some(&mut Arc::make_mut(fields)[at].value),
+            List::Split(_) => unreachable!("made whole above"),
+        }
     }
 
     /// Sets the field named `key`: in place if it is authored, else after the others.
@@ -218,22 +289,23 @@ impl Fields {
     /// Appends a field not yet authored, in one allocation of exactly the new length.
     fn push(&mut self, name: FieldName, value: Value) {
         let field = std::iter::once(Field { name, value });
-        self.0 = Some(match self.0.take() {
-            None => field.collect(),
-            Some(mut fields) => match Arc::get_mut(&mut fields) {
+        let fields: Arc<[Field]> = match &mut self.0 {
+            List::Whole(fields) => match Arc::get_mut(fields) {
                 Some(own) => own.iter_mut().map(take_field).chain(field).collect(),
                 None => fields.iter().cloned().chain(field).collect(),
             },
-        });
+            List::Split(split) => split.head.iter().chain(std::iter::once(&split.last)).cloned().chain(field).collect(),
+        };
+        self.0 = List::Whole(fields);
     }
 
     /// Removes the field named `key`, returning its value; the others keep their order.
     pub fn remove(&mut self, key: &str) -> Option<Value> {
         let at = self.position(key)?;
-        let mut fields = into_vec(self.0.take()?);
+        let mut fields = into_vec(std::mem::take(self).0);
         let removed = fields.remove(at);
         if !fields.is_empty() {
-            self.0 = Some(fields.into());
+            self.0 = List::Whole(fields.into());
         }
         Some(removed.value)
     }
@@ -241,22 +313,41 @@ impl Fields {
     /// Whether `self` and `other` hold the same list (not merely equal fields).
     pub fn is_shared_with(&self, other: &Fields) -> bool {
         match (&self.0, &other.0) {
-            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (List::Whole(a), List::Whole(b)) => !a.is_empty() && Arc::ptr_eq(a, b),
+            (List::Split(a), List::Split(b)) => Arc::ptr_eq(a, b),
             _ => false,
         }
+    }
+
+    /// Whether `self` holds its last field apart from a head it shares with `other`.
+    pub fn shares_head_with(&self, other: &Fields) -> bool {
+        let head = |fields: &Fields| match &fields.0 {
+            List::Split(split) => Some(split.head.clone()),
+            List::Whole(_) => None,
+        };
+        matches!((head(self), head(other)), (Some(a), Some(b)) if Arc::ptr_eq(&a, &b))
     }
 }
 
 /// The fields, moved out of a list only one spec holds or cloned from a shared one.
-fn into_vec(mut fields: Arc<[Field]>) -> Vec<Field> {
-    match Arc::get_mut(&mut fields) {
-        Some(own) => own.iter_mut().map(take_field).collect(),
-        None => fields.to_vec(),
+fn into_vec(list: List) -> Vec<Field> {
+    match list {
+        List::Whole(mut fields) => match Arc::get_mut(&mut fields) {
+            Some(own) => own.iter_mut().map(take_field).collect(),
+            None => fields.to_vec(),
+        },
+        List::Split(split) => {
+            let Split { head, last } = Arc::try_unwrap(split).unwrap_or_else(|shared| (*shared).clone());
+            let mut fields = Vec::with_capacity(head.len() + 1);
+            fields.extend(head.iter().cloned());
+            fields.push(last);
+            fields
+        }
     }
 }
 
 /// The field, moved out of a list only one spec holds; an empty placeholder is left.
-fn take_field(field: &mut Field) -> Field {
+pub(super) fn take_field(field: &mut Field) -> Field {
     Field {
         name: std::mem::replace(&mut field.name, FieldName(Repr::Registered(0))),
         value: std::mem::replace(&mut field.value, Value::None),
@@ -279,7 +370,7 @@ impl<'a> IntoIterator for &'a Fields {
 }
 
 /// The names and values of a spec's fields, in authored order.
-pub struct Iter<'a>(std::slice::Iter<'a, Field>);
+pub struct Iter<'a>(FieldIter<'a>);
 
 impl<'a> Iterator for Iter<'a> {
     type Item = (&'a str, &'a Value);
@@ -309,7 +400,7 @@ impl IntoIterator for Fields {
     type IntoIter = IntoIter;
 
     fn into_iter(self) -> IntoIter {
-        IntoIter(self.0.map(into_vec).unwrap_or_default().into_iter())
+        IntoIter(into_vec(self.0).into_iter())
     }
 }
 
