@@ -28,10 +28,8 @@ pub fn compensate_pyramid(finest: u32, pyramid: &[f32], out: &mut [f32]) -> Resu
             return Err(EnvError::WrongLength { buffer, expected: len, found });
         }
     }
+    inverse_mean(pyramid)?;
     let mean = pyramid[0];
-    if !mean.is_finite() || mean < 0.0 {
-        return Err(EnvError::NotSanitized);
-    }
     let start = level_offset(finest);
     for (o, &v) in out[start..].iter_mut().zip(&pyramid[start..]) {
         *o = (v - mean).max(0.0);
@@ -46,8 +44,7 @@ impl<'a> EnvHierarchy<'a> {
     /// to return a view over.
     pub fn with_compensated(mut self, pyramid: &'a [f32]) -> Result<Self, EnvError> {
         check_lengths(self.finest, self.radiance.len(), pyramid.len())?;
-        inverse_mean(pyramid)?;
-        self.compensated = Some(pyramid);
+        self.compensated = Some((pyramid, inverse_mean(pyramid)?));
         Ok(self)
     }
 
@@ -57,9 +54,8 @@ impl<'a> EnvHierarchy<'a> {
     /// sampling), else this view itself.
     pub fn compensated(&self) -> Self {
         let mut view = *self;
-        if let Some(pyramid) = self.compensated {
-            (view.pyramid, view.inv_mean) = (pyramid, inverse_mean(pyramid).unwrap_or(0.0));
-            (view.cdf, view.compensated) = (None, None);
+        if let Some((pyramid, inv_mean)) = self.compensated {
+            (view.pyramid, view.inv_mean, view.cdf, view.compensated) = (pyramid, inv_mean, None, None);
         }
         view
     }

@@ -33,9 +33,9 @@ pub struct EnvHierarchy<'a> {
     map_to_world: Mat3,
     /// The texel table env-only sampling uses instead of the descent, when attached.
     pub(crate) cdf: Option<TexelCdf<'a>>,
-    /// The MIS-compensated pyramid ([`compensate_pyramid`](super::compensate_pyramid)), when
-    /// attached.
-    pub(super) compensated: Option<&'a [f32]>,
+    /// The MIS-compensated pyramid ([`compensate_pyramid`](super::compensate_pyramid)) and its
+    /// `inv_mean`, when attached.
+    pub(super) compensated: Option<(&'a [f32], f32)>,
 }
 
 impl<'a> EnvHierarchy<'a> {
