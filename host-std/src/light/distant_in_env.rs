@@ -6,7 +6,7 @@
 //! the texels', not exact: what the image gains or loses by it is measured in docs/tuning.md,
 //! "A sun in the map or by its cone".
 
-use crate::light::environment::{Environment, compensated_pyramid};
+use crate::light::environment::Environment;
 use sampler_core::env::build_pyramid;
 use sampler_core::glam::{Vec2, Vec3};
 use sampler_core::light::{DistantLight, Light, SceneLight};
@@ -56,7 +56,6 @@ impl Environment {
             }
         }
         build_pyramid(self.level, &self.rgb, &mut self.pyramid).expect("the map's own level and buffers");
-        self.compensated = compensated_pyramid(self.level, &self.pyramid).expect("the map's own level and buffers");
         true
     }
 }

@@ -92,9 +92,6 @@ pub struct Environment {
     pub rgb: Vec<[f32; 3]>,
     /// The importance pyramid over the map's luminance (sampler-core's layout).
     pub pyramid: Vec<f32>,
-    /// The pyramid compensated for MIS with BRDF samples (`sampler_core::env::compensate_pyramid`),
-    /// `None` where nothing of the map stands above its mean.
-    pub compensated: Option<Vec<f32>>,
     /// Directions of the map's frame into the world's.
     pub map_to_world: Mat3,
     /// What building it found and took.
@@ -172,7 +169,6 @@ impl Environment {
         sampler_core::env::sanitize_rgb(&mut rgb);
         let mut pyramid = vec![0.0f32; pyramid_len(level)];
         build_pyramid(level, &rgb, &mut pyramid)?;
-        let compensated = compensated_pyramid(level, &pyramid)?;
         stats.level = level;
         stats.map_mean = resample::equal_area_mean(&rgb);
         if matches!(source, EnvSource::Sky { .. } | EnvSource::Constant { .. }) {
@@ -182,9 +178,9 @@ impl Environment {
         }
         // Everything after reading the file: resampling, scaling, the pyramid.
         stats.build_seconds = t0.elapsed().as_secs_f64() - stats.load_seconds;
-        stats.bytes = rgb.len() * 12 + (pyramid.len() + compensated.as_ref().map_or(0, Vec::len)) * 4;
+        stats.bytes = rgb.len() * 12 + pyramid.len() * 4;
         let map_to_world = Mat3::from_rotation_y(placement.rotate_y_deg.to_radians()) * placement.rotation;
-        Ok(Self { level, rgb, pyramid, compensated, map_to_world, stats })
+        Ok(Self { level, rgb, pyramid, map_to_world, stats })
     }
 
     /// The equal-area texels, their level, and the source's mean radiance.
@@ -202,23 +198,11 @@ impl Environment {
         }
     }
 
-    /// The core's view of this map.
+    /// The core's view of this map (a render attaches the MIS-compensated pyramid where a plan
+    /// needs it: `render::compensated_pyramid`).
     pub fn hierarchy(&self) -> EnvHierarchy<'_> {
-        let h = EnvHierarchy::new(self.level, &self.pyramid, &self.rgb)
+        EnvHierarchy::new(self.level, &self.pyramid, &self.rgb)
             .expect("buffers built by Environment::build have matching lengths")
-            .with_rotation(self.map_to_world);
-        match &self.compensated {
-            Some(c) => h.with_compensated(c).expect("built from this map's pyramid"),
-            None => h,
-        }
+            .with_rotation(self.map_to_world)
     }
-}
-
-/// The MIS-compensated pyramid of `pyramid`, or `None` where nothing stands above the mean.
-pub(crate) fn compensated_pyramid(
-    level: u32,
-    pyramid: &[f32],
-) -> Result<Option<Vec<f32>>, sampler_core::env::EnvError> {
-    let mut out = vec![0.0f32; pyramid.len()];
-    Ok(sampler_core::env::compensate_pyramid(level, pyramid, &mut out)?.then_some(out))
 }

@@ -20,7 +20,7 @@ use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
-use crate::render::{Context, Lightcuts, Options, summed_area_table, two_level_cones};
+use crate::render::{Context, Lightcuts, Options, compensated_pyramid, summed_area_table, two_level_cones};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
@@ -140,6 +140,13 @@ pub fn render_crop(
         .iter()
         .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf, settings.brdf_samples))
         .collect();
+    // MIS's env samples draw from the compensated pyramid, built only where MIS may sample.
+    let compensated = env.and_then(|e| compensated_pyramid(e, &plans, settings.method == Method::Auto));
+    let env_view = env.map(|e| match &compensated {
+        Some(c) => e.with_compensated(c).expect("built from this view's pyramid"),
+        None => *e,
+    });
+    let env = env_view.as_ref();
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));
     let cones = env.and_then(|e| two_level_cones(e, &plans));

@@ -114,6 +114,19 @@ pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option
     })
 }
 
+/// The MIS-compensated pyramid of `env` ([`EnvHierarchy::compensated`]), built when a plan
+/// samples MIS or `auto`'s pilot may choose it, and `env` has none attached; `None` also where
+/// nothing of the map stands above its mean (the plain pyramid then serves MIS).
+#[must_use]
+pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<Vec<f32>> {
+    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, strategy::Strategy::Mis { .. }));
+    if !mis || env.has_compensated() {
+        return None;
+    }
+    let mut out = vec![0.0f32; sampler_core::env::pyramid_len(env.finest_level())];
+    env.compensate_into(&mut out).expect("a view's own pyramid has its level's length").then_some(out)
+}
+
 /// The summed-area table two-stage sampling reads, built when a plan needs it.
 #[must_use]
 pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<f64>> {
@@ -122,4 +135,30 @@ pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Opti
         sampler_core::two_stage::build_sat(env, &mut sat);
         sat
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::brdf_samples::BrdfSamples;
+    use crate::render::strategy::Strategy;
+    use crate::scene::Bsdf;
+    use sampler_core::brdf::Lambert;
+    use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
+
+    #[test]
+    fn the_compensated_pyramid_is_built_only_where_mis_may_sample() {
+        let rgb: Vec<[f32; 3]> = (0..16).map(|i| [i as f32; 3]).collect();
+        let mut pyramid = vec![0.0; pyramid_len(2)];
+        build_pyramid(2, &rgb, &mut pyramid).unwrap();
+        let env = EnvHierarchy::new(2, &pyramid, &rgb).unwrap();
+        let bsdf = Bsdf::Diffuse(Lambert::new(sampler_core::glam::Vec3::ONE));
+        let plan = |strategy| MaterialPlan::new(strategy, &bsdf, BrdfSamples::default());
+        let (env_only, mis) = ([plan(Strategy::Env)], [plan(Strategy::Env), plan(Strategy::Mis { env_share: 0.5 })]);
+        assert!(compensated_pyramid(&env, &env_only, false).is_none());
+        let built = compensated_pyramid(&env, &mis, false).expect("a MIS plan");
+        assert!(compensated_pyramid(&env, &env_only, true).is_some(), "auto's pilot may choose MIS");
+        let attached = env.with_compensated(&built).unwrap();
+        assert!(compensated_pyramid(&attached, &mis, true).is_none(), "one is attached already");
+    }
 }

@@ -48,6 +48,21 @@ impl<'a> EnvHierarchy<'a> {
         Ok(self)
     }
 
+    /// Whether a compensated pyramid is attached.
+    #[inline]
+    #[must_use]
+    pub fn has_compensated(&self) -> bool {
+        self.compensated.is_some()
+    }
+
+    /// Writes into `out` (as long as this view's pyramid) the compensated pyramid of this
+    /// view's pyramid, as [`compensate_pyramid`](super::compensate_pyramid) does; returns
+    /// whether anything of the map stands above its mean (where nothing does, the plain view
+    /// serves MIS as it is).
+    pub fn compensate_into(&self, out: &mut [f32]) -> Result<bool, EnvError> {
+        compensate_pyramid(self.finest, self.pyramid, out)
+    }
+
     /// The view env samples combined with BRDF samples (MIS) draw from: the same map, its
     /// radiance and frame, sampled by the compensated pyramid where one is attached (its
     /// density is zero where the map is at or below its mean, so never for env-only
@@ -78,6 +93,23 @@ mod tests {
         let at = |x, y| c[pyramid_index(Cell::new(1, x, y))];
         assert_eq!([at(0, 0), at(1, 0), at(0, 1), at(1, 1)], [0.0, 0.0, 0.0, 3.0]);
         assert_eq!(c[0], 0.75);
+    }
+
+    #[test]
+    fn a_view_writes_its_own_compensated_pyramid_and_attaches_it() {
+        let rgb = [[0.0; 3], [1.0; 3], [2.0; 3], [5.0; 3]];
+        let mut p = [0.0f32; 5];
+        build_pyramid(1, &rgb, &mut p).unwrap();
+        let view = EnvHierarchy::new(1, &p, &rgb).unwrap();
+        assert!(!view.has_compensated());
+        let (mut c, mut direct) = ([0.0f32; 5], [0.0f32; 5]);
+        assert!(view.compensate_into(&mut c).unwrap());
+        compensate_pyramid(1, &p, &mut direct).unwrap();
+        assert_eq!(c, direct);
+        let attached = view.with_compensated(&c).unwrap();
+        assert!(attached.has_compensated());
+        assert_eq!(attached.compensated().pdf_square(glam::Vec2::new(0.75, 0.75)), 4.0);
+        assert!(matches!(view.compensate_into(&mut c[..4]), Err(EnvError::WrongLength { .. })));
     }
 
     #[test]
