@@ -22,7 +22,7 @@ pub(crate) const LANES: usize = 8;
 pub(crate) struct WarpLane {
     pub cell: Cell,
     /// Morton index of the cell within its level.
-    morton: usize,
+    pub(super) morton: usize,
     pub xi: DVec2,
     /// False once the descent met a node without mass (or never started).
     pub alive: bool,
@@ -36,7 +36,7 @@ impl WarpLane {
     }
 
     #[inline(always)]
-    fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
+    pub(super) fn step(&mut self, levels: u32, dx: u32, dy: u32, child: usize) {
         let c = &mut self.cell;
         (c.level, c.x, c.y) = (c.level + levels, (c.x << levels) + dx, (c.y << levels) + dy);
         self.morton = (self.morton << (2 * levels)) + child;
@@ -58,6 +58,8 @@ impl EnvHierarchy<'_> {
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = WarpLane::new(Cell::ROOT, *u);
             }
+            #[cfg(target_arch = "x86_64")]
+            self.warp_down_pairs_avx2(&mut lanes[..n]);
             self.warp_down_lanes(&mut lanes[..n]);
             // The points and densities, then the directions at once.
             let mut points = [(Vec2::ZERO, 0.0); LANES];

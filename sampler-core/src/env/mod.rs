@@ -20,6 +20,8 @@
 mod compensation;
 mod hierarchy;
 mod lanes;
+#[cfg(target_arch = "x86_64")]
+mod lanes_avx2;
 mod pyramid;
 mod sample;
 mod texel_cdf;
