@@ -1,12 +1,15 @@
 //! Env-only descents four to a register: [`choose_grandchild_branchless`]'s step for four
 //! descents at once in AVX2 (four f64 lanes), with the same operations in the same order — the
-//! same choices and rescaled points, bit for bit. A descent spends most of its instructions on
-//! this step's scalar arithmetic; here one register's instructions serve four. A lane whose
-//! chosen side holds no mass (rounding at a row's end) takes the scalar step instead.
+//! same choices and rescaled points, bit for bit. The lanes' ξ, Morton indices and cells stay
+//! in registers from the root down; per step only the four addresses of the next sixteen
+//! grandchildren leave them. Two groups of four interleave, so that one group's loads overlap
+//! the other's arithmetic. A lane whose chosen side holds no mass (rounding at a row's end)
+//! takes the scalar step instead.
 
 use super::EnvHierarchy;
 use super::lanes::WarpLane;
 use super::pyramid::level_offset;
+use crate::cell::Cell;
 use crate::warp::{ONE_MINUS_EPSILON, choose_grandchild_branchless, grandchild_index};
 use core::arch::x86_64::*;
 
@@ -22,91 +25,227 @@ impl EnvHierarchy<'_> {
         if !crate::cpu::has_avx2() {
             return false;
         }
-        let Some(mut level) = lanes.first().map(|l| l.cell.level) else { return true };
+        let Some(level) = lanes.first().map(|l| l.cell.level) else { return true };
         debug_assert!(lanes.iter().all(|l| l.cell.level == level), "one level for all lanes");
         if self.is_black() {
             lanes.iter_mut().for_each(|l| l.alive = false);
             return true;
         }
-        while level + 2 <= self.finest {
-            for lane in lanes.iter().filter(|l| l.alive) {
-                crate::prefetch::prefetch(self.grandchildren(level, lane));
-            }
-            for group in lanes.chunks_mut(4) {
-                // SAFETY: AVX2 is available (checked above).
-                unsafe { self.step_x4(level, group) };
-            }
-            level += 2;
+        for eight in lanes.chunks_mut(8) {
+            // SAFETY: AVX2 is available (checked above).
+            unsafe { self.descend_x8(level, eight) };
         }
         true
     }
 
-    /// The sixteen grandchildren of `lane`'s node at `level`, or [`EMPTY`] for a dead lane.
-    #[inline(always)]
-    fn grandchildren(&self, level: u32, lane: &WarpLane) -> &[f32; 16] {
-        if !lane.alive {
-            return &EMPTY;
-        }
-        let base = level_offset(level + 2) + 16 * lane.morton;
-        self.pyramid[base..base + 16].try_into().expect("sixteen grandchildren")
-    }
-
-    /// One two-level step of up to four lanes at `level`.
+    /// Up to eight lanes from `level` down to the last even step above the finest level, as
+    /// two groups of four whose loads and arithmetic interleave.
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    unsafe fn step_x4(&self, level: u32, group: &mut [WarpLane]) {
-        let block = |k: usize| group.get(k).map_or(&EMPTY, |l| self.grandchildren(level, l));
-        let m = transpose([block(0), block(1), block(2), block(3)]);
-        let xi = |k: usize, y: bool| group.get(k).map_or(0.0, |l| if y { l.xi.y } else { l.xi.x });
+    unsafe fn descend_x8(&self, mut level: u32, lanes: &mut [WarpLane]) {
+        let (a, b) = lanes.split_at_mut(lanes.len().min(4));
+        let mut groups = [Group::load(a, level), Group::load(b, level)];
+        while level + 2 <= self.finest {
+            let base = level_offset(level + 2);
+            let blocks = groups.map(|g| g.blocks(self.pyramid, base));
+            for (g, blocks) in groups.iter_mut().zip(blocks) {
+                g.step(level, blocks);
+            }
+            level += 2;
+        }
+        groups[0].store(a, level);
+        groups[1].store(b, level);
+    }
+}
+
+/// Four descents in registers: ξ, the Morton index and the cell's column and row per lane.
+#[derive(Clone, Copy)]
+struct Group {
+    xi_x: __m256d,
+    xi_y: __m256d,
+    morton: __m256i,
+    x: __m256i,
+    y: __m256i,
+    /// Lane bits still descending.
+    alive: i32,
+    /// Per lane, the level it stopped at if it died.
+    died_at: [u32; 4],
+}
+
+impl Group {
+    /// The state of `lanes` (up to four, all at `level`); missing lanes are dead.
+    #[target_feature(enable = "avx2")]
+    fn load(lanes: &[WarpLane], level: u32) -> Self {
+        let get = |k: usize, f: fn(&WarpLane) -> u64| lanes.get(k).map_or(0, f);
+        let ints = |f: fn(&WarpLane) -> u64| {
+            _mm256_setr_epi64x(get(0, f) as i64, get(1, f) as i64, get(2, f) as i64, get(3, f) as i64)
+        };
+        let xs = |f: fn(&WarpLane) -> u64| {
+            _mm256_setr_pd(
+                f64::from_bits(get(0, f)),
+                f64::from_bits(get(1, f)),
+                f64::from_bits(get(2, f)),
+                f64::from_bits(get(3, f)),
+            )
+        };
+        let alive = lanes.iter().take(4).enumerate().filter(|(_, l)| l.alive).fold(0, |a, (k, _)| a | 1 << k);
+        Self {
+            xi_x: xs(|l| l.xi.x.to_bits()),
+            xi_y: xs(|l| l.xi.y.to_bits()),
+            morton: ints(|l| l.morton as u64),
+            x: ints(|l| u64::from(l.cell.x)),
+            y: ints(|l| u64::from(l.cell.y)),
+            alive,
+            died_at: [level; 4],
+        }
+    }
+
+    /// Writes the state back into `lanes`, those still descending at `level`.
+    #[target_feature(enable = "avx2")]
+    fn store(&self, lanes: &mut [WarpLane], level: u32) {
+        let [xs, ys] = [self.xi_x, self.xi_y].map(|v| floats(v));
+        let [ms, cx, cy] = [self.morton, self.x, self.y].map(|v| ints(v));
+        for (k, lane) in lanes.iter_mut().enumerate().take(4) {
+            let alive = self.alive & (1 << k) != 0;
+            if !lane.alive {
+                continue;
+            }
+            lane.xi = glam::DVec2::new(xs[k], ys[k]);
+            lane.morton = ms[k] as usize;
+            let l = if alive { level } else { self.died_at[k] };
+            lane.cell = Cell::new(l, cx[k] as u32, cy[k] as u32);
+            lane.alive = alive;
+        }
+    }
+
+    /// Each lane's sixteen grandchildren at the level starting at `base`, [`EMPTY`] for a dead lane.
+    #[target_feature(enable = "avx2")]
+    fn blocks<'p>(&self, pyramid: &'p [f32], base: usize) -> [&'p [f32; 16]; 4] {
+        let ms = ints(self.morton);
+        core::array::from_fn(|k| {
+            if self.alive & (1 << k) == 0 {
+                return &EMPTY;
+            }
+            let at = base + 16 * ms[k] as usize;
+            pyramid[at..at + 16].try_into().expect("sixteen grandchildren")
+        })
+    }
+
+    /// One two-level step of the lanes at `level` over their grandchildren `blocks`.
+    #[target_feature(enable = "avx2")]
+    fn step(&mut self, level: u32, blocks: [&[f32; 16]; 4]) {
+        let m = transpose(blocks);
         let at = |x: usize, y: usize| m[grandchild_index(x as u32, y as u32)];
         let cols: [__m256d; 4] = core::array::from_fn(|x| {
             _mm256_add_pd(_mm256_add_pd(at(x, 0), at(x, 1)), _mm256_add_pd(at(x, 2), at(x, 3)))
         });
-        let column = pick_x4(cols, _mm256_setr_pd(xi(0, false), xi(1, false), xi(2, false), xi(3, false)));
+        let column = pick_x4(cols, self.xi_x);
         // The chosen column's four masses, by the same nested masks that chose it.
         let rows: [__m256d; 4] =
             core::array::from_fn(|y| select(column.at_least, [at(0, y), at(1, y), at(2, y), at(3, y)]));
-        let row = pick_x4(rows, _mm256_setr_pd(xi(0, true), xi(1, true), xi(2, true), xi(3, true)));
+        let row = pick_x4(rows, self.xi_y);
         // rescale: r = 1/(wx·wy), ξ = (ox·wy·r, oy·wx·r) clamped to [0, 1).
         let r = _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_mul_pd(column.weight, row.weight));
         let nx = clamp_unit(_mm256_mul_pd(_mm256_mul_pd(column.offset, row.weight), r));
         let ny = clamp_unit(_mm256_mul_pd(_mm256_mul_pd(row.offset, column.weight), r));
-        let (mut xs, mut ys) = ([0.0f64; 4], [0.0f64; 4]);
-        // SAFETY: each array holds four f64.
-        unsafe {
-            _mm256_storeu_pd(xs.as_mut_ptr(), nx);
-            _mm256_storeu_pd(ys.as_mut_ptr(), ny);
+        // The grandchild (gx, gy) and its Morton index x0 | y0 << 1 | x1 << 2 | y1 << 3.
+        let (gx, gy) = (column.index(), row.index());
+        let one = _mm256_set1_epi64x(1);
+        let bits = |v: __m256i, low: i32, high: i32| {
+            _mm256_or_si256(
+                _mm256_sll_epi64(_mm256_and_si256(v, one), _mm_cvtsi32_si128(low)),
+                _mm256_sll_epi64(_mm256_srli_epi64::<1>(v), _mm_cvtsi32_si128(high)),
+            )
+        };
+        let child = _mm256_or_si256(bits(gx, 0, 2), bits(gy, 1, 3));
+        let old = *self;
+        let ok = column.ok & row.ok & self.alive;
+        let keep = lane_mask(ok);
+        let keep_i = _mm256_castpd_si256(keep);
+        self.xi_x = _mm256_blendv_pd(self.xi_x, nx, keep);
+        self.xi_y = _mm256_blendv_pd(self.xi_y, ny, keep);
+        let advance = |v: __m256i, by: __m256i, shift: i32| {
+            let next = _mm256_add_epi64(_mm256_sll_epi64(v, _mm_cvtsi32_si128(shift)), by);
+            _mm256_blendv_epi8(v, next, keep_i)
+        };
+        self.morton = advance(self.morton, child, 4);
+        self.x = advance(self.x, gx, 2);
+        self.y = advance(self.y, gy, 2);
+        for k in (0..4).filter(|k| self.alive & !ok & (1 << k) != 0) {
+            self.died_at[k] = level;
         }
-        let (ok, fallback) = (column.ok & row.ok, column.fallback | row.fallback);
-        for (k, lane) in group.iter_mut().enumerate().filter(|(_, l)| l.alive) {
-            let bit = 1 << k;
-            if ok & bit == 0 {
-                lane.alive = false;
-            } else if fallback & bit != 0 {
-                // Rounding put t past a side of mass: the scalar step's own fallback decides.
-                let g = self.grandchildren(level, lane);
-                match choose_grandchild_branchless(g, &mut lane.xi) {
-                    Some((c, gx, gy)) => lane.step(2, gx, gy, c),
-                    None => lane.alive = false,
-                }
-            } else {
-                let (x, y) = (column.index(k), row.index(k));
-                lane.xi.x = xs[k];
-                lane.xi.y = ys[k];
-                lane.step(2, x, y, grandchild_index(x, y));
-            }
+        self.alive = ok;
+        let fallback = (column.fallback | row.fallback) & ok;
+        if fallback != 0 {
+            self.redo_scalar(&old, level, blocks, fallback);
         }
     }
+
+    /// The scalar step, from the state before it (`old`), for the lanes of `fallback`: rounding
+    /// put t past a side of mass, which the scalar step's own fallback decides.
+    #[cold]
+    #[target_feature(enable = "avx2")]
+    fn redo_scalar(&mut self, old: &Group, level: u32, blocks: [&[f32; 16]; 4], fallback: i32) {
+        let [mut xs, mut ys] = [self.xi_x, self.xi_y].map(|v| floats(v));
+        let [mut ms, mut cx, mut cy] = [self.morton, self.x, self.y].map(|v| ints(v));
+        let [ox, oy] = [old.xi_x, old.xi_y].map(|v| floats(v));
+        let [om, ocx, ocy] = [old.morton, old.x, old.y].map(|v| ints(v));
+        for k in (0..4).filter(|k| fallback & (1 << k) != 0) {
+            let mut xi = glam::DVec2::new(ox[k], oy[k]);
+            match choose_grandchild_branchless(blocks[k], &mut xi) {
+                Some((c, gx, gy)) => {
+                    (xs[k], ys[k]) = (xi.x, xi.y);
+                    ms[k] = (om[k] << 4) + c as u64;
+                    (cx[k], cy[k]) = ((ocx[k] << 2) + u64::from(gx), (ocy[k] << 2) + u64::from(gy));
+                }
+                None => {
+                    (xs[k], ys[k], ms[k], cx[k], cy[k]) = (ox[k], oy[k], om[k], ocx[k], ocy[k]);
+                    self.alive &= !(1 << k);
+                    self.died_at[k] = level;
+                }
+            }
+        }
+        self.xi_x = _mm256_setr_pd(xs[0], xs[1], xs[2], xs[3]);
+        self.xi_y = _mm256_setr_pd(ys[0], ys[1], ys[2], ys[3]);
+        let v = |a: [u64; 4]| _mm256_setr_epi64x(a[0] as i64, a[1] as i64, a[2] as i64, a[3] as i64);
+        (self.morton, self.x, self.y) = (v(ms), v(cx), v(cy));
+    }
+}
+
+/// Lane bits as a mask register (all ones where set).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn lane_mask(bits: i32) -> __m256d {
+    let m = |k: i32| if bits & (1 << k) != 0 { -1 } else { 0 };
+    _mm256_castsi256_pd(_mm256_setr_epi64x(m(0), m(1), m(2), m(3)))
+}
+
+/// The four f64 of a register.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn floats(v: __m256d) -> [f64; 4] {
+    let mut out = [0.0; 4];
+    // SAFETY: `out` holds four f64.
+    unsafe { _mm256_storeu_pd(out.as_mut_ptr(), v) };
+    out
+}
+
+/// The four u64 of a register.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn ints(v: __m256i) -> [u64; 4] {
+    let mut out = [0u64; 4];
+    // SAFETY: `out` holds four u64.
+    unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), v) };
+    out
 }
 
 /// The side a [`pick_x4`] chose per lane, with what the rescaling needs.
 struct Picked {
     /// `at_least[j - 1]`: lanes whose side is ≥ j (t ≥ prefix j), for j = 1, 2, 3.
     at_least: [__m256d; 3],
-    /// The same masks as lane bits.
-    at_least_bits: [i32; 3],
     /// t less the chosen side's prefix.
     offset: __m256d,
     /// The chosen side's weight.
@@ -118,9 +257,12 @@ struct Picked {
 }
 
 impl Picked {
-    /// Lane `k`'s side: how many prefixes t reached.
-    fn index(&self, k: usize) -> u32 {
-        self.at_least_bits.iter().map(|&m| ((m >> k) & 1) as u32).sum()
+    /// Each lane's side: how many prefixes t reached (each mask is −1 where set).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn index(&self) -> __m256i {
+        let [a, b, c] = self.at_least.map(|m| _mm256_castpd_si256(m));
+        _mm256_sub_epi64(_mm256_setzero_si256(), _mm256_add_epi64(_mm256_add_epi64(a, b), c))
     }
 }
 
@@ -140,7 +282,6 @@ fn pick_x4(w: [__m256d; 4], x: __m256d) -> Picked {
     let weight = select(at_least, w);
     Picked {
         at_least,
-        at_least_bits: at_least.map(|m| _mm256_movemask_pd(m)),
         offset: _mm256_sub_pd(t, prefix),
         weight,
         ok: _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(total, zero)),

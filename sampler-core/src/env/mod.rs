@@ -13,7 +13,8 @@
 //! radiance cancels exactly in the product estimator.
 //!
 //! The pyramid's layout and builders are in `pyramid.rs`, the view over it in `hierarchy.rs`,
-//! env-only sampling in `sample.rs` and the same four descents at a time in `lanes.rs`; with a
+//! env-only sampling in `sample.rs`, descents side by side in `lanes.rs` (four to an AVX2 register
+//! in `lanes_avx2.rs` where the CPU has it); with a
 //! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent. MIS with BRDF
 //! samples draws from a compensated pyramid (`compensation.rs`) where one is attached.
 
