@@ -58,8 +58,6 @@ impl EnvHierarchy<'_> {
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = WarpLane::new(Cell::ROOT, *u);
             }
-            #[cfg(target_arch = "x86_64")]
-            self.warp_down_pairs_avx2(&mut lanes[..n]);
             self.warp_down_lanes(&mut lanes[..n]);
             // The points and densities, then the directions at once.
             let mut points = [(Vec2::ZERO, 0.0); LANES];
@@ -100,6 +98,14 @@ impl EnvHierarchy<'_> {
     /// [`warp_down`](Self::warp_down) for up to a few descents at once, each from its own node,
     /// advanced level by level side by side. A lane that meets a node without mass dies.
     pub(crate) fn warp_down_lanes(&self, lanes: &mut [WarpLane]) {
+        #[cfg(target_arch = "x86_64")]
+        self.warp_down_pairs_avx2(lanes);
+        self.warp_down_lanes_scalar(lanes);
+    }
+
+    /// [`warp_down_lanes`](Self::warp_down_lanes) without AVX2: every step in scalar
+    /// arithmetic, the lanes side by side.
+    pub(super) fn warp_down_lanes_scalar(&self, lanes: &mut [WarpLane]) {
         if self.is_black() {
             lanes.iter_mut().for_each(|l| l.alive = false);
             return;

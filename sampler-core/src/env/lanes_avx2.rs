@@ -17,46 +17,48 @@ use core::arch::x86_64::*;
 static EMPTY: [f32; 16] = [0.0; 16];
 
 impl EnvHierarchy<'_> {
-    /// Descends `lanes` — all at one level — two levels at a time while two remain, four lanes to
-    /// a register, as [`warp_down_lanes`](Self::warp_down_lanes) would; returns false (nothing
-    /// done) where the CPU lacks AVX2. The last single level, if any, is left to
-    /// `warp_down_lanes`.
+    /// Descends `lanes`, each from its own node, two levels at a time while two remain, four
+    /// lanes to a register, as [`warp_down_lanes_scalar`](Self::warp_down_lanes_scalar) would;
+    /// returns false (nothing done) where the CPU lacks AVX2. A last single level is left to
+    /// the scalar lanes.
     pub(super) fn warp_down_pairs_avx2(&self, lanes: &mut [WarpLane]) -> bool {
         if !crate::cpu::has_avx2() {
             return false;
         }
-        let Some(level) = lanes.first().map(|l| l.cell.level) else { return true };
-        debug_assert!(lanes.iter().all(|l| l.cell.level == level), "one level for all lanes");
         if self.is_black() {
             lanes.iter_mut().for_each(|l| l.alive = false);
             return true;
         }
         for eight in lanes.chunks_mut(8) {
             // SAFETY: AVX2 is available (checked above).
-            unsafe { self.descend_x8(level, eight) };
+            unsafe { self.descend_x8(eight) };
         }
         true
     }
 
-    /// Up to eight lanes from `level` down to the last even step above the finest level, as
-    /// two groups of four whose loads and arithmetic interleave.
+    /// Up to eight lanes down to the last even step above the finest level, as two groups of
+    /// four whose loads and arithmetic interleave.
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    unsafe fn descend_x8(&self, mut level: u32, lanes: &mut [WarpLane]) {
+    unsafe fn descend_x8(&self, lanes: &mut [WarpLane]) {
         let (a, b) = lanes.split_at_mut(lanes.len().min(4));
-        let mut groups = [Group::load(a, level), Group::load(b, level)];
-        while level + 2 <= self.finest {
-            let base = level_offset(level + 2);
-            let blocks = groups.map(|g| g.blocks(self.pyramid, base));
-            for (g, blocks) in groups.iter_mut().zip(blocks) {
-                g.step(level, blocks);
+        let mut groups = [Group::load(a), Group::load(b)];
+        loop {
+            let active = groups.map(|g| g.active(self.finest));
+            if active == [0, 0] {
+                break;
             }
-            level += 2;
+            let blocks = [0, 1].map(|i| groups[i].blocks(self.pyramid, active[i]));
+            for ((g, blocks), active) in groups.iter_mut().zip(blocks).zip(active) {
+                if active != 0 {
+                    g.step(active, blocks);
+                }
+            }
         }
-        groups[0].store(a, level);
-        groups[1].store(b, level);
+        groups[0].store(a);
+        groups[1].store(b);
     }
 }
 
@@ -68,16 +70,16 @@ struct Group {
     morton: __m256i,
     x: __m256i,
     y: __m256i,
-    /// Lane bits still descending.
+    /// Lane bits not dead.
     alive: i32,
-    /// Per lane, the level it stopped at if it died.
-    died_at: [u32; 4],
+    /// Per lane, the level of its node.
+    level: [u32; 4],
 }
 
 impl Group {
-    /// The state of `lanes` (up to four, all at `level`); missing lanes are dead.
+    /// The state of `lanes` (up to four); missing lanes are dead.
     #[target_feature(enable = "avx2")]
-    fn load(lanes: &[WarpLane], level: u32) -> Self {
+    fn load(lanes: &[WarpLane]) -> Self {
         let get = |k: usize, f: fn(&WarpLane) -> u64| lanes.get(k).map_or(0, f);
         let ints = |f: fn(&WarpLane) -> u64| {
             _mm256_setr_epi64x(get(0, f) as i64, get(1, f) as i64, get(2, f) as i64, get(3, f) as i64)
@@ -98,44 +100,44 @@ impl Group {
             x: ints(|l| u64::from(l.cell.x)),
             y: ints(|l| u64::from(l.cell.y)),
             alive,
-            died_at: [level; 4],
+            level: core::array::from_fn(|k| lanes.get(k).map_or(0, |l| l.cell.level)),
         }
     }
 
-    /// Writes the state back into `lanes`, those still descending at `level`.
+    /// Writes the state back into `lanes`.
     #[target_feature(enable = "avx2")]
-    fn store(&self, lanes: &mut [WarpLane], level: u32) {
+    fn store(&self, lanes: &mut [WarpLane]) {
         let [xs, ys] = [self.xi_x, self.xi_y].map(|v| floats(v));
         let [ms, cx, cy] = [self.morton, self.x, self.y].map(|v| ints(v));
-        for (k, lane) in lanes.iter_mut().enumerate().take(4) {
-            let alive = self.alive & (1 << k) != 0;
-            if !lane.alive {
-                continue;
-            }
+        for (k, lane) in lanes.iter_mut().enumerate().take(4).filter(|(_, l)| l.alive) {
             lane.xi = glam::DVec2::new(xs[k], ys[k]);
             lane.morton = ms[k] as usize;
-            let l = if alive { level } else { self.died_at[k] };
-            lane.cell = Cell::new(l, cx[k] as u32, cy[k] as u32);
-            lane.alive = alive;
+            lane.cell = Cell::new(self.level[k], cx[k] as u32, cy[k] as u32);
+            lane.alive = self.alive & (1 << k) != 0;
         }
     }
 
-    /// Each lane's sixteen grandchildren at the level starting at `base`, [`EMPTY`] for a dead lane.
+    /// Lane bits alive with two levels left above `finest`.
+    fn active(&self, finest: u32) -> i32 {
+        (0..4).filter(|&k| self.alive & (1 << k) != 0 && self.level[k] + 2 <= finest).fold(0, |a, k| a | 1 << k)
+    }
+
+    /// Each active lane's sixteen grandchildren, [`EMPTY`] for the others.
     #[target_feature(enable = "avx2")]
-    fn blocks<'p>(&self, pyramid: &'p [f32], base: usize) -> [&'p [f32; 16]; 4] {
+    fn blocks<'p>(&self, pyramid: &'p [f32], active: i32) -> [&'p [f32; 16]; 4] {
         let ms = ints(self.morton);
         core::array::from_fn(|k| {
-            if self.alive & (1 << k) == 0 {
+            if active & (1 << k) == 0 {
                 return &EMPTY;
             }
-            let at = base + 16 * ms[k] as usize;
+            let at = level_offset(self.level[k] + 2) + 16 * ms[k] as usize;
             pyramid[at..at + 16].try_into().expect("sixteen grandchildren")
         })
     }
 
-    /// One two-level step of the lanes at `level` over their grandchildren `blocks`.
+    /// One two-level step of the `active` lanes over their grandchildren `blocks`.
     #[target_feature(enable = "avx2")]
-    fn step(&mut self, level: u32, blocks: [&[f32; 16]; 4]) {
+    fn step(&mut self, active: i32, blocks: [&[f32; 16]; 4]) {
         let m = transpose(blocks);
         let at = |x: usize, y: usize| m[grandchild_index(x as u32, y as u32)];
         let cols: [__m256d; 4] = core::array::from_fn(|x| {
@@ -161,7 +163,7 @@ impl Group {
         };
         let child = _mm256_or_si256(bits(gx, 0, 2), bits(gy, 1, 3));
         let old = *self;
-        let ok = column.ok & row.ok & self.alive;
+        let ok = column.ok & row.ok & active;
         let keep = lane_mask(ok);
         let keep_i = _mm256_castpd_si256(keep);
         self.xi_x = _mm256_blendv_pd(self.xi_x, nx, keep);
@@ -173,13 +175,14 @@ impl Group {
         self.morton = advance(self.morton, child, 4);
         self.x = advance(self.x, gx, 2);
         self.y = advance(self.y, gy, 2);
-        for k in (0..4).filter(|k| self.alive & !ok & (1 << k) != 0) {
-            self.died_at[k] = level;
+        // Active lanes without mass die where they are; the others move two levels down.
+        self.alive &= !(active & !ok);
+        for k in (0..4).filter(|k| ok & (1 << k) != 0) {
+            self.level[k] += 2;
         }
-        self.alive = ok;
         let fallback = (column.fallback | row.fallback) & ok;
         if fallback != 0 {
-            self.redo_scalar(&old, level, blocks, fallback);
+            self.redo_scalar(&old, blocks, fallback);
         }
     }
 
@@ -187,7 +190,7 @@ impl Group {
     /// put t past a side of mass, which the scalar step's own fallback decides.
     #[cold]
     #[target_feature(enable = "avx2")]
-    fn redo_scalar(&mut self, old: &Group, level: u32, blocks: [&[f32; 16]; 4], fallback: i32) {
+    fn redo_scalar(&mut self, old: &Group, blocks: [&[f32; 16]; 4], fallback: i32) {
         let [mut xs, mut ys] = [self.xi_x, self.xi_y].map(|v| floats(v));
         let [mut ms, mut cx, mut cy] = [self.morton, self.x, self.y].map(|v| ints(v));
         let [ox, oy] = [old.xi_x, old.xi_y].map(|v| floats(v));
@@ -203,7 +206,7 @@ impl Group {
                 None => {
                     (xs[k], ys[k], ms[k], cx[k], cy[k]) = (ox[k], oy[k], om[k], ocx[k], ocy[k]);
                     self.alive &= !(1 << k);
-                    self.died_at[k] = level;
+                    self.level[k] = old.level[k];
                 }
             }
         }
@@ -362,18 +365,29 @@ mod tests {
                 let env = EnvHierarchy::new(level, &p, &rgb).unwrap();
                 let mut u = vec![DVec2::ZERO; 4099];
                 crate::points::sobol02(u64::from(level), 0, &mut u);
-                u[1] = DVec2::new(crate::warp::ONE_MINUS_EPSILON, crate::warp::ONE_MINUS_EPSILON);
-                u[2] = DVec2::new(0.0, crate::warp::ONE_MINUS_EPSILON);
-                // Every group size, the last group partial.
-                for chunk in u.chunks(7) {
-                    let start: Vec<WarpLane> = chunk.iter().map(|u| WarpLane::new(Cell::ROOT, *u)).collect();
-                    let (mut simd, mut scalar) = (start.clone(), start);
-                    assert!(env.warp_down_pairs_avx2(&mut simd));
-                    env.warp_down_lanes(&mut simd);
-                    env.warp_down_lanes(&mut scalar);
-                    for (a, b) in simd.iter().zip(&scalar) {
-                        assert_eq!((a.alive, a.cell, a.morton), (b.alive, b.cell, b.morton));
-                        assert_eq!((a.xi.x.to_bits(), a.xi.y.to_bits()), (b.xi.x.to_bits(), b.xi.y.to_bits()));
+                u[1] = DVec2::new(ONE_MINUS_EPSILON, ONE_MINUS_EPSILON);
+                u[2] = DVec2::new(0.0, ONE_MINUS_EPSILON);
+                // From the root, and from nodes of every level (the product's leaves), in
+                // groups of every size.
+                let node = |k: usize| {
+                    let l = (k as u32 * 7) % (level + 1);
+                    let side = 1u32 << l;
+                    Cell::new(l, (k as u32 * 13) % side, (k as u32 * 29) % side)
+                };
+                for (mixed, size) in [(false, 8), (true, 7), (true, 3)] {
+                    for (c, chunk) in u.chunks(size).enumerate() {
+                        let start: Vec<WarpLane> = chunk
+                            .iter()
+                            .enumerate()
+                            .map(|(k, u)| WarpLane::new(if mixed { node(c * size + k) } else { Cell::ROOT }, *u))
+                            .collect();
+                        let (mut simd, mut scalar) = (start.clone(), start);
+                        env.warp_down_lanes(&mut simd);
+                        env.warp_down_lanes_scalar(&mut scalar);
+                        for (a, b) in simd.iter().zip(&scalar) {
+                            assert_eq!((a.alive, a.cell, a.morton), (b.alive, b.cell, b.morton));
+                            assert_eq!((a.xi.x.to_bits(), a.xi.y.to_bits()), (b.xi.x.to_bits(), b.xi.y.to_bits()));
+                        }
                     }
                 }
             }
