@@ -46,11 +46,13 @@ impl EnvHierarchy<'_> {
         let (a, b) = lanes.split_at_mut(lanes.len().min(4));
         let mut groups = [Group::load(a), Group::load(b)];
         loop {
-            let active = groups.map(|g| g.active(self.finest));
+            // No closures through generic code here: they would not inherit AVX2 and so
+            // would not inline.
+            let active = [groups[0].active(self.finest), groups[1].active(self.finest)];
             if active == [0, 0] {
                 break;
             }
-            let blocks = [0, 1].map(|i| groups[i].blocks(self.pyramid, active[i]));
+            let blocks = [groups[0].blocks(self.pyramid, active[0]), groups[1].blocks(self.pyramid, active[1])];
             for ((g, blocks), active) in groups.iter_mut().zip(blocks).zip(active) {
                 if active != 0 {
                     g.step(active, blocks);
@@ -119,20 +121,27 @@ impl Group {
 
     /// Lane bits alive with two levels left above `finest`.
     fn active(&self, finest: u32) -> i32 {
-        (0..4).filter(|&k| self.alive & (1 << k) != 0 && self.level[k] + 2 <= finest).fold(0, |a, k| a | 1 << k)
+        let mut bits = 0;
+        for k in 0..4 {
+            if self.alive & (1 << k) != 0 && self.level[k] + 2 <= finest {
+                bits |= 1 << k;
+            }
+        }
+        bits
     }
 
     /// Each active lane's sixteen grandchildren, [`EMPTY`] for the others.
     #[target_feature(enable = "avx2")]
     fn blocks<'p>(&self, pyramid: &'p [f32], active: i32) -> [&'p [f32; 16]; 4] {
         let ms = ints(self.morton);
-        core::array::from_fn(|k| {
-            if active & (1 << k) == 0 {
-                return &EMPTY;
+        let mut out = [&EMPTY; 4];
+        for k in 0..4 {
+            if active & (1 << k) != 0 {
+                let at = level_offset(self.level[k] + 2) + 16 * ms[k] as usize;
+                out[k] = pyramid[at..at + 16].try_into().expect("sixteen grandchildren");
             }
-            let at = level_offset(self.level[k] + 2) + 16 * ms[k] as usize;
-            pyramid[at..at + 16].try_into().expect("sixteen grandchildren")
-        })
+        }
+        out
     }
 
     /// One two-level step of the `active` lanes over their grandchildren `blocks`.
@@ -140,13 +149,12 @@ impl Group {
     fn step(&mut self, active: i32, blocks: [&[f32; 16]; 4]) {
         let m = transpose(blocks);
         let at = |x: usize, y: usize| m[grandchild_index(x as u32, y as u32)];
-        let cols: [__m256d; 4] = core::array::from_fn(|x| {
-            _mm256_add_pd(_mm256_add_pd(at(x, 0), at(x, 1)), _mm256_add_pd(at(x, 2), at(x, 3)))
-        });
+        let col = |x: usize| _mm256_add_pd(_mm256_add_pd(at(x, 0), at(x, 1)), _mm256_add_pd(at(x, 2), at(x, 3)));
+        let cols = [col(0), col(1), col(2), col(3)];
         let column = pick_x4(cols, self.xi_x);
         // The chosen column's four masses, by the same nested masks that chose it.
-        let rows: [__m256d; 4] =
-            core::array::from_fn(|y| select(column.at_least, [at(0, y), at(1, y), at(2, y), at(3, y)]));
+        let row_of = |y: usize| select(column.at_least, [at(0, y), at(1, y), at(2, y), at(3, y)]);
+        let rows = [row_of(0), row_of(1), row_of(2), row_of(3)];
         let row = pick_x4(rows, self.xi_y);
         // rescale: r = 1/(wx·wy), ξ = (ox·wy·r, oy·wx·r) clamped to [0, 1).
         let r = _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_mul_pd(column.weight, row.weight));
@@ -177,8 +185,8 @@ impl Group {
         self.y = advance(self.y, gy, 2);
         // Active lanes without mass die where they are; the others move two levels down.
         self.alive &= !(active & !ok);
-        for k in (0..4).filter(|k| ok & (1 << k) != 0) {
-            self.level[k] += 2;
+        for k in 0..4 {
+            self.level[k] += if ok & (1 << k) != 0 { 2 } else { 0 };
         }
         let fallback = (column.fallback | row.fallback) & ok;
         if fallback != 0 {
@@ -264,7 +272,8 @@ impl Picked {
     #[inline]
     #[target_feature(enable = "avx2")]
     fn index(&self) -> __m256i {
-        let [a, b, c] = self.at_least.map(|m| _mm256_castpd_si256(m));
+        let [a, b, c] = self.at_least;
+        let (a, b, c) = (_mm256_castpd_si256(a), _mm256_castpd_si256(b), _mm256_castpd_si256(c));
         _mm256_sub_epi64(_mm256_setzero_si256(), _mm256_add_epi64(_mm256_add_epi64(a, b), c))
     }
 }
@@ -280,7 +289,8 @@ fn pick_x4(w: [__m256d; 4], x: __m256d) -> Picked {
     let p3 = _mm256_add_pd(p2, w[2]);
     let total = _mm256_add_pd(p3, w[3]);
     let t = _mm256_mul_pd(x, total);
-    let at_least = [p1, p2, p3].map(|p| _mm256_cmp_pd::<_CMP_GE_OQ>(t, p));
+    let at_least =
+        [_mm256_cmp_pd::<_CMP_GE_OQ>(t, p1), _mm256_cmp_pd::<_CMP_GE_OQ>(t, p2), _mm256_cmp_pd::<_CMP_GE_OQ>(t, p3)];
     let prefix = select(at_least, [zero, p1, p2, p3]);
     let weight = select(at_least, w);
     Picked {
@@ -317,12 +327,13 @@ fn transpose(blocks: [&[f32; 16]; 4]) -> [__m256d; 16] {
     let mut out = [_mm256_setzero_pd(); 16];
     for g in 0..4 {
         // SAFETY: each block holds sixteen values; 4·g + 4 ≤ 16.
-        let [a0, a1, a2, a3] = blocks.map(|b| unsafe { _mm_loadu_ps(b.as_ptr().add(4 * g)) });
+        let load = |b: &[f32; 16]| unsafe { _mm_loadu_ps(b.as_ptr().add(4 * g)) };
+        let (a0, a1, a2, a3) = (load(blocks[0]), load(blocks[1]), load(blocks[2]), load(blocks[3]));
         let (t0, t1) = (_mm_unpacklo_ps(a0, a1), _mm_unpacklo_ps(a2, a3));
         let (t2, t3) = (_mm_unpackhi_ps(a0, a1), _mm_unpackhi_ps(a2, a3));
         let columns = [_mm_movelh_ps(t0, t1), _mm_movehl_ps(t1, t0), _mm_movelh_ps(t2, t3), _mm_movehl_ps(t3, t2)];
-        for (j, c) in columns.into_iter().enumerate() {
-            out[4 * g + j] = _mm256_cvtps_pd(c);
+        for j in 0..4 {
+            out[4 * g + j] = _mm256_cvtps_pd(columns[j]);
         }
     }
     out
