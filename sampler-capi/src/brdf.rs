@@ -6,7 +6,7 @@ use crate::{borrow, finish, place, ppis_status, ppis_vec2, ppis_vec3};
 use core::ffi::c_void;
 use sampler_core::brdf::{Brdf, BrdfDraw, BrdfSample, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::cone::Cone;
-use sampler_core::glam::{Vec2, Vec3};
+use sampler_core::glam::{Vec2, Vec3, Vec4};
 
 /// A BRDF: built-in or an engine's callbacks.
 pub struct ppis_brdf(Kind);
@@ -58,6 +58,9 @@ impl Brdf for ppis_brdf {
     }
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         self.inner().sample_batch(wo, u, out)
+    }
+    fn eval_luminance_x4(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        self.inner().eval_luminance_x4(wo, wi)
     }
     fn is_diffuse(&self) -> bool {
         self.inner().is_diffuse()

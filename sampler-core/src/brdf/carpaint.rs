@@ -10,7 +10,7 @@ use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::{reflect, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use core::f32::consts::FRAC_1_PI;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// Lambert base + GGX flakes under a GGX clear coat with Schlick Fresnel (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,6 +179,10 @@ impl Brdf for CarPaint {
         let (coat, flake) =
             if wo.dot(h) > 0.0 { (gc_o * dc / (4.0 * wo.z), gf_o * df / (4.0 * wo.z)) } else { (0.0, 0.0) };
         (value, (w[0] * coat + w[1] * flake + w[2] * square_to_cosine_hemisphere_pdf(wi)) / total)
+    }
+
+    fn eval_luminance_x4(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        self.eval_luminance_lanes(wo, wi)
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {

@@ -4,10 +4,10 @@
 //! is bit for bit the one-at-a-time draw of `CarPaint::sample_batch`: the same IEEE operations
 //! in the same order, selects where it branches (tests below).
 
-use super::BrdfDraw;
 use super::carpaint::CarPaint;
 use super::ggx_x4::Dir4;
 use super::microfacet::fresnel_schlick;
+use super::{BrdfDraw, luminance_x4};
 use crate::env::luminance;
 use crate::mapping::sqrt4;
 use crate::sampling::square_to_cosine_hemisphere_x4;
@@ -139,6 +139,40 @@ impl CarPaint {
                 o.value = value[j];
             }
         }
+    }
+}
+
+impl CarPaint {
+    /// [`Brdf::eval_luminance_x4`](super::Brdf::eval_luminance_x4): `eval`'s coat, flakes and
+    /// base in lanes, each term in `eval`'s order, then the luminance of the RGB sum; +0 where
+    /// `eval` returns zero (no half vector, ωi below the surface).
+    pub(super) fn eval_luminance_lanes(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        if wo.z <= 0.0 {
+            return Vec4::ZERO;
+        }
+        let sp = Vec4::splat;
+        let (c, f) = (&self.coat_ggx, &self.flake_ggx);
+        let wi = Dir4 { x: wi[0], y: wi[1], z: wi[2] };
+        let s = Dir4 { x: sp(wo.x) + wi.x, y: sp(wo.y) + wi.y, z: sp(wo.z) + wi.z };
+        let len2 = s.length_squared();
+        let exists = len2.cmpgt(sp(1e-24)) & len2.is_finite_mask();
+        let len = sqrt4(len2);
+        let h = Dir4 { x: s.x / len, y: s.y / len, z: s.z / len };
+        let four_cos_o = sp(4.0 * wo.z);
+        let coat =
+            sp(self.coat) * fresnel_schlick_x4(self.coat_f0, h.dot(wo)) * c.d_x4(&h) * c.g1_x4(&wi) * sp(c.g1(wo))
+                / four_cos_o;
+        let flake = f.d_x4(&h) * f.g1_x4(&wi) * sp(f.g1(wo)) / four_cos_o;
+        let transmit = sp(1.0 - self.coat * fresnel_schlick(self.coat_f0, wo.z))
+            * (Vec4::ONE - sp(self.coat) * fresnel_schlick_x4(self.coat_f0, wi.z));
+        let cos_base = sp(FRAC_1_PI) * wi.z;
+        let rgb = |flake_c: f32, base_c: f32| coat + transmit * (sp(flake_c) * flake + sp(base_c) * cos_base);
+        let lum = luminance_x4(
+            rgb(self.flake.x, self.base.x),
+            rgb(self.flake.y, self.base.y),
+            rgb(self.flake.z, self.base.z),
+        );
+        Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), lum, Vec4::ZERO)
     }
 }
 

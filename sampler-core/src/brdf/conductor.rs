@@ -6,7 +6,7 @@ use super::{Brdf, BrdfDraw, BrdfSample};
 use crate::cone::Cone;
 use crate::env::luminance;
 use crate::sampling::reflect;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// GGX rough conductor with Fresnel 1 (see the module).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +97,10 @@ impl Brdf for RoughConductor {
 
     fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
         self.eval_pdf_many_x4(wo, wi, out);
+    }
+
+    fn eval_luminance_x4(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        self.eval_luminance_lanes(wo, wi)
     }
 
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {

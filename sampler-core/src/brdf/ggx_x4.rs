@@ -5,7 +5,7 @@
 
 use super::conductor::RoughConductor;
 use super::microfacet::Ggx;
-use super::{BrdfDraw, BrdfSample};
+use super::{BrdfDraw, BrdfSample, luminance_x4};
 use crate::mapping::sqrt4;
 use crate::sampling::sin_cos_2pi_x4;
 use core::f32::consts::PI;
@@ -100,6 +100,26 @@ impl RoughConductor {
         let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO);
         let pdf = Vec4::select(exists & h.dot(wo).cmpgt(Vec4::ZERO), pdf, Vec4::ZERO);
         (value, pdf)
+    }
+
+    /// [`Brdf::eval_luminance_x4`](super::Brdf::eval_luminance_x4): `eval`'s scalar factor
+    /// D·G1(ωi)·G1(ωo)/(4 cosθo) in lanes, times `specular`, its luminance; +0 where `eval`
+    /// returns zero (no half vector, ωi below the surface).
+    pub(crate) fn eval_luminance_lanes(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        if wo.z <= 0.0 {
+            return Vec4::ZERO;
+        }
+        let g = &self.ggx;
+        let wi = Dir4 { x: wi[0], y: wi[1], z: wi[2] };
+        let s = Dir4 { x: Vec4::splat(wo.x) + wi.x, y: Vec4::splat(wo.y) + wi.y, z: Vec4::splat(wo.z) + wi.z };
+        let len2 = s.length_squared();
+        let exists = len2.cmpgt(Vec4::splat(1e-24)) & len2.is_finite_mask();
+        let len = sqrt4(len2);
+        let h = Dir4 { x: s.x / len, y: s.y / len, z: s.z / len };
+        let value = g.d_x4(&h) * g.g1_x4(&wi) * Vec4::splat(g.g1(wo)) / Vec4::splat(4.0 * wo.z);
+        let sp = self.specular;
+        let lum = luminance_x4(Vec4::splat(sp.x) * value, Vec4::splat(sp.y) * value, Vec4::splat(sp.z) * value);
+        Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), lum, Vec4::ZERO)
     }
 
     /// [`Brdf::sample`](super::Brdf::sample) for every point of `u` (`out[k]` from `u[k]`), four

@@ -20,7 +20,7 @@ pub use phong::Phong;
 
 use crate::cone::Cone;
 use crate::env::luminance;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// A direction drawn by a BRDF's own importance sampler.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,6 +75,15 @@ pub trait Brdf {
         for (o, w) in out.iter_mut().zip(wi) {
             *o = self.eval_pdf(wo, *w);
         }
+    }
+
+    /// The luminance of [`Brdf::eval`] at four directions given in lanes (`wi[0]`, `wi[1]`,
+    /// `wi[2]`: their x, y and z), bit for bit `luminance(self.eval(wo, ωk))` in lane k: the
+    /// product's build probes B at several cells' centres at once. Implementations may
+    /// evaluate the four side by side (the GGX conductor, the car paint).
+    fn eval_luminance_x4(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        let [x, y, z] = wi;
+        Vec4::from_array(core::array::from_fn(|k| luminance(self.eval(wo, Vec3::new(x[k], y[k], z[k])))))
     }
 
     /// Draws one direction per point of `u` like [`Brdf::sample`], for building B̃: writes
@@ -154,6 +163,9 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         (**self).sample_batch(wo, u, out)
     }
+    fn eval_luminance_x4(&self, wo: Vec3, wi: [Vec4; 3]) -> Vec4 {
+        (**self).eval_luminance_x4(wo, wi)
+    }
     fn is_diffuse(&self) -> bool {
         (**self).is_diffuse()
     }
@@ -169,6 +181,15 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
         (**self).reflectance_bound(wo)
     }
+}
+
+/// [`luminance`] of four RGB values given as their red, green and blue lanes, bit for bit the
+/// scalar function in each lane: its weights are read from it (`luminance(Vec3::X)` is the red
+/// weight exactly: the other terms add zeros) and summed in its order.
+#[inline]
+pub(crate) fn luminance_x4(r: Vec4, g: Vec4, b: Vec4) -> Vec4 {
+    let w = |axis: Vec3| Vec4::splat(luminance(axis));
+    w(Vec3::X) * r + w(Vec3::Y) * g + w(Vec3::Z) * b
 }
 
 /// Chooses one of up to three lobes with probability ∝ `weights`, rescaling `u` so that it is
@@ -190,4 +211,62 @@ pub(crate) fn pick_lobe(weights: [f32; 3], u: &mut f32) -> Option<usize> {
         acc += p;
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mapping::square_to_sphere;
+    use crate::rng::Pcg32;
+
+    /// Every lane of `eval_luminance_x4` is `luminance(eval)` of its direction, bit for bit:
+    /// the four-wide GGX conductor and car paint and the default (Lambert, Phong), for smooth
+    /// to rough lobes, coloured reflectances, views from the normal to grazing and below the
+    /// surface, and directions over the whole sphere, plus the mirror of the view (no half
+    /// vector), the horizon and ±0.
+    #[test]
+    fn four_wide_luminance_is_the_scalar_eval_bit_for_bit() {
+        let colour = Vec3::new(0.9, 0.6, 0.2);
+        let brdfs: [&dyn Brdf; 9] = [
+            &RoughConductor::new(1e-4, colour),
+            &RoughConductor::new(0.01, colour),
+            &RoughConductor::new(0.3, Vec3::ONE),
+            &RoughConductor::new(1.0, colour),
+            &CarPaint::default(),
+            &CarPaint::new(colour, Vec3::splat(0.5), 0.1, 0.0, 0.01),
+            &CarPaint::new(Vec3::splat(0.3), Vec3::ZERO, 0.1, 0.5, 0.05),
+            &Lambert::new(colour),
+            &Phong::new(Vec3::splat(0.2), colour, 50.0),
+        ];
+        let mut rng = Pcg32::new(3, 3);
+        for brdf in brdfs {
+            for wo in [
+                Vec3::Z,
+                Vec3::new(0.3, -0.2, 0.9).normalize(),
+                Vec3::new(0.999, 0.0, 0.01).normalize(),
+                Vec3::new(0.2, 0.1, -0.9).normalize(),
+            ] {
+                let mut dirs: [Vec3; 256] =
+                    core::array::from_fn(|_| square_to_sphere(Vec2::new(rng.next_f32(), rng.next_f32())));
+                dirs[..8].copy_from_slice(&[
+                    -wo,
+                    wo,
+                    Vec3::X,
+                    Vec3::new(0.6, 0.8, 0.0),
+                    Vec3::new(0.0, 0.0, -0.0),
+                    Vec3::Z,
+                    -Vec3::Z,
+                    Vec3::Y,
+                ]);
+                for four in dirs.chunks_exact(4) {
+                    let lanes = [0, 1, 2].map(|a| Vec4::from_array(core::array::from_fn(|k| four[k][a])));
+                    let got = brdf.eval_luminance_x4(wo, lanes);
+                    for (k, wi) in four.iter().enumerate() {
+                        let want = luminance(brdf.eval(wo, *wi));
+                        assert_eq!(got[k].to_bits(), want.to_bits(), "wo {wo}, wi {wi}: {} against {want}", got[k]);
+                    }
+                }
+            }
+        }
+    }
 }

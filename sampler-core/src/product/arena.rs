@@ -9,9 +9,9 @@ use super::sampler::ProductSampler;
 use crate::brdf::{Brdf, BrdfDraw};
 use crate::env::{EnvHierarchy, luminance};
 use crate::frame::Frame;
-use crate::mapping::{sphere_to_square_batch, square_to_sphere};
+use crate::mapping::{sphere_to_square_batch, square_to_sphere, square_to_sphere_x4};
 use crate::points::sobol02_shifted;
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Mat3, Vec2, Vec3, Vec4};
 use heapless::Vec;
 
 /// Scratch memory for one shading point at a time: K BRDF samples and up to NODES tree nodes.
@@ -120,9 +120,20 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             }
             self.keys.sort_unstable();
         }
-        // B·cos at a point of the square, for the empty cells that need it.
+        // B·cos at a point of the square, and at four side by side (each lane as `eval` gives
+        // it), for the cells the build probes.
         let map_to_local = (env.world_to_map() * Mat3::from_cols(frame.s, frame.t, frame.n)).transpose();
         let eval = |uv: Vec2| luminance(brdf.eval(wo_local, map_to_local * square_to_sphere(uv)));
+        let eval4 = |u: Vec4, v: Vec4| {
+            let [x, y, z] = square_to_sphere_x4(u, v);
+            let m = map_to_local;
+            // `Mat3 * Vec3`'s order: the columns scaled by x, y, z and summed in turn.
+            let row = |k: usize| {
+                let c = |axis: Vec3| Vec4::splat(axis[k]);
+                c(m.x_axis) * x + c(m.y_axis) * y + c(m.z_axis) * z
+            };
+            brdf.eval_luminance_x4(wo_local, [row(0), row(1), row(2)])
+        };
         let mut builder = TreeBuilder {
             keys: &self.keys,
             values: &self.values[..count],
@@ -132,6 +143,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             max_depth: params.max_depth.min(COORD_BITS),
             wavelet: kind.is_wavelet(),
             eval,
+            eval4,
             probe_leaves: kind.leaves() == Leaves::Probed,
             refine_share: kind.refine_share(),
             bilinear: kind.leaves() == Leaves::Bilinear,

@@ -1,9 +1,9 @@
 //! The quadtree product of one shading point (Clarberg & Akenine-Möller 2008), all its parts
 //! together: the tree over the BRDF samples with the product computed in the same traversal
-//! ([`quadtree`], its Haar cross-check [`wavelet`] and the [`bilinear`] leaves), the arena that
-//! builds it, the [`sampler`] that warps points through it and evaluates its density, and the
-//! same four descents at a time (`lanes.rs`). The public modules are re-exported at the crate's
-//! root (`sampler_core::sampler`, …).
+//! ([`quadtree`], its probes of B (`probe.rs`), its Haar cross-check [`wavelet`] and the
+//! [`bilinear`] leaves), the arena that builds it, the [`sampler`] that warps points through
+//! it and evaluates its density, and the same four descents at a time (`lanes.rs`). The public
+//! modules are re-exported at the crate's root (`sampler_core::sampler`, …).
 
 mod arena;
 pub mod bilinear;
@@ -11,6 +11,7 @@ mod bilinear_walk;
 mod keys;
 mod lanes;
 mod params;
+mod probe;
 pub mod quadtree;
 pub mod sampler;
 pub mod wavelet;

@@ -28,7 +28,7 @@ use crate::bilinear::{self, Corners};
 use crate::cell::Cell;
 use crate::env::EnvHierarchy;
 use crate::wavelet::haar_product_mean;
-use glam::Vec2;
+use glam::{Vec2, Vec4};
 use heapless::Vec;
 
 /// Prior count α of the add-α smoothing that gives empty leaves their B̃ (see
@@ -69,9 +69,14 @@ impl Node {
 }
 
 /// Builds the tree over `keys` (sorted) whose sample values are `values[key & 0xFFFF]`;
-/// `eval(uv)` gives B·cos (luminance) at a point of the square, for empty cells where the
-/// sample counts say B is small.
-pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> {
+/// `eval(uv)` gives B·cos (luminance) at a point of the square and `eval4(u, v)` at four, their
+/// coordinates in lanes (each lane bit for bit `eval` of its point), for the cells whose B is
+/// probed.
+pub(crate) struct TreeBuilder<'b, 'e, F, G, const NODES: usize, const CORNERS: usize>
+where
+    F: FnMut(Vec2) -> f32,
+    G: FnMut(Vec4, Vec4) -> Vec4,
+{
     pub keys: &'b [u64],
     pub values: &'b [f32],
     pub env: &'b EnvHierarchy<'e>,
@@ -83,6 +88,7 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     /// Internal nodes by the Haar wavelet product instead of the average.
     pub wavelet: bool,
     pub eval: F,
+    pub eval4: G,
     /// Also probe B at the centre of every leaf that holds samples (see `node`).
     pub probe_leaves: bool,
     /// Split leaves holding more than this share of the product's mass, B probed at each new
@@ -94,7 +100,11 @@ pub(crate) struct TreeBuilder<'b, 'e, F: FnMut(Vec2) -> f32, const NODES: usize,
     pub corners: &'b mut Vec<Corners, CORNERS>,
 }
 
-impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, NODES, CORNERS> {
+impl<F, G, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, G, NODES, CORNERS>
+where
+    F: FnMut(Vec2) -> f32,
+    G: FnMut(Vec4, Vec4) -> Vec4,
+{
     /// Builds the whole tree; the root is node 0. Returns false when there are no samples.
     pub fn build(&mut self) -> bool {
         self.nodes.clear();
@@ -144,11 +154,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         let l = if depth < self.env.finest_level() { self.env.children_relative(cell) } else { [env; 4] };
         let first = if node.is_leaf() {
             let first = self.push_children(index, cell);
-            for c in 0..4 {
+            let probes = if self.bilinear { [0.0; 4] } else { self.probe4(&[0, 1, 2, 3].map(|c| cell.child(c))) };
+            for (c, probe) in probes.into_iter().enumerate() {
                 let b = if self.bilinear {
                     bilinear::mean(&self.corners[first + c])
                 } else {
-                    let probe = self.probe(cell.child(c));
                     // NaN (unknown) keeps the parent's B̃.
                     if probe.is_finite() { probe } else { node.product / env.max(f32::MIN_POSITIVE) }
                 };
@@ -189,13 +199,14 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         } else {
             [env; 4]
         };
+        let probes = self.probe_children(cell, hi - lo, &bounds);
         let mut b = [0.0f32; 4];
         let mut p = [0.0f32; 4];
         let (mut sum_b, mut filled) = (0.0f32, 0u32);
         for c in 0..4 {
-            if bounds[c + 1] == bounds[c] + 1 && !self.probe_leaves && !self.bilinear {
+            if bounds[c + 1] == bounds[c] + 1 && !self.bilinear {
                 // A leaf of one sample (most leaves) without the call.
-                (b[c], p[c]) = self.sample_leaf(first + c, l[c], bounds[c]);
+                (b[c], p[c]) = self.sample_leaf(first + c, l[c], bounds[c], probes[c]);
                 sum_b += b[c];
                 filled += 1;
             } else if bounds[c + 1] > bounds[c] {
@@ -219,7 +230,7 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
                 let fill = if self.bilinear {
                     bilinear::mean(&self.corners[first + c])
                 } else if hi - lo >= EVAL_EMPTY_FROM {
-                    count_fill.min(self.probe(cell.child(c)))
+                    count_fill.min(probes[c])
                 } else {
                     count_fill
                 };
@@ -259,11 +270,15 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
         (b, product)
     }
 
-    /// [`leaf`](Self::leaf) of the one sample `keys[at]`, with neither probed nor bilinear leaves.
+    /// [`leaf`](Self::leaf) of the one sample `keys[at]` without bilinear leaves; `probe` is B
+    /// at the leaf's centre where leaves are probed (`probe_children`).
     #[inline(always)]
-    fn sample_leaf(&mut self, index: usize, env: f32, at: usize) -> (f32, f32) {
+    fn sample_leaf(&mut self, index: usize, env: f32, at: usize, probe: f32) -> (f32, f32) {
         let sum: f32 = core::iter::once(self.values[(self.keys[at] & 0xFFFF) as usize]).sum();
-        let b = sum / 1.0;
+        let mut b = sum / 1.0;
+        if self.probe_leaves && probe.is_finite() {
+            b = b.max(probe);
+        }
         let product = b * env;
         set(&mut self.nodes[index], 0, product);
         (b, product)
@@ -292,7 +307,11 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     }
 }
 
-impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, NODES, CORNERS> {
+impl<F, G, const NODES: usize, const CORNERS: usize> TreeBuilder<'_, '_, F, G, NODES, CORNERS>
+where
+    F: FnMut(Vec2) -> f32,
+    G: FnMut(Vec4, Vec4) -> Vec4,
+{
     /// Appends the four children of node `index` (covering `cell`) and, for a bilinear
     /// B̃, their corner values: the parent's corners, B at the four edge midpoints and at the
     /// centre — five evaluations, shared by the children so that B̃ is continuous across them.
@@ -317,24 +336,6 @@ impl<F: FnMut(Vec2) -> f32, const NODES: usize, const CORNERS: usize> TreeBuilde
     fn eval_at(&mut self, uv: Vec2) -> f32 {
         let v = (self.eval)(uv);
         if v.is_nan() || v <= 0.0 { 0.0 } else { v.min(f32::MAX) }
-    }
-
-    /// B·cos at the centre of `cell`; where that is 0 (e.g. below the
-    /// surface), the largest of its four corners (inset by 1/64 of the cell), so that a cell
-    /// straddling the horizon is not zeroed. NaN reads as unknown (+∞: keep the count fill).
-    fn probe(&mut self, cell: Cell) -> f32 {
-        let Cell { level: depth, x, y } = cell;
-        let inv = 1.0 / (1u64 << depth) as f32;
-        let at = |s: f32, t: f32| Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv);
-        let read = |v: f32| {
-            if v.is_nan() { f32::INFINITY } else { v.max(0.0) }
-        };
-        let centre = read((self.eval)(at(0.5, 0.5)));
-        if centre > 0.0 {
-            return centre;
-        }
-        let (a, b) = (1.0 / 64.0, 63.0 / 64.0);
-        [at(a, a), at(b, a), at(a, b), at(b, b)].into_iter().map(|p| read((self.eval)(p))).fold(0.0, f32::max)
     }
 }
 
