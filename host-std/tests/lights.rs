@@ -176,3 +176,24 @@ fn lit_images_are_bit_identical_at_any_thread_count_and_area_lights_occlude() {
     let shadowed = plane_under(vec![point.into(), blocker.into()]);
     assert_eq!(mean_red(&shadowed, &settings(Method::Mis, 8)), 0.0);
 }
+
+/// An area light seen by the camera shows its radiance from the front and black from behind
+/// (one-sided; it has no material, so it reflects nothing, not even a point light shining on
+/// its back), and `hide_emitters` hides it while it still occludes the plane behind it.
+#[test]
+fn area_lights_are_seen_from_the_front_only_and_hide_emitters_hides_them() {
+    let radiance = Vec3::new(3.0, 2.0, 1.0);
+    let (corner, e1, e2) = (Vec3::new(-1.0, -1.0, 1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0));
+    let facing_camera = sampler_core::light::RectLight::new(corner, e1, e2, radiance).unwrap();
+    let facing_away = sampler_core::light::RectLight::new(corner, e2, e1, radiance).unwrap();
+    let lamp = PointLight::new(Vec3::new(0.0, 0.0, 5.0), Vec3::splat(100.0)).unwrap();
+    let pixels = |light: &sampler_core::light::RectLight, hide: bool| {
+        let mut scene = plane_under(vec![(*light).into(), lamp.into()]);
+        scene.hide_emitters = hide;
+        let bvh = Bvh::build(&scene);
+        render(&scene, &bvh, None, &settings(Method::Mis, 4)).pixels
+    };
+    assert!(pixels(&facing_camera, false).iter().all(|p| *p == radiance.to_array()), "front: its radiance");
+    assert!(pixels(&facing_away, false).iter().all(|p| *p == [0.0; 3]), "back: black, reflecting nothing");
+    assert!(pixels(&facing_camera, true).iter().all(|p| *p == [0.0; 3]), "hidden, and still occluding");
+}
