@@ -7,6 +7,7 @@
 //! a tolerance several times its standard error. And the image stays bit-identical at any
 //! thread count, and area lights occlude.
 
+use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::{Method, Settings, render};
 use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
@@ -196,4 +197,40 @@ fn area_lights_are_seen_from_the_front_only_and_hide_emitters_hides_them() {
     assert!(pixels(&facing_camera, false).iter().all(|p| *p == radiance.to_array()), "front: its radiance");
     assert!(pixels(&facing_away, false).iter().all(|p| *p == [0.0; 3]), "back: black, reflecting nothing");
     assert!(pixels(&facing_camera, true).iter().all(|p| *p == [0.0; 3]), "hidden, and still occluding");
+}
+
+/// Every unbiased method's one estimator of the environment, the lights and BRDF samples
+/// together: a Lambert plane under a constant sky of radiance L_e, a sphere light of radiance L_s
+/// subtending a cone of half-angle α at elevation θ_c (which hides that much of the sky) and a
+/// 2° sun of irradiance E at θ_d shades ρ [L_e (1 − sin²α cos θ_c) + L_s sin²α cos θ_c] + ρ E
+/// cos θ_d / π; each method's mean is within 4 standard errors (over pixels) and 0.2% of it.
+#[test]
+fn the_environment_lights_and_brdf_samples_together_shade_their_closed_form() {
+    let (l_env, l_sphere, e) = (1.0f32, 4.0f32, 2.0f32);
+    let (center, radius) = (Vec3::new(1.5, 0.0, 3.0), 0.5f32);
+    let sun = Vec3::new(-1.0, 0.5, 2.0).normalize();
+    let tmp = tempfile::Builder::new().prefix("ppis-env-lights-").tempdir().unwrap();
+    let path = tmp.path().join("sky.exr");
+    exr::prelude::write_rgb_file(&path, 32, 32, |_, _| (l_env, l_env, l_env)).unwrap();
+    let env = Environment::build(&EnvSource::File(path), Placement::default()).unwrap();
+    let lights = vec![
+        SphereLight::new(center, radius, Vec3::splat(l_sphere)).unwrap().into(),
+        DistantLight::new(sun, Vec3::splat(e), 2f32.to_radians()).unwrap().into(),
+    ];
+    let scene = plane_under(lights);
+    let bvh = Bvh::build(&scene);
+    let expected = over_the_view(|p| {
+        let v = center - p;
+        let covered = ((radius / v.length()).powi(2) * v.z / v.length()) as f64;
+        let sky = l_env as f64 * (1.0 - covered) + l_sphere as f64 * covered;
+        ALBEDO as f64 * (sky + e as f64 * sun.z as f64 / std::f64::consts::PI)
+    });
+    for method in Method::ALL.into_iter().filter(|m| m.is_unbiased()) {
+        let pixels = render(&scene, &bvh, Some(&env.hierarchy()), &settings(method, 64)).pixels;
+        let n = pixels.len() as f64;
+        let mean = pixels.iter().map(|p| p[0] as f64).sum::<f64>() / n;
+        let var = pixels.iter().map(|p| (p[0] as f64 - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let tolerance = 4.0 * (var / n).sqrt() + 2e-3 * expected;
+        assert!((mean - expected).abs() < tolerance, "{method}: {mean} against {expected} (± {tolerance})");
+    }
 }

@@ -289,7 +289,8 @@ fn the_blackbody_colour_is_pixars_up_to_the_schemas_white_at_6500_k() {
 #[test]
 fn a_geometry_light_makes_its_targets_emit_and_not_also_surfaces() {
     let s = host_usd::load(&fixture("lights_geometry.usda")).unwrap();
-    let Emitter::Triangles { ref positions, ref triangles, radiance, two_sided } = light(&s, "/World/PanelLight").emitter
+    let Emitter::Triangles { ref positions, ref triangles, radiance, two_sided } =
+        light(&s, "/World/PanelLight").emitter
     else {
         panic!()
     };
