@@ -13,6 +13,9 @@ IES profiles from docs/scenes/ies/); its USD twin is host-usd/tests/fixtures/lig
 With `--many DIR`, it writes instead the many-light scenes of docs/perf.md, "Many lights", into
 DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a floor with 20
 spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).
+With `--many-scaling DIR`, area{10,100,1000,10000}.json (the emitting area and power of tri1000
+split into that many triangles: the same coverage of the sky at every count) and
+points{10,100,1000,10000}.json (that many point lights of pt1000's total power).
 """
 import json
 import math
@@ -87,20 +90,20 @@ def write(name, scene):
         f.write("\n")
 
 
-def many(out, n_tri, n_point, name):
-    """A floor with 20 spheres under n_tri emissive triangles (0.15 wide, facing down, 1.5–3
+def many(out, n_tri, n_point, name, side=0.15, point_intensity=(0.3, 0.3, 0.4)):
+    """A floor with 20 spheres under n_tri emissive triangles (`side` wide, facing down, 1.5–3
     above it) and n_point point lights, all scattered over 20×20."""
     random.seed(1)
     lights = []
     if n_tri:
         with open(os.path.join(out, name + ".obj"), "w") as f:
             for i in range(n_tri):
-                x, z, y, s = random.uniform(-10, 10), random.uniform(-10, 10), random.uniform(1.5, 3.0), 0.15
+                x, z, y, s = random.uniform(-10, 10), random.uniform(-10, 10), random.uniform(1.5, 3.0), side
                 f.write(f"v {x} {y} {z}\nv {x + s} {y} {z}\nv {x} {y} {z + s}\nf {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
         lights.append({"type": "mesh", "file": name + ".obj", "radiance": [20, 18, 15]})
     for _ in range(n_point):
         x, z = random.uniform(-10, 10), random.uniform(-10, 10)
-        lights.append({"type": "point", "position": [x, random.uniform(0.5, 2.5), z], "intensity": [0.3, 0.3, 0.4]})
+        lights.append({"type": "point", "position": [x, random.uniform(0.5, 2.5), z], "intensity": list(point_intensity)})
     shapes = [{"type": "rectangle", "p0": [-12, 0, -12], "e1": [0, 0, 24], "e2": [24, 0, 0],
                "material": {"type": "diffuse", "albedo": [0.6, 0.6, 0.6]}}]
     for i in range(20):
@@ -120,6 +123,15 @@ def main():
             many(sys.argv[2], n, 0, f"tri{n}")
         many(sys.argv[2], 0, 1000, "pt1000")
         many(sys.argv[2], 10000, 1000, "both")
+        return
+    if len(sys.argv) == 3 and sys.argv[1] == "--many-scaling":
+        # The same emitting area and power (1000 triangles 0.15 wide) split into n triangles, so
+        # that the sky the emitters cover stays alike while the light count grows; and n point
+        # lights of the same total power, which are no geometry at all.
+        os.makedirs(sys.argv[2], exist_ok=True)
+        for n in [10, 100, 1000, 10000]:
+            many(sys.argv[2], n, 0, f"area{n}", side=0.15 * math.sqrt(1000 / n))
+            many(sys.argv[2], 0, n, f"points{n}", point_intensity=[c * 1000 / n for c in (0.3, 0.3, 0.4)])
         return
     os.makedirs(os.path.join(HERE, "meshes"), exist_ok=True)
     torus(os.path.join(HERE, "meshes", "torus_lamp.obj"))

@@ -8,10 +8,11 @@ use crate::stage::{PrimPath, Stage, TimeCode, Value};
 use crate::xform::{WorldTransforms, up_axis_conversion};
 use crate::{camera, dome, render_settings};
 use glam::DMat4;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::time::Instant;
 
+mod geometry_light;
 mod gprim;
 mod lights;
 mod material_binding;
@@ -58,8 +59,9 @@ const STRUCTURE: [&str; 10] = [
     "RenderSettings",
     "RenderProduct",
 ];
-/// Lights not rendered (the others are `crate::lights::KINDS`, the dome and MeshLightAPI).
-const OTHER_LIGHTS: [&str; 3] = ["GeometryLight", "PortalLight", "PluginLight"];
+/// Lights not rendered (the others are `crate::lights::KINDS`, the dome, MeshLightAPI and
+/// GeometryLight).
+const OTHER_LIGHTS: [&str; 2] = ["PortalLight", "PluginLight"];
 const SKELETAL: [&str; 4] = ["SkelRoot", "Skeleton", "SkelAnimation", "BlendShape"];
 
 struct Importer<'a> {
@@ -76,6 +78,9 @@ struct Importer<'a> {
     cameras: Vec<PrimPath>,
     /// The RenderSettings prims in walk order.
     settings: Vec<PrimPath>,
+    /// The gprims GeometryLights have made lights, which the walk does not also import as
+    /// surfaces.
+    light_geometry: HashSet<String>,
 }
 
 /// Imports a USD file with default options.
@@ -212,6 +217,7 @@ impl<'a> Importer<'a> {
             prototypes,
             cameras: Vec::new(),
             settings: Vec::new(),
+            light_geometry: HashSet::new(),
         }
     }
 

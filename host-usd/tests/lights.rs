@@ -282,3 +282,43 @@ fn the_blackbody_colour_is_pixars_up_to_the_schemas_white_at_6500_k() {
         }
     }
 }
+
+/// A GeometryLight (`lights_geometry.usda`) makes the gprims it targets emit with its inputs,
+/// as MeshLightAPI would, whether the walk meets the light or the gprim first; the gprims
+/// are lights only, not also surfaces. A GeometryLight with nothing to light is a note.
+#[test]
+fn a_geometry_light_makes_its_targets_emit_and_not_also_surfaces() {
+    let s = host_usd::load(&fixture("lights_geometry.usda")).unwrap();
+    let Emitter::Triangles { ref positions, ref triangles, radiance, two_sided } =
+        light(&s, "/World/PanelLight").emitter
+    else {
+        panic!()
+    };
+    assert_eq!(triangles.len(), 2);
+    assert!(two_sided, "the quad is doubleSided");
+    assert!(positions.iter().all(|p| (5.0..=6.0).contains(&p.x) && (0.0..=1.0).contains(&p.y) && p.z == 0.0));
+    assert!(close(radiance, Vec3::new(2.0, 1.0, 0.5)), "2 · color over area 1: {radiance}");
+    let Emitter::Triangles { ref positions, radiance, two_sided, .. } = light(&s, "/World/BallLight").emitter else {
+        panic!()
+    };
+    assert!(!two_sided);
+    assert!(positions.iter().all(|p| ((*p - Vec3::new(0.0, 2.0, 0.0)).length() - 0.5).abs() < 1e-3));
+    assert!(close(radiance, Vec3::splat(6.0)), "3 · 2¹, not normalised: {radiance}");
+    assert_eq!(light(&s, "/World/BallLight").prim_type, "GeometryLight");
+    // Neither target is also a surface; the untargeted cube is.
+    assert!(s.spheres.is_empty(), "{:?}", s.spheres.iter().map(|p| &p.path).collect::<Vec<_>>());
+    let surfaces: Vec<&str> = s.meshes.iter().map(|m| m.path.as_str()).collect();
+    assert_eq!(surfaces, ["/World/Box"]);
+    assert_eq!((s.counts.gprims, s.counts.meshes), (1, 0), "{:?}", s.counts);
+    assert_eq!(s.counts.triangles, s.meshes[0].triangles.len());
+    for (path, note) in [
+        ("/World/Empty", "targets no geometry"),
+        ("/World/NotGprim", "is not a gprim"),
+        ("/World/HiddenTarget", "is invisible"),
+    ] {
+        let notes = notes_of(&s, path);
+        assert!(notes.iter().any(|n| n.contains(note)), "{path}: {notes:?}");
+        assert!(s.lights.iter().all(|l| l.path != path));
+    }
+    assert!(s.skipped.iter().all(|k| !k.what.contains("GeometryLight not rendered")), "{:?}", s.skipped);
+}

@@ -89,21 +89,38 @@ impl Importer<'_> {
         m: &DMat4,
         label: &str,
     ) -> Result<(), String> {
-        let (stage, m) = (self.stage, *m);
-        let emission = Emission::read(stage, prim, 1.0)?;
-        lights::unrendered(stage, prim, type_name)?.into_iter().for_each(|n| self.skip(prim, n));
-        if stage.bound_material(prim)?.is_some() {
-            self.skip(prim, "its material is not rendered (a MeshLightAPI mesh emits and reflects nothing)");
+        let light = LightPrim { prim, type_name, world: m };
+        self.emitting_gprim(&light, prim, type_name, m, label)
+    }
+
+    /// The gprim `geometry` of `type_name` under the renderer-frame transform `m` as a light
+    /// with the LightAPI inputs and shaping of `light` (the gprim itself for MeshLightAPI, a
+    /// GeometryLight prim targeting it otherwise), named `label`. Its triangles emit (front
+    /// faces, both sides when the gprim is `doubleSided`); its material is not rendered.
+    pub(super) fn emitting_gprim(
+        &mut self,
+        light: &LightPrim,
+        geometry: &PrimPath,
+        type_name: &str,
+        m: &DMat4,
+        label: &str,
+    ) -> Result<(), String> {
+        let stage = self.stage;
+        let emission = Emission::read(stage, light.prim, 1.0)?;
+        lights::unrendered(stage, light.prim, light.type_name)?.into_iter().for_each(|n| self.skip(light.prim, n));
+        if stage.bound_material(geometry)?.is_some() {
+            self.skip(geometry, "its material is not rendered (a mesh light emits and reflects nothing)");
         }
         let local = if type_name == "Mesh" {
-            crate::mesh::read(stage, prim, None)?
+            crate::mesh::read(stage, geometry, None)?
         } else {
-            shapes::tessellate(stage, prim, type_name)?.unwrap_or_default()
+            shapes::tessellate(stage, geometry, type_name)?.unwrap_or_default()
         };
-        let two_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
-        let built = triangles(&local.positions, &local.triangles, &m, &emission, two_sided);
-        let (shaping, ies) = (shaping::read(stage, prim, &m)?, shaping::read_ies(stage, prim, &m)?);
-        self.add_light(prim, label, type_name, built, Shaped { shaping, ies, texture: None });
+        let two_sided = stage.value(geometry, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
+        let built = triangles(&local.positions, &local.triangles, m, &emission, two_sided);
+        let shaping = shaping::read(stage, light.prim, light.world)?;
+        let ies = shaping::read_ies(stage, light.prim, light.world)?;
+        self.add_light(light.prim, label, light.type_name, built, Shaped { shaping, ies, texture: None });
         Ok(())
     }
 
@@ -125,6 +142,14 @@ impl Importer<'_> {
             Err(note) => self.skip(prim, format!("{type_name} {note}")),
         }
     }
+}
+
+/// The prim whose LightAPI inputs and shaping a light takes, with its type and its
+/// renderer-frame transform (which places its shaping axis).
+pub(super) struct LightPrim<'p> {
+    pub(super) prim: &'p PrimPath,
+    pub(super) type_name: &'p str,
+    pub(super) world: &'p DMat4,
 }
 
 /// What varies a light's emission over its surface or its directions.

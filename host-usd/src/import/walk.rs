@@ -78,6 +78,10 @@ impl Importer<'_> {
                 if stage.applied_schemas(prim).map_err(fail(prim))?.iter().any(|s| s == "MeshLightAPI") {
                     return Ok(self.mesh_light(prim, t).map_err(fail(prim))?);
                 }
+                if !self.light_geometry.is_empty() && self.light_geometry.contains(&prim.to_string()) {
+                    // A GeometryLight met earlier made it a light.
+                    return Ok(());
+                }
                 self.gprim(prim, t, &prim.to_string(), &(self.conversion * world)).map_err(fail(prim))?;
             }
         } else if t == "Camera" {
@@ -100,10 +104,10 @@ impl Importer<'_> {
             self.scene.dome = Some(d);
         } else if crate::lights::KINDS.contains(&t) {
             self.light(prim, t).map_err(fail(prim))?;
+        } else if t == "GeometryLight" {
+            self.geometry_light(prim).map_err(fail(prim))?;
         } else if OTHER_LIGHTS.contains(&t) {
-            let why =
-                if t == "GeometryLight" { " (deprecated by UsdLux: MeshLightAPI on the mesh renders)" } else { "" };
-            self.skip(prim, format!("{t} not rendered{why}"));
+            self.skip(prim, format!("{t} not rendered"));
         } else if SKELETAL.contains(&t) {
             self.skip(prim, format!("{t}: skinning not applied (meshes render in their rest pose)"));
         } else if !STRUCTURE.contains(&t) {

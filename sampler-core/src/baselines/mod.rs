@@ -6,6 +6,7 @@
 //! ([`sis`]: the map as N pre-integrated directional lights) and Lightcuts ([`lightcuts`]: a cut
 //! through a light tree per shading point), both deterministic and biased by design.
 
+mod lightcut_bound;
 mod lightcut_tree;
 pub mod lightcuts;
 pub mod sis;

@@ -10,6 +10,7 @@
 //! that grid once ([`TiltedGrid`]) and each face's integral is then a sum of products.
 
 use super::Shaping;
+use core::cell::Cell;
 use core::f32::consts::{FRAC_PI_2, PI};
 use glam::Vec3;
 
@@ -126,10 +127,13 @@ fn clipped(cos: f32, two_sided: bool) -> f32 {
 }
 
 /// The grid of [`Shaping::tilted_grid_cell`] computed once for the many faces of one light (a
-/// host keeps it): the cells where the emission is not zero.
-#[derive(Clone, Copy, Debug)]
+/// host keeps it): the cells where the emission is not zero, and the last face's sum, which
+/// the next face reuses when it has the same normal and sides (a quad's two triangles, the
+/// faces of a flat panel, a row of like tiles).
+#[derive(Clone, Debug)]
 pub struct TiltedGrid<'a> {
     cells: &'a [(Vec3, Vec3)],
+    last: Cell<Option<(Vec3, bool, Vec3)>>,
 }
 
 impl<'a> TiltedGrid<'a> {
@@ -144,14 +148,26 @@ impl<'a> TiltedGrid<'a> {
                 used += 1;
             }
         }
-        Self { cells: &cells[..used] }
+        Self { cells: &cells[..used], last: Cell::new(None) }
     }
 
     /// [`Shaping::integral_about`] for a profiled shaping whose axis is not `normal`, from the
-    /// grid: the same midpoint sum, without evaluating the profile again.
+    /// grid: the same midpoint sum, without evaluating the profile again (nor the sum, for the
+    /// normal and sides of the face before).
     #[must_use]
     pub fn integral_about(&self, normal: Vec3, two_sided: bool) -> Vec3 {
-        self.cells.iter().fold(Vec3::ZERO, |total, (w, weight)| total + *weight * clipped(w.dot(normal), two_sided))
+        if let Some((n, sides, total)) = self.last.get()
+            && n.to_array().map(f32::to_bits) == normal.to_array().map(f32::to_bits)
+            && sides == two_sided
+        {
+            return total;
+        }
+        let total = self
+            .cells
+            .iter()
+            .fold(Vec3::ZERO, |total, (w, weight)| total + *weight * clipped(w.dot(normal), two_sided));
+        self.last.set(Some((normal, two_sided, total)));
+        total
     }
 }
 
