@@ -136,6 +136,17 @@ impl Asset for io::Cursor<Vec<u8>> {
     fn size(&self) -> io::Result<u64> {
         Ok(self.get_ref().len() as u64)
     }
+
+    /// The bytes from the position on, moved out rather than copied (ppis patch, see
+    /// PATCHED.md): a layer read out of a package is held once, not twice, while it is
+    /// parsed. The cursor is left empty, at its end.
+    fn read_all(&mut self) -> io::Result<Vec<u8>> {
+        let start = (self.position() as usize).min(self.get_ref().len());
+        let mut bytes = std::mem::take(self.get_mut());
+        bytes.drain(..start);
+        self.set_position(0);
+        Ok(bytes)
+    }
 }
 
 /// Interface for resolving asset paths to physical locations.
@@ -408,9 +419,14 @@ impl Resolver for DefaultResolver {
             })?;
 
             let mut archive = open_package_archive(Path::new(&package))?;
+            let package_len = fs::metadata(&package)?.len();
             let mut entry = archive.by_name(&inner).map_err(io::Error::other)?;
 
-            let mut buffer = Vec::new();
+            // Room for the entry as its header sizes it (ppis patch, see PATCHED.md): a
+            // usdz stores its files unpacked, so the buffer is not grown by doubling and
+            // copied. The header is the file's word, so the room is no more than the
+            // package's length; a larger (compressed) entry grows as it is read.
+            let mut buffer = Vec::with_capacity(entry.size().min(package_len) as usize);
             entry.read_to_end(&mut buffer)?;
 
             return Ok(Box::new(io::Cursor::new(buffer)));
@@ -632,6 +648,20 @@ mod tests {
     // -----------------------------------------------------------------------
     // ResolvedPath
     // -----------------------------------------------------------------------
+
+    #[test]
+    fn a_cursor_reads_all_from_its_position_without_a_copy() {
+        let bytes = b"#usda 1.0\n".to_vec();
+        let at = bytes.as_ptr();
+        let mut whole = io::Cursor::new(bytes.clone());
+        let mut moved = io::Cursor::new(bytes);
+        let all = moved.read_all().unwrap();
+        assert_eq!(all, b"#usda 1.0\n");
+        assert_eq!(all.as_ptr(), at, "the buffer is moved, not copied");
+        assert!(moved.read_all().unwrap().is_empty(), "nothing is left to read");
+        whole.set_position(6);
+        assert_eq!(whole.read_all().unwrap(), b"1.0\n");
+    }
 
     #[test]
     fn resolved_path_empty() {

@@ -5,9 +5,10 @@
 //! similar prims holds each prim's common fields once, as a usdc file stores its field
 //! sets once. Lists are equal when their names are and their values are bit for bit:
 //! `0.0` and `-0.0` are kept apart, as every NaN is from every other. Only lists of plain
-//! values (numbers, vectors, matrices, tokens, strings, their arrays and the spec enums)
-//! are shared; a list holding anything else (a dictionary, a list op, time samples) is
-//! left as it is.
+//! values (numbers, vectors, matrices, tokens, strings, their arrays, the spec enums, and
+//! token and path list ops: a prim's `apiSchemas`, a relationship's `targetPaths`, an
+//! attribute's `connectionPaths`) are shared; a list holding anything else (a dictionary,
+//! a reference or payload list op, time samples) is left as it is.
 
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
@@ -17,7 +18,7 @@ use std::sync::Arc;
 use bytemuck::{bytes_of, cast_slice};
 
 use super::fields::{take_field, Field, Fields, List, Split};
-use crate::sdf::Value;
+use crate::sdf::{ListOp, Value};
 use crate::tf::Token;
 
 /// The distinct field lists a reader has finished so far, and the heads (every field but
@@ -133,7 +134,44 @@ enum Content<'a> {
     Text(&'a str),
     Tokens(&'a [Token]),
     Strings(&'a [String]),
+    TokenOp(Op<'a, Token>),
+    PathOp(Op<'a, crate::sdf::Path>),
 }
+
+/// A list op compared item by item, its explicit flag included. Tokens and paths are
+/// equal exactly when their texts are.
+struct Op<'a, T: Default + Clone + PartialEq>(&'a ListOp<T>);
+
+impl<T: Default + Clone + PartialEq> Op<'_, T> {
+    fn lists(&self) -> [&[T]; 6] {
+        let op = self.0;
+        [
+            &op.explicit_items,
+            &op.added_items,
+            &op.prepended_items,
+            &op.appended_items,
+            &op.deleted_items,
+            &op.ordered_items,
+        ]
+    }
+}
+
+impl<T: Default + Clone + PartialEq + Hash> Hash for Op<'_, T> {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.0.explicit.hash(state);
+        for list in self.lists() {
+            list.hash(state);
+        }
+    }
+}
+
+impl<T: Default + Clone + PartialEq> PartialEq for Op<'_, T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.0 == other.0
+    }
+}
+
+impl<T: Default + Clone + Eq> Eq for Op<'_, T> {}
 
 /// The bits of a plain value; `None` for values the table does not share.
 fn bits(value: &Value) -> Option<Bits<'_>> {
@@ -164,6 +202,8 @@ fn bits(value: &Value) -> Option<Bits<'_>> {
         Value::Specifier(v) => Small(*v as u64),
         Value::Permission(v) => Small(*v as u64),
         Value::Variability(v) => Small(*v as u64),
+        Value::TokenListOp(v) => Content::TokenOp(Op(v)),
+        Value::PathListOp(v) => Content::PathOp(Op(v)),
         _ => Bytes(vector_bits(value)?),
     };
     Some((std::mem::discriminant(value), content))
@@ -283,6 +323,36 @@ mod tests {
         assert_eq!(d.get("default"), Some(&Value::Int(2)));
         assert_eq!(d.remove("default"), Some(Value::Int(2)));
         assert_eq!(c.get("default"), Some(&Value::Int(1)));
+    }
+
+    #[test]
+    fn equal_token_and_path_list_ops_are_one_list() {
+        use crate::sdf::{path, ListOp};
+        let mut table = FieldTable::default();
+        let prim = |op: ListOp<Token>| fields(&[("typeName", Value::Token(Token::new("Sphere"))), ("apiSchemas", op.into())]);
+        let binding = ListOp::prepended([Token::new("MaterialBindingAPI")]);
+        let mut lists = [
+            prim(binding.clone()),
+            prim(binding.clone()),
+            prim(ListOp::appended([Token::new("MaterialBindingAPI")])),
+            prim(ListOp::explicit([Token::new("MaterialBindingAPI")])),
+            prim(ListOp::prepended([Token::new("MaterialBindingAPI"), Token::new("LightAPI")])),
+        ];
+        for list in &mut lists {
+            table.share(list);
+        }
+        assert!(lists[0].is_shared_with(&lists[1]));
+        assert_eq!(table.len(), 4, "a different operation or item is a different list");
+
+        let rel = |target: &str| fields(&[("targetPaths", ListOp::explicit([path(target).unwrap()]).into())]);
+        let (mut a, mut b, mut c) = (rel("/Looks/M0"), rel("/Looks/M0"), rel("/Looks/M1"));
+        for list in [&mut a, &mut b, &mut c] {
+            table.share(list);
+        }
+        assert!(a.is_shared_with(&b) && !a.is_shared_with(&c));
+        // An edit copies the shared list.
+        b.set("targetPaths", ListOp::explicit([path("/Looks/M2").unwrap()]).into());
+        assert_eq!(a.get("targetPaths"), Some(&ListOp::explicit([path("/Looks/M0").unwrap()]).into()));
     }
 
     #[test]
