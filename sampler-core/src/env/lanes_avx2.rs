@@ -18,22 +18,17 @@ static EMPTY: [f32; 16] = [0.0; 16];
 
 impl EnvHierarchy<'_> {
     /// Descends `lanes`, each from its own node, two levels at a time while two remain, four
-    /// lanes to a register, as [`warp_down_lanes_scalar`](Self::warp_down_lanes_scalar) would;
-    /// returns false (nothing done) where the CPU lacks AVX2. A last single level is left to
-    /// the scalar lanes.
-    pub(super) fn warp_down_pairs_avx2(&self, lanes: &mut [WarpLane]) -> bool {
+    /// lanes to a register, as [`warp_down_lanes_scalar`](Self::warp_down_lanes_scalar) would
+    /// (a black map's lanes die at their first step, there as here); nothing where the CPU
+    /// lacks AVX2. A last single level is left to the scalar lanes.
+    pub(super) fn warp_down_pairs_avx2(&self, lanes: &mut [WarpLane]) {
         if !crate::cpu::has_avx2() {
-            return false;
-        }
-        if self.is_black() {
-            lanes.iter_mut().for_each(|l| l.alive = false);
-            return true;
+            return;
         }
         for eight in lanes.chunks_mut(8) {
             // SAFETY: AVX2 is available (checked above).
             unsafe { self.descend_x8(eight) };
         }
-        true
     }
 
     /// Up to eight lanes down to the last even step above the finest level, as two groups of
@@ -349,7 +344,7 @@ mod tests {
     use std::vec::Vec;
 
     /// Maps with every kind of mass: smooth, zeros in rows and columns, a 1e7× texel, a
-    /// denormal-sized one.
+    /// denormal-sized one, a single texel, none.
     fn maps(level: u32) -> Vec<Vec<[f32; 3]>> {
         let n = 1usize << (2 * level);
         let smooth: Vec<[f32; 3]> = (0..n).map(|i| [(i * 7 % 13) as f32 + 0.5, (i % 3) as f32, 1.0]).collect();
@@ -360,7 +355,7 @@ mod tests {
         sun[n / 2] = [1e-38; 3];
         let mut lone = vec![[0.0f32; 3]; n];
         lone[n - 1] = [2.0; 3];
-        vec![smooth, holes, sun, lone]
+        vec![smooth, holes, sun, lone, vec![[0.0f32; 3]; n]]
     }
 
     #[test]
