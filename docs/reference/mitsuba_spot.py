@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Mitsuba 3's `spot` emitter against UsdLux ShapingAPI's cone, the formula
-`sampler-core/tests/light_shaping.rs` holds ppis's shaped point light to.
+`sampler-core/tests/integration/light_shaping.rs` holds ppis's shaped point light to.
 
     pip install mitsuba
     python3 docs/reference/mitsuba_spot.py

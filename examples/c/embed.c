@@ -7,7 +7,7 @@
  *   cc -std=c99 -O2 -Wall -Wextra -pedantic examples/c/embed.c -Isampler-capi/include \
  *      target/release/libsampler_capi.a -lm -lpthread -ldl -o embed && ./embed
  *
- * It prints the first samples of each sampler as hex floats (sampler-capi/tests/examples.rs
+ * It prints the first samples of each sampler as hex floats (sampler-capi/tests/integration/examples.rs
  * compares them bit for bit with the Rust API) and exits 1 when the estimate misses. Every
  * object lives in memory this program owns; nothing is freed by the library. */
 #include "ppis.h"

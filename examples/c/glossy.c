@@ -9,7 +9,7 @@
  *   cc -std=c99 -O2 -Wall -Wextra -pedantic examples/c/glossy.c -Isampler-capi/include \
  *      target/release/libsampler_capi.a -lm -lpthread -ldl -o glossy && ./glossy
  *
- * `./glossy --quick` runs a small version in a second (sampler-capi/tests/examples.rs runs it).
+ * `./glossy --quick` runs a small version in a second (sampler-capi/tests/integration/examples.rs runs it).
  * Each method's errors must average out to zero against the reference (a z-test over every
  * shading point and run): the program prints FAIL and exits 1 when one does not. */
 #define _POSIX_C_SOURCE 199309L

@@ -7,7 +7,7 @@
 //   c++ -std=c++17 -O2 -Wall -Wextra -pedantic examples/cpp/embed.cpp -Isampler-capi/include
 //       target/release/libsampler_capi.a -lpthread -ldl -o embed_cpp && ./embed_cpp
 //
-// It prints the first samples as hex floats (sampler-capi/tests/examples.rs compares them bit
+// It prints the first samples as hex floats (sampler-capi/tests/integration/examples.rs compares them bit
 // for bit with the Rust API) and exits 1 when the estimate misses.
 #include "ppis.h"
 

@@ -7,7 +7,7 @@
 //!
 //! Pixar's `UsdLuxBlackbodyTemperatureAsRgb` normalises to unit luminance only, so its 6500 K
 //! is slightly off white; the two agree on every other temperature up to that one per-channel
-//! factor (`host-usd/tests/lights.rs` compares them).
+//! factor (`host-usd/tests/integration/lights.rs` compares them).
 
 use glam::DVec3;
 

@@ -33,7 +33,7 @@ use heapless::Vec;
 
 /// Prior count α of the add-α smoothing that gives empty leaves their B̃ (see
 /// `TreeBuilder::node`): the best value on every non-needle case of the efficiency set
-/// (tests/efficiency.rs; docs/perf.md#per-sample-variance).
+/// (tests/integration/efficiency.rs; docs/perf.md#per-sample-variance).
 pub const FILL_PRIOR: f32 = 2.0;
 
 /// Samples in a parent from which an empty child's B̃ also looks at B at its centre.

@@ -5,9 +5,7 @@
 //! gives, in every channel (the tint makes them differ); and the light tree's bounds of a
 //! shaped light never cull a point the light reaches.
 
-mod common;
-
-use common::integrate_cone_jittered;
+use crate::common::integrate_cone_jittered;
 use glam::{Vec2, Vec3};
 use sampler_core::light::{DiskLight, Light, LightBounds, PointLight, RectLight, SceneLight, Shaping, SphereLight};
 use sampler_core::rng::Pcg32;

@@ -1,9 +1,7 @@
 //! Two-stage importance sampling (the paper's baseline): χ² against its own pdf, the pdf
 //! integrates to 1, the estimator matches quadrature, and it never allocates beyond the SAT.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::luminance;

@@ -5,11 +5,10 @@
 //! for unbiased estimators, so each estimator draws from its own stream: one stream shared by
 //! all would tie their excursions together.
 
-mod common;
 #[path = "estimators/units.rs"]
 mod units;
 
-use common::*;
+use crate::common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, luminance};

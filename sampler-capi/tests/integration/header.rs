@@ -1,5 +1,5 @@
 //! `include/ppis.h` is what cbindgen makes of the sources: CI fails when it is stale.
-//! `PPIS_BLESS=1 cargo test -p sampler-capi --test header` rewrites it.
+//! `PPIS_BLESS=1 cargo test -p sampler-capi --test integration header` rewrites it.
 
 use std::path::Path;
 
@@ -22,6 +22,6 @@ fn the_checked_in_header_is_current() {
     let checked_in = std::fs::read(&path).unwrap_or_default();
     assert!(
         checked_in == generated,
-        "sampler-capi/include/ppis.h is stale: run `PPIS_BLESS=1 cargo test -p sampler-capi --test header`"
+        "sampler-capi/include/ppis.h is stale: run `PPIS_BLESS=1 cargo test -p sampler-capi --test integration header`"
     );
 }

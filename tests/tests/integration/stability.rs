@@ -1,9 +1,7 @@
 //! End-to-end stability on extreme inputs: every method renders without
 //! panic and without a non-finite value, and where the answer is analytic it is met.
 
-mod common;
-
-use common::{env_from, materials, sphere_scene};
+use crate::common::{env_from, materials, sphere_scene};
 use glam::Vec3;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;

@@ -5,9 +5,7 @@
 //! (light samples alone on the wide lobes) — within 4 standard errors plus the quadrature's error. With several lights picked by power the
 //! pair still averages to the sum of their quadratures; a delta light is estimated exactly.
 
-mod common;
-
-use common::{integrate_cone_jittered, light_cases};
+use crate::common::{integrate_cone_jittered, light_cases};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, RoughConductor};
 use sampler_core::estimator::ShadingPoint;

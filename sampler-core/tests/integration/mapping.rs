@@ -1,8 +1,6 @@
 //! Equal-area mapping: round trips, equal areas, continuity across the square's edges, and the
 //! batched form against the scalar one.
 
-mod common;
-
 use glam::{Vec2, Vec3};
 use proptest::prelude::*;
 use sampler_core::mapping::*;

@@ -8,9 +8,7 @@
 //!   (f/p ≈ const) and no defensive product sampler can match it; MIS with BRDF sampling must
 //!   recover at least 3× of the gap. Hosts pick BRDF sampling there (the `auto` method).
 
-mod common;
-
-use common::TestEnv;
+use crate::common::TestEnv;
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};

@@ -4,9 +4,7 @@
 //! cannot be made says why. (The shared estimator harness in `estimators.rs` covers occluders
 //! and the other lobes.)
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{DVec2, DVec3, Mat3, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, BrdfSample, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::cone::{Cone, build_cell_cones, cell_count, morton_cell};

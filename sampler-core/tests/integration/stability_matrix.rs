@@ -15,9 +15,7 @@
 //!   direction, for an estimator that merely missed it). They are asserted one-sided — a missed rare event makes the mean
 //!   low, never high: mean ≤ reference + 3 SE — and their z is recorded.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::env::{EnvHierarchy, luminance};

@@ -6,9 +6,7 @@
 //! then inherits B̃ = 0. Without the defensive mixture the estimate is visibly biased; with it,
 //! it matches quadrature.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, BrdfSample};
 use sampler_core::env::luminance;

@@ -4,8 +4,7 @@
 //! matte studio where it measures twice as good as the rules' MIS; two-level-MIS measured only
 //! where enough samples share its build per shading point, and not chosen where it scores worse.
 
-mod common;
-
+use crate::common;
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::Method;
 use host_std::plan::pilot;

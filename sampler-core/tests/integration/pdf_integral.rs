@@ -1,8 +1,6 @@
 //! Every sampler's pdf integrates to 1 over the sphere within 1e-3.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::frame::Frame;

@@ -3,8 +3,7 @@
 //! whose pixels depend on the tile's earlier pixels through the product-MIS samplers they keep —
 //! and `auto`'s pilot decides from the whole frame whichever crop is rendered.
 
-mod common;
-
+use crate::common;
 use host_std::light::environment::Environment;
 use host_std::plan::{Method, Rendered, Settings, render, render_crop};
 use host_std::render::brdf_samples::BrdfSamples;

@@ -2,9 +2,7 @@
 //! random and sunny environments, every built-in BRDF, near-normal and grazing views.
 //! Also checks that the pdf returned with a sample equals `pdf(ω)`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::frame::Frame;

@@ -3,9 +3,8 @@
 //! env-only sampler and a product, alone, in pairs and with a split budget — and asks for a
 //! shadow ray exactly where they ask for visibility.
 
-mod common;
-
-use common::TestEnv;
+use crate::common;
+use crate::common::TestEnv;
 use glam::{DVec2, DVec3, Vec3};
 use sampler_core::brdf::Brdf;
 use sampler_core::direction::DirectionSampler;

@@ -6,9 +6,7 @@
 //! included; profiled area lights keep their unshaped densities and estimate what quadrature of
 //! `eval` gives; the tree's bounds never cull a point the light reaches.
 
-mod common;
-
-use common::integrate_cone_jittered;
+use crate::common::integrate_cone_jittered;
 use glam::{Vec2, Vec3};
 use sampler_core::light::{
     DiskLight, IntensityProfile, Light, LightBounds, PointLight, RectLight, SceneLight, Shaping, SphereLight,

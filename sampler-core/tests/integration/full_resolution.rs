@@ -1,8 +1,6 @@
 //! The paper's point is full-resolution lighting: a 4096² map (16.7 M texels) with a one-texel
 //! sun of 1e6× the sky is sampled exactly — env-only and product — down to the texel.
 
-mod common;
-
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::RoughConductor;
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};

@@ -2,9 +2,7 @@
 //! polar chart about the light), the pdf integrates to 1 over the directions that reach the
 //! light, and the pdf returned with a sample is the one `pdf(p, ω)` gives.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::Vec3;
 use sampler_core::light::Light;
 

@@ -6,14 +6,13 @@
 //! here; then run
 //!
 //! ```text
-//! cargo test --release -p host-std --test image_hashes -- --nocapture
+//! cargo test --release -p host-std --test integration image_hashes -- --nocapture
 //! ```
 //!
 //! and replace [`EXPECTED`] with the table the failure prints, saying in the commit why the
 //! images changed.
 
-mod common;
-
+use crate::common;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Rendered, Settings, render};
@@ -147,7 +146,7 @@ fn images_are_bit_identical_to_the_recorded_hashes() {
     assert!(
         actual == expected,
         "the rendered images differ from the recorded ones. If that is meant (the commit says \
-         why), replace EXPECTED in host-std/tests/image_hashes.rs with:\n\
+         why), replace EXPECTED in host-std/tests/integration/image_hashes.rs with:\n\
          const EXPECTED: &[(&str, u64)] = &[\n{table}];"
     );
 }

@@ -1,8 +1,6 @@
 //! Same inputs and seed → bit-identical samples; different seeds → different samples.
 
-mod common;
-
-use common::TestEnv;
+use crate::common::TestEnv;
 use glam::{DVec2, Vec3};
 use sampler_core::brdf::CarPaint;
 use sampler_core::frame::Frame;

@@ -4,9 +4,8 @@
 //! six batches of `estimator::BATCH`, the last one partial, and more than the 64 an older
 //! version took at most).
 
-mod common;
-
-use common::TestEnv;
+use crate::common;
+use crate::common::TestEnv;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::estimator::{self, Contribution, ShadingPoint};
 use sampler_core::frame::Frame;

@@ -5,9 +5,7 @@
 //! below the horizon, jittered quadrature of what rays see (`eval`), within 4 standard errors
 //! plus the quadrature's error. Near and far, face-on and grazing.
 
-mod common;
-
-use common::integrate_cone_jittered;
+use crate::common::integrate_cone_jittered;
 use glam::{DVec3, Vec2, Vec3};
 use sampler_core::light::{
     DiskLight, DistantLight, Light, PointLight, RectLight, SceneLight, SphereLight, TriangleLight, TriangleSampling,
