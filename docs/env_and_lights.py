@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Equal CPU time on a scene with an environment and other lights (docs/perf.md, "An
 environment and a sun at equal time"): every environment method, the sun by its cone or in the
-map (`--distant-carrier cone|map`; `auto` chooses between them per scene), and the lights' share of each shading point's budget, in one table.
+map (`--distant-carrier cone|map`; `auto` chooses between them per scene), and the lights' share
+of each shading point's budget, in one table.
 
   python3 docs/env_and_lights.py --out DIR [--size 128] [--shares 0.25,0.5,0.75] [--ppis target/release/ppis] SCENE.json
 
