@@ -1,17 +1,19 @@
 #!/usr/bin/env python3
 """Equal CPU time on a scene with an environment and other lights (docs/perf.md, "An
 environment and a sun at equal time"): every environment method, the sun by its cone or in the
-map, and the lights' share of each shading point's budget, in one table.
+map (`--distant-carrier cone|map`; `auto` chooses between them per scene), and the lights' share
+of each shading point's budget, in one table.
 
   python3 docs/env_and_lights.py --out DIR [--size 128] [--shares 0.25,0.5,0.75] [--ppis target/release/ppis] SCENE.json
 
-Renders two converged references with MIS (8192 spp, 1024 shading points, seed 777): the scene
-as written, and with `--distant-in-env` (a sun rasterised into the map is a slightly different
+Renders two converged references with MIS (8192 spp, 1024 shading points, seed 777): the sun by
+its cone, and with `--distant-carrier map` (a sun rasterised into the map is a slightly different
 light, so those variants are measured against their own). Then one `ppis report` per variant
 (`--clock cpu --bracket --base mis`, 64/256/1024 spp, 2048 too but for `cone`):
 
-- `cone`: mis, product-mis, auto, sis, lightcuts, the sun (every light) by the lights' estimator;
-- `map`: mis, product-mis, auto with `--distant-in-env` (only where the scene has a distant light
+- `cone`: mis, product-mis, auto, sis, lightcuts, the sun (every light) by the lights' estimator
+  (`--distant-carrier cone`, as every variant but `map`);
+- `map`: mis, product-mis, auto with `--distant-carrier map` (only where the scene has a distant light
   with an angle);
 - `share-S`: mis and product-mis at 16 visibility samples per shading point with
   `--light-share S` for S in --shares (default ¼, ½, ¾; at the default four per point the split is
@@ -45,13 +47,14 @@ def has_sun(scene):
 
 def variants(has_distant, shares, per_point, cone_methods):
     """(name, methods, extra flags, uses the map reference)."""
-    out = [('cone', cone_methods, [], False)]
+    cone = ['--distant-carrier', 'cone']
+    out = [('cone', cone_methods, cone, False)]
     if has_distant:
-        out.append(('map', 'mis,product-mis,auto', ['--distant-in-env'], True))
+        out.append(('map', 'mis,product-mis,auto', ['--distant-carrier', 'map'], True))
     for s in shares:
-        out.append(('share-' + s, 'mis,product-mis', ['--samples-per-point', '16', '--light-share', s], False))
+        out.append(('share-' + s, 'mis,product-mis', cone + ['--samples-per-point', '16', '--light-share', s], False))
     for v in per_point:
-        out.append(('points-' + v, 'mis,product-mis,auto', ['--samples-per-point', v], False))
+        out.append(('points-' + v, 'mis,product-mis,auto', cone + ['--samples-per-point', v], False))
     return out
 
 
@@ -105,7 +108,7 @@ def main():
         if (in_map and not sun) or os.path.exists(path):
             continue
         run([a.ppis, 'render', a.scene, '--method', 'mis', '--spp', '8192', '--shading-points', '1024',
-             '--seed', '777', '-o', path] + size + (['--distant-in-env'] if in_map else []))
+             '--seed', '777', '-o', path] + size + ['--distant-carrier', 'map' if in_map else 'cone'])
     curves = {}
     for name, methods, flags, in_map in variants(sun, listed(a.shares), listed(a.per_point), a.cone_methods):
         folder = os.path.join(a.out, name)

@@ -15,7 +15,8 @@ DIR: tri{10,100,1000,10000}.json (that many small emissive triangles facing a fl
 spheres), pt1000.json (1000 point lights) and both.json (10 000 triangles and 1000 point lights).
 With `--many-scaling DIR`, area{10,100,1000,10000}.json (the emitting area and power of tri1000
 split into that many triangles: the same coverage of the sky at every count) and
-points{10,100,1000,10000}.json (that many point lights of pt1000's total power).
+points{10,100,1000,10000}.json (that many point lights of pt1000's total power) and
+flat{10,100,1000,10000}.json (area{N}'s triangles, all 2.25 above the floor).
 """
 import json
 import math
@@ -90,15 +91,16 @@ def write(name, scene):
         f.write("\n")
 
 
-def many(out, n_tri, n_point, name, side=0.15, point_intensity=(0.3, 0.3, 0.4)):
-    """A floor with 20 spheres under n_tri emissive triangles (`side` wide, facing down, 1.5–3
-    above it) and n_point point lights, all scattered over 20×20."""
+def many(out, n_tri, n_point, name, side=0.15, point_intensity=(0.3, 0.3, 0.4), heights=(1.5, 3.0)):
+    """A floor with 20 spheres under n_tri emissive triangles (`side` wide, facing down, at
+    `heights` above it: a layer 1.5 deep by default) and n_point point lights, all scattered
+    over 20×20."""
     random.seed(1)
     lights = []
     if n_tri:
         with open(os.path.join(out, name + ".obj"), "w") as f:
             for i in range(n_tri):
-                x, z, y, s = random.uniform(-10, 10), random.uniform(-10, 10), random.uniform(1.5, 3.0), side
+                x, z, y, s = random.uniform(-10, 10), random.uniform(-10, 10), random.uniform(*heights), side
                 f.write(f"v {x} {y} {z}\nv {x + s} {y} {z}\nv {x} {y} {z + s}\nf {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
         lights.append({"type": "mesh", "file": name + ".obj", "radiance": [20, 18, 15]})
     for _ in range(n_point):
@@ -132,6 +134,8 @@ def main():
         for n in [10, 100, 1000, 10000]:
             many(sys.argv[2], n, 0, f"area{n}", side=0.15 * math.sqrt(1000 / n))
             many(sys.argv[2], 0, n, f"points{n}", point_intensity=[c * 1000 / n for c in (0.3, 0.3, 0.4)])
+            # The same triangles in one plane (a ceiling of tiles) instead of a layer 1.5 deep.
+            many(sys.argv[2], n, 0, f"flat{n}", side=0.15 * math.sqrt(1000 / n), heights=(2.25, 2.25))
         return
     os.makedirs(os.path.join(HERE, "meshes"), exist_ok=True)
     torus(os.path.join(HERE, "meshes", "torus_lamp.obj"))

@@ -5,6 +5,7 @@
 
 pub mod budget;
 pub mod candidates;
+pub mod carrier;
 mod decision;
 pub mod method;
 pub mod pilot;

@@ -54,6 +54,9 @@ fn bad_input_fails_cleanly() {
     fails(dir, &["render", "--method", "lightcuts", "--lightcut-error", "0"], "--lightcut-error");
     fails(dir, &["render", "--method", "lightcuts", "--lightcut-error=-0.1"], "--lightcut-error");
     fails(dir, &["report", "--methods", "sis", "--sis-lights=-3"], "--sis-lights");
+    // The sun's carrier.
+    fails(dir, &["render", "--distant-carrier", "sky"], "sky");
+    fails(dir, &["render", "--distant-carrier", "cone", "--distant-in-env"], "--distant-in-env");
     // A K above the largest arena names both; no silent clamp.
     fails(
         dir,
@@ -202,6 +205,34 @@ fn the_same_seed_writes_the_same_files_at_any_thread_count() {
             assert!(one == other, "{ext}: 1 and {threads} threads wrote different files");
         }
     }
+}
+
+#[test]
+fn a_suns_carrier_is_measured_once_and_the_same_at_any_thread_count() {
+    let tmp = scratch("carrier");
+    let dir = tmp.path();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes/sun_env.json");
+    let render = |threads: &str, carrier: &str| {
+        let out = ppis()
+            .current_dir(dir)
+            .arg("render")
+            .arg(&scene)
+            .args(["--width", "40", "--height", "24", "--spp", "8", "--threads", threads])
+            .args(["--distant-carrier", carrier, "-o"])
+            .arg(format!("{carrier}{threads}.exr"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{stderr}");
+        (std::fs::read(dir.join(format!("{carrier}{threads}.exr"))).unwrap(), stderr)
+    };
+    let (one, said) = render("1", "auto");
+    assert_eq!(said.matches("ppis: distant light: ").count(), 1, "{said}");
+    assert!(one == render("2", "auto").0, "the pilot's choice and the image do not depend on threads");
+    let (cone, map) = (render("1", "cone"), render("1", "map"));
+    assert!(!cone.1.contains("distant light:") && cone.0 != map.0, "a given carrier runs no pilot");
+    let chosen = if said.contains("carried by the environment map") { &map.0 } else { &cone.0 };
+    assert!(one == *chosen, "auto renders the image of the carrier it names");
 }
 
 /// Runs `ppis report` on a tiny image (24×14, 2 samples per shading point, a 16-spp rendered

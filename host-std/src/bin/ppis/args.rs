@@ -3,6 +3,7 @@
 use clap::Args;
 use host_std::light::lights::{LightOptions, LightSelection};
 use host_std::plan::Method;
+use host_std::plan::carrier::Carrier;
 use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::Scene;
 use std::path::PathBuf;
@@ -87,10 +88,14 @@ pub(crate) struct SamplingArgs {
     /// samples spent on the other lights, in (0, 1).
     #[arg(long, value_name = "SHARE", default_value_t = 0.5, value_parser = parse_share)]
     pub(crate) light_share: f64,
-    /// Rasterise distant lights with an angular size (the sun) into the environment map, so
-    /// that the map's samplers (the product among them) sample them, instead of sampling each
-    /// by its cone; needs an environment.
-    #[arg(long)]
+    /// Where the scene has an environment, how a distant light with an angular size (the sun)
+    /// is sampled: `cone` (by its cone, MIS with BRDF samples), `map` (rasterised into the
+    /// environment map, so that the map's samplers, the product among them, sample it) or
+    /// `auto` (whichever a pilot render of the scene measures better).
+    #[arg(long, value_enum, value_name = "cone|map|auto", default_value = "auto")]
+    pub(crate) distant_carrier: Carrier,
+    /// Short for `--distant-carrier map`.
+    #[arg(long, conflicts_with = "distant_carrier")]
     pub(crate) distant_in_env: bool,
     /// `--method sis`: the strata (directional lights) the environment is stratified into
     /// (the paper's 300 by default), each shaded at every shading point.
@@ -145,6 +150,11 @@ impl SamplingArgs {
             sis_lights: self.sis_lights,
             lightcut_error: self.lightcut_error,
         }
+    }
+
+    /// `--distant-carrier`, `--distant-in-env` read as `map`.
+    pub(crate) fn carrier(&self) -> Carrier {
+        if self.distant_in_env { Carrier::Map } else { self.distant_carrier }
     }
 
     /// --width and --height, as given.

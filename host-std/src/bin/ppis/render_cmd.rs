@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::output;
+use host_std::plan::carrier::{self, Carrier, CarrierChoice};
 use host_std::plan::method::Lighting;
 use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
 use host_std::render::crop::Crop;
@@ -83,28 +84,34 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let threads = args.sampling.threads();
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
-    let prepared = prepare(&args, &pool)?;
-    let lighting = Lighting::of(prepared.environment.is_some(), prepared.scene.lights.len());
-    let shading_points = match args.sampling.shading_points {
-        Some(p) => p,
-        None => ShadingPoints::Rule.resolve(args.method, args.spp as usize, lighting) as u32,
-    };
-    let settings = Settings {
+    let mut prepared = prepare(&args, &pool)?;
+    let mut settings = Settings {
         method: args.method,
         spp: args.spp as usize,
-        shading_points: shading_points as usize,
+        shading_points: 1,
         brdf_samples,
         seed: args.sampling.seed,
         progress: true,
         shadows: !args.sampling.unshadowed,
         lights: args.sampling.lights(),
     };
+    let points = args.sampling.shading_points.map_or(ShadingPoints::Rule, |p| ShadingPoints::Given(p as usize));
+    let carrier = pool.install(|| carry_distant_lights(args.sampling.carrier(), &mut prepared, &settings, points));
+    let lighting = Lighting::of(prepared.environment.is_some(), prepared.scene.lights.len());
+    let shading_points = points.resolve(args.method, args.spp as usize, lighting) as u32;
+    settings.shading_points = shading_points as usize;
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
     let record = provenance::settings_text(&args, &settings, frame, &prepared.files)?;
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
-    let image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
+    let mut image =
+        pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
+    if let Some(c) = &carrier {
+        // The pilot is part of the render's cost.
+        image.render_seconds += c.seconds;
+        image.render_cpu_seconds = image.render_cpu_seconds.zip(c.cpu_seconds).map(|(r, p)| r + p);
+    }
 
     output::write_exr_part(&exr_path, frame, crop, &image.pixels, Some(&record))?;
     output::write_png(&png_path, image.width, image.height, &image.pixels)?;
@@ -127,6 +134,16 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         exr_path.display(),
         png_path.display()
     );
+    if let Some(c) = &carrier {
+        eprintln!(
+            "ppis: distant light: {} (pilot of {} pixels: variance × cost {:.3e} by its cone, {:.3e} in the map; {:.2} s)",
+            if c.carrier == Carrier::Map { "carried by the environment map" } else { "sampled by its cone" },
+            c.pixels,
+            c.scores[0],
+            c.scores[1],
+            c.seconds
+        );
+    }
     report_pilot(&prepared.scene, &image);
     if image.non_finite > 0 {
         eprintln!("ppis: warning: {} pixels were not finite and were written as 0", image.non_finite);
@@ -169,15 +186,10 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
     };
     let load_seconds = t_load.elapsed().as_secs_f64();
     let cpu_loaded = cpu();
-    let mut environment = match &scene.env {
+    let environment = match &scene.env {
         Some((source, placement)) => Some(pool.install(|| Environment::build(source, *placement))?),
         None => None,
     };
-    if args.sampling.distant_in_env
-        && let Some(env) = environment.as_mut()
-    {
-        host_std::light::move_distant_lights(&mut scene.lights, env);
-    }
     let cpu_env = cpu();
     let t_bvh = Instant::now();
     let bvh = pool.install(|| Bvh::build(&scene));
@@ -195,6 +207,23 @@ fn prepare(args: &RenderArgs, pool: &rayon::ThreadPool) -> Result<Prepared> {
         );
     }
     Ok(Prepared { scene, environment, bvh, load_seconds, bvh_seconds, crop, files, cpu_seconds })
+}
+
+/// Applies `--distant-carrier` to the prepared scene (a chosen or measured `map` moves its wide
+/// distant lights into the environment); returns what `auto`'s pilot measured, where it ran.
+fn carry_distant_lights(
+    carrier: Carrier,
+    prepared: &mut Prepared,
+    settings: &Settings,
+    points: ShadingPoints,
+) -> Option<CarrierChoice> {
+    let env = prepared.environment.as_mut()?;
+    let choice = match carrier {
+        Carrier::Auto => carrier::choose(&prepared.scene, &prepared.bvh, env, settings, points),
+        _ => None,
+    };
+    carrier::apply(choice.map_or(carrier, |c| c.carrier), &mut prepared.scene.lights, env);
+    choice
 }
 
 /// One line per material `auto`'s pilot measured.

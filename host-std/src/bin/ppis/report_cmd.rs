@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
+use host_std::plan::carrier::Carrier;
 use host_std::plan::method::Lighting;
 use host_std::plan::{self, Settings, ShadingPoints};
 use host_std::render::brdf_samples::BrdfSamples;
@@ -113,18 +114,16 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         Some((source, placement)) => Some(Environment::build(source, *placement)?),
         None => None,
     };
-    if args.sampling.distant_in_env
-        && let Some(env) = environment.as_mut()
-    {
-        host_std::light::move_distant_lights(&mut scene.lights, env);
-    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the output folder", args.out.display()))?;
     let bvh = Bvh::build(&scene);
-    let hierarchy = environment.as_ref().map(Environment::hierarchy);
     let threads = args.sampling.threads();
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")?;
+    if let Some(env) = environment.as_mut() {
+        carry_distant_lights(&args, &mut scene, &bvh, env, render_k, &pool);
+    }
+    let hierarchy = environment.as_ref().map(Environment::hierarchy);
     let base = Settings {
         method: Method::Product,
         spp: 1,
@@ -176,6 +175,44 @@ pub(crate) fn report_command(args: ReportArgs) -> Result<()> {
         write_k_sweep(&args, &scene.name, &measurements, reference_k, threads, &note)?;
     }
     Ok(())
+}
+
+/// Applies `--distant-carrier` once for the whole report: `auto` measures it for the first
+/// method at the largest spp (its pilot's time is not in the series' times).
+fn carry_distant_lights(
+    args: &ReportArgs,
+    scene: &mut Scene,
+    bvh: &Bvh,
+    env: &mut Environment,
+    brdf_samples: BrdfSamples,
+    pool: &rayon::ThreadPool,
+) {
+    let mut carrier = args.sampling.carrier();
+    if carrier == Carrier::Auto {
+        let settings = Settings {
+            method: args.methods[0],
+            spp: args.spp.iter().copied().max().unwrap_or(1) as usize,
+            shading_points: 1,
+            brdf_samples,
+            seed: args.sampling.seed,
+            progress: false,
+            shadows: !args.sampling.unshadowed,
+            lights: args.sampling.lights(),
+        };
+        let choice = pool.install(|| plan::carrier::choose(scene, bvh, env, &settings, shading_points(args)));
+        if let Some(c) = choice {
+            eprintln!(
+                "ppis: distant light: {} for every series ({} at {} spp: variance × cost {:.3e} by its cone, {:.3e} in the map)",
+                if c.carrier == Carrier::Map { "carried by the environment map" } else { "sampled by its cone" },
+                settings.method,
+                settings.spp,
+                c.scores[0],
+                c.scores[1]
+            );
+            carrier = c.carrier;
+        }
+    }
+    plan::carrier::apply(carrier, &mut scene.lights, env);
 }
 
 /// Renders the reference (`--reference-method` at `--reference-spp`, an independent seed),
