@@ -124,11 +124,21 @@ pub trait Asset: Read + Seek + Send {
         self.read_to_end(&mut buf)?;
         Ok(buf)
     }
+
+    /// The file the asset reads, if it is one (ppis patch, see PATCHED.md): a reader may
+    /// map it rather than read it.
+    fn as_file(&self) -> Option<&fs::File> {
+        None
+    }
 }
 
 impl Asset for fs::File {
     fn size(&self) -> io::Result<u64> {
         self.metadata().map(|m| m.len())
+    }
+
+    fn as_file(&self) -> Option<&fs::File> {
+        Some(self)
     }
 }
 

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
+#[cfg(unix)]
+mod mapped;
 mod names;
 pub mod parser;
 pub mod token;
@@ -62,7 +64,15 @@ impl sdf::FileFormat for UsdaFileFormat {
     }
 
     fn read(&self, resolver: &dyn ar::Resolver, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
-        let bytes = resolver.open_asset(resolved)?.read_all()?;
+        let mut asset = resolver.open_asset(resolved)?;
+        #[cfg(unix)]
+        if let Some(map) = asset.as_file().map(mapped::MappedText::map).transpose()?.flatten() {
+            let text = map.text()?;
+            let release = |offset: usize| map.release_before(offset);
+            let mut parser = Parser::with_release(text, &release);
+            return Ok(Box::new(parse_on_own_stack(&mut parser).context("failed to parse USDA layer")?));
+        }
+        let bytes = asset.read_all()?;
         let text = String::from_utf8(bytes).context("layer is not valid UTF-8")?;
         Ok(Box::new(parse(&text).context("failed to parse USDA layer")?))
     }

@@ -32,6 +32,10 @@ pub const MAX_NESTING: usize = 2 * MAX_NAMESPACE_DEPTH;
 /// committed: only the pages a deep file touches are used.
 pub const PARSER_STACK_BYTES: usize = 64 << 20;
 
+/// The text a parser made [`Parser::with_release`] gives back behind itself at a time
+/// (ppis patch): fewer, larger calls cost less, and this much of the passed text stays.
+pub const RELEASE_STEP: usize = 1 << 20;
+
 pub struct Parser<'a> {
     iter: Peekable<logos::SpannedIter<'a, Token<'a>>>,
     source: &'a str,
@@ -43,6 +47,11 @@ pub struct Parser<'a> {
     /// The distinct field lists of the specs read so far (ppis patch, see
     /// [`sdf::FieldTable`]): each finished prim's specs share the equal lists of earlier ones.
     fields: sdf::FieldTable,
+    /// Gives back the source's text before an offset the parser has passed (ppis patch,
+    /// see [`Parser::with_release`]).
+    release: Option<&'a (dyn Fn(usize) + Sync)>,
+    /// The token offset at which the text behind is next given back.
+    next_release: usize,
 }
 
 /// A path for an error message: long ones keep their start and end.
@@ -84,7 +93,30 @@ impl<'a> Parser<'a> {
             depth: 0,
             names: HashMap::new(),
             fields: sdf::FieldTable::default(),
+            release: None,
+            next_release: usize::MAX,
         }
+    }
+
+    /// A parser that calls `release(offset)` as it passes the source's text, each
+    /// [`RELEASE_STEP`] bytes, with an offset a step behind the token it reads: the text
+    /// before that offset is not needed for parsing (a slice of it the parser keeps may
+    /// still be read). A mapped file gives those pages back ([`super::mapped`]).
+    pub fn with_release(data: &'a str, release: &'a (dyn Fn(usize) + Sync)) -> Self {
+        Self {
+            release: Some(release),
+            next_release: 2 * RELEASE_STEP,
+            ..Self::new(data)
+        }
+    }
+
+    /// Gives back the text a step behind `offset`; the next call comes a step later.
+    #[cold]
+    fn release_passed(&mut self, offset: usize) {
+        if let Some(release) = self.release {
+            release(offset - RELEASE_STEP);
+        }
+        self.next_release = offset + RELEASE_STEP;
     }
 
     /// Returns a highlight for the most recent token span processed by the parser.
@@ -152,6 +184,9 @@ impl<'a> Parser<'a> {
     #[inline]
     fn fetch_next(&mut self) -> Result<Token<'a>> {
         let (token, span) = self.iter.next().context("Unexpected end of tokens")?;
+        if span.start >= self.next_release {
+            self.release_passed(span.start);
+        }
         self.last_span = Some(span);
         token.map_err(|e| anyhow!("Logos error: {e:?}"))
     }

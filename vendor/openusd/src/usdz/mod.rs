@@ -56,13 +56,8 @@ impl sdf::FileFormat for UsdzFileFormat {
         // A package that cannot be opened, or that lists no default layer, falls
         // back to the bare package path so `read` surfaces the precise zip/parse
         // error, rather than being demoted to an unresolved (missing) asset.
-        //
-        // TODO(perf): `from_asset` slurps the whole package into memory only to
-        // list its central directory (`first_layer_name`), and `read` then reads
-        // it again to extract the anchored layer. The resolver's asset is `Seek`,
-        // so a `ZipArchive` could read just the central directory here (as
-        // `ar::open_package_archive` does off a `File`); carry that opened archive
-        // through so a bare-package open touches the file once.
+        // `from_asset` reads only the central directory, so the package's bytes
+        // are read once, when the anchored layer is.
         match Archive::from_asset(resolver, resolved)
             .ok()
             .and_then(|a| a.first_layer_name())
@@ -76,7 +71,7 @@ impl sdf::FileFormat for UsdzFileFormat {
         // A package-relative path reaches this format only when its named entry is
         // itself a package (an ordinary inner layer dispatches to its own format),
         // so it is a nested package — unsupported. Reported before opening the
-        // outer archive, since the whole-package read would only be discarded.
+        // outer archive, which would only be discarded.
         let s = resolved.to_string();
         if let Some((_, inner)) = ar::split_package_relative_path_outer(&s) {
             bail!("Nested USDZ files are not yet supported: '{inner}'");

@@ -33,12 +33,14 @@ impl Archive<File> {
     }
 }
 
-impl Archive<Cursor<Vec<u8>>> {
-    /// Reads the entire package at `resolved` through the resolver's asset seam
-    /// and opens it as an archive, so a host-provided byte source is honored.
+impl Archive<Box<dyn ar::Asset>> {
+    /// Opens the package at `resolved` through the resolver's asset seam, so a
+    /// host-provided byte source is honored. Only the archive's central directory
+    /// is read here (ppis patch, see PATCHED.md); an entry's bytes are read when
+    /// it is.
     pub fn from_asset(resolver: &dyn ar::Resolver, resolved: &ar::ResolvedPath) -> Result<Self> {
-        let bytes = resolver.open_asset(resolved)?.read_all()?;
-        Archive::from_reader(Cursor::new(bytes)).context("failed to open USDZ archive")
+        let asset = resolver.open_asset(resolved)?;
+        Archive::from_reader(asset).context("failed to open USDZ archive")
     }
 }
 
