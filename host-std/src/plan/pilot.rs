@@ -1,6 +1,7 @@
 //! `auto`'s choice of strategy per material, checked on the scene: a pilot render of a few of
 //! each material's pixels with every candidate plan, twice with independent samples, at a
-//! quarter of the render's shading points ([`PILOT_SHADING_POINT_DIVISOR`]), each plan at its
+//! quarter of the render's shading points where no candidate builds a product sampler
+//! ([`PILOT_SHADING_POINT_DIVISOR`]), each plan at its
 //! equal-cost budget of samples per
 //! shading point (`plan::candidates`: a plan that costs more per sample takes fewer, so that
 //! no material's choice takes time from the others'), scored by variance × cost per shading
@@ -223,7 +224,7 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
             (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak) && affordable(c, v)).map(move |c| (m, c))
         })
         .collect();
-    let pilot = pilot_options(ctx.options);
+    let pilot = pilot_options(ctx.options, &tasks);
     let share = pilot.shading_points as f64 / ctx.options.shading_points.max(1) as f64;
     let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost_per_point(v) * share).sum();
     let per_material = ((PILOT_SHARE * n as f64 / cost_per_pixel.max(1.0)) as usize).clamp(MIN_PIXELS, MAX_PIXELS);
@@ -255,8 +256,10 @@ fn measure(
             let mut plans: Vec<MaterialPlan> = ctx.plans.to_vec();
             plans[m] = at_equal_cost(MaterialPlan { strategy: PLANS[c].strategy, ..ctx.plans[m] }, env_budget);
             [0u64, 1].map(|rep| {
-                let options =
-                    Options { seed: hash_combine(ctx.options.seed, 0x9170_0000 + rep), ..pilot_options(ctx.options) };
+                let options = Options {
+                    seed: hash_combine(ctx.options.seed, 0x9170_0000 + rep),
+                    ..pilot_options(ctx.options, tasks)
+                };
                 let job = Context { env: Some(env), options: &options, plans: &plans, ..*ctx };
                 // A fresh scratch: no product sampler carried over from another pixel or
                 // repetition (that would correlate the pair).
@@ -273,10 +276,15 @@ fn measure(
 }
 
 /// How a pilot pixel of a render of `options` is sampled: [`PILOT_SHADING_POINT_DIVISOR`]
-/// times fewer shading points (at least [`MIN_PILOT_SHADING_POINTS`]), as many samples each.
-fn pilot_options(options: &Options) -> Options {
+/// times fewer shading points (at least [`MIN_PILOT_SHADING_POINTS`]), as many samples each —
+/// unless a task measures product-MIS, whose sampler a pilot pixel builds afresh (the image's
+/// serves a pixel and its neighbours): fewer shading points would not amortise that build,
+/// and the pilot would cost more than its share. Then the render's own shading points.
+fn pilot_options(options: &Options, tasks: &[(usize, usize)]) -> Options {
     let p = options.shading_points.max(1);
-    let shading_points = (p / PILOT_SHADING_POINT_DIVISOR).max(MIN_PILOT_SHADING_POINTS).min(p);
+    let builds = tasks.iter().any(|&(_, c)| matches!(PLANS[c].strategy, Strategy::ProductMis { .. }));
+    let divisor = if builds { 1 } else { PILOT_SHADING_POINT_DIVISOR };
+    let shading_points = (p / divisor).max(MIN_PILOT_SHADING_POINTS).min(p);
     Options { spp: samples_per_point(options) * shading_points, shading_points, ..*options }
 }
 
