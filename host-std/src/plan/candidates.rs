@@ -5,7 +5,7 @@
 //! image, depend only on the scene, the settings and the seed.
 
 use crate::plan::pilot::COSTLIER_OVERRIDE_MARGIN;
-use crate::render::strategy::Strategy;
+use crate::render::strategy::{MaterialPlan, Strategy};
 
 /// A plan the pilot may choose, with its cost.
 #[derive(Clone, Copy, Debug)]
@@ -30,6 +30,46 @@ impl Candidate {
     pub fn cost_at(&self, samples_per_point: usize) -> f64 {
         self.cost + self.build / samples_per_point.max(1) as f64
     }
+
+    /// Light samples per shading point that cost about what MIS's `samples_per_point` cost:
+    /// as many for a plan no costlier per sample than MIS, fewer for a costlier one — the
+    /// fewest whose time reaches MIS's, so that a split plan keeps samples of both its
+    /// techniques (product-MIS 3:1 at two samples of four would be 1:1 at half the samples).
+    /// `auto` gives each material its plan's budget, so that a material whose plan costs more
+    /// per sample takes about the share of the render's time it takes under MIS, and the
+    /// other materials' time stays MIS's (docs/perf.md, "`auto` and its pilot").
+    #[must_use]
+    pub fn equal_cost_budget(&self, samples_per_point: usize) -> usize {
+        let v = samples_per_point.max(1);
+        if self.cost_at(v) <= 1.0 {
+            return v;
+        }
+        ((v as f64 - self.build) / self.cost).ceil().clamp(1.0, v as f64) as usize
+    }
+
+    /// Time per shading point at [`equal_cost_budget`](Self::equal_cost_budget), relative to
+    /// MIS's at `samples_per_point`.
+    #[must_use]
+    pub fn cost_per_point(&self, samples_per_point: usize) -> f64 {
+        let v = samples_per_point.max(1);
+        let b = self.equal_cost_budget(v);
+        (b as f64 * self.cost + self.build) / v as f64
+    }
+}
+
+/// `plan` at its strategy's [`equal_cost_budget`](Candidate::equal_cost_budget) of
+/// `samples_per_point` environment samples (a strategy not among [`PLANS`] keeps the
+/// render's).
+#[must_use]
+pub fn at_equal_cost(plan: MaterialPlan, samples_per_point: usize) -> MaterialPlan {
+    let env_budget = candidate_of(plan.strategy).map(|c| PLANS[c].equal_cost_budget(samples_per_point));
+    MaterialPlan { env_budget, ..plan }
+}
+
+/// The candidate of [`PLANS`] that samples with `strategy`, if any.
+#[must_use]
+pub fn candidate_of(strategy: Strategy) -> Option<usize> {
+    PLANS.iter().position(|p| p.strategy == strategy)
 }
 
 /// The candidates.
@@ -89,5 +129,32 @@ mod tests {
             assert!([1, 2, 4, 16, 1024].iter().all(|&v| affordable(c, v)), "{c}");
             assert_eq!(PLANS[c].cost_at(1), PLANS[c].cost_at(64));
         }
+    }
+
+    #[test]
+    fn a_costlier_plan_takes_fewer_samples_per_shading_point_for_about_mis_s_time() {
+        let mis = candidate_of(Strategy::Mis { env_share: 0.5 }).unwrap();
+        let product_mis = candidate_of(Strategy::ProductMis { product_share: 0.5 }).unwrap();
+        let brdf = candidate_of(Strategy::Brdf).unwrap();
+        for v in [1, 2, 4, 16, 64] {
+            assert_eq!(PLANS[mis].equal_cost_budget(v), v);
+            assert_eq!(PLANS[brdf].equal_cost_budget(v), v, "cheaper plans keep the render's budget");
+            assert!((PLANS[mis].cost_per_point(v) - 1.0).abs() < 1e-12);
+        }
+        // 4 / 1.45 ≈ 2.8 samples: three, at 1.09× MIS's time per shading point; 4 / 1.67 ≈
+        // 2.4: three too (two would split 1:1).
+        assert_eq!(PLANS[product_mis].equal_cost_budget(4), 3);
+        assert!((PLANS[product_mis].cost_per_point(4) - 3.0 * 1.45 / 4.0).abs() < 1e-12);
+        assert_eq!(PLANS[product_mis + 1].equal_cost_budget(4), 3);
+        assert_eq!(PLANS[product_mis].equal_cost_budget(1), 1, "at least one sample");
+        for (c, plan) in PLANS.iter().enumerate() {
+            for v in [4, 16, 64].into_iter().filter(|&v| v as f64 - plan.build >= plan.cost) {
+                let p = plan.cost_per_point(v);
+                assert!(p <= 1.0 || p - 1.0 < plan.cost / v as f64, "{c} at {v}: {p}");
+            }
+        }
+        // Two-level-MIS's build takes most of 16 samples' time.
+        let two_level = PLANS.iter().position(|p| p.strategy.is_two_level()).unwrap();
+        assert_eq!(PLANS[two_level].equal_cost_budget(16), 3);
     }
 }

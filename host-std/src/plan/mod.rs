@@ -21,7 +21,7 @@ use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
 use crate::render::tiles::render_tiles;
-use crate::render::{Context, Lightcuts, Options, compensated_pyramid, summed_area_table, two_level_cones};
+use crate::render::{Context, Lightcuts, Options, budgets, compensated_pyramid, summed_area_table, two_level_cones};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
@@ -172,6 +172,15 @@ pub fn render_crop(
         options: &options,
         plans: &plans,
     };
+    // `auto` gives each material its plan's equal-cost budget (`plan::candidates`).
+    let equal_cost: Vec<MaterialPlan>;
+    let ctx = if settings.method == Method::Auto {
+        let env_budget = budgets(&ctx).0;
+        equal_cost = plans.iter().map(|p| candidates::at_equal_cost(*p, env_budget)).collect();
+        Context { plans: &equal_cost, ..ctx }
+    } else {
+        ctx
+    };
     // Timed from here: `auto`'s pilot is part of its cost.
     let start = Instant::now();
     let cpu_start = process_cpu_time();
@@ -183,7 +192,7 @@ pub fn render_crop(
         _ => (None, Vec::new()),
     };
     // A two-level plan the pilot chose reads the cell cones, which the rules' plans did not build.
-    let plans = chosen.as_deref().unwrap_or(&plans);
+    let plans = chosen.as_deref().unwrap_or(ctx.plans);
     let pilot_cones = match (env, ctx.cones) {
         (Some(e), None) => two_level_cones(e, plans),
         _ => None,

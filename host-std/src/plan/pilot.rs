@@ -1,17 +1,24 @@
 //! `auto`'s choice of strategy per material, checked on the scene: a pilot render of a few of
-//! each material's pixels with every candidate plan, twice with independent samples, at the
-//! render's own spp and shading points, scored by variance × cost — the variance from the
-//! pixel pairs' squared differences (relMSE's normalisation), the cost a fixed per-sample
-//! weight per plan and a sampler's build per shading point ([`PLANS`], `plan::candidates`),
-//! not the pilot's clock, so that the choice, and the image, depend only on the scene, the
-//! settings and the seed. The pilot's samples are independent of
-//! the render's (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
+//! each material's pixels with every candidate plan, twice with independent samples, at a
+//! quarter of the render's shading points where no candidate builds a product sampler
+//! ([`PILOT_SHADING_POINT_DIVISOR`]), each plan at its
+//! equal-cost budget of samples per
+//! shading point (`plan::candidates`: a plan that costs more per sample takes fewer, so that
+//! no material's choice takes time from the others'), scored by variance × cost per shading
+//! point — the variance from the pixel pairs' squared differences (relMSE's normalisation),
+//! the cost a fixed per-sample weight per plan and a sampler's build per shading point
+//! ([`PLANS`]), not the pilot's clock, so that the choice, and the image, depend only on the
+//! scene, the settings and the seed. The pilot's samples are independent of the render's
+//! (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
 //!
 //! The pilot overrides the rules' plan ([`auto_strategy`](crate::plan::rules::auto_strategy))
-//! only when another plan scores [`OVERRIDE_MARGIN`]× better: a variance estimate from tens of
-//! pixel pairs is dominated by its few brightest pixels and is good to tens of per cent at
-//! best, while an env map whose light is unlike the scenes the rules were set on makes a plan
-//! win by several times.
+//! only when another plan scores [`OVERRIDE_MARGIN`]× better, and by [`SEPARATION`] standard
+//! errors of the pilot pixels' paired differences: a variance estimate from tens of pixel pairs
+//! is dominated by its few brightest pixels and is good to tens of per cent at best, while an
+//! env map whose light is unlike the scenes the rules were set on makes a plan win by several
+//! times. Plain MIS, the baseline `auto` must never fall behind, replaces the rules' plan by
+//! the margin alone. Where the rules' plan is not trusted, the best plan replaces it only
+//! where it separates from plain MIS; otherwise MIS does.
 //!
 //! A pilot cannot see rare large samples it did not draw: BRDF sampling under a sun looks quiet
 //! in a pilot that never hit the sun, and then leaves fireflies across the image. So only plans
@@ -21,7 +28,10 @@
 //! where the lighting is (its weight is L × B·cos/p). Each MIS strategy competes with the
 //! rules' split and plain MIS (1:1) only: the splits between differ by less than the pilot
 //! can tell apart ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the
-//! others.
+//! others. Product-MIS competes on glossy lobes only: on a diffuse one env sampling draws
+//! nearly the product, cheaper, and product-MIS has lost on every diffuse region measured
+//! (docs/perf.md, "The products against MIS at equal time"), so measuring it there only adds
+//! to the pilot's cost.
 //!
 //! Nor can a pilot see the rare pixels where a plan fails. Env-only sampling fails where the
 //! bright part of the map is hidden (in a shadow, the sky is lit only by the few samples that
@@ -33,13 +43,14 @@
 //! samples per shading point let it repay its build ([`affordable`]): elsewhere the pilot
 //! is the pilot without it, at no cost.
 
+use crate::plan::candidates::at_equal_cost;
 pub use crate::plan::candidates::{Candidate, PLANS, affordable};
 use crate::plan::decision::{decide, score};
 use crate::plan::method::strategy_name;
 use crate::plan::rules::{SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
 use crate::render::pixel::{Scratch, pixel};
 use crate::render::strategy::{MaterialPlan, Strategy};
-use crate::render::{Context, Options, two_level_cones};
+use crate::render::{Context, Options, budgets, two_level_cones};
 use crate::scene::Bsdf;
 use rayon::prelude::*;
 use sampler_core::env::EnvHierarchy;
@@ -56,6 +67,11 @@ pub const OVERRIDE_MARGIN: f64 = 1.25;
 /// it loses on every scene measured (docs/perf.md, "`auto` and its pilot"), and a pilot whose
 /// few brightest pixels happened to favour it would spend the render's time where it does not pay.
 pub const COSTLIER_OVERRIDE_MARGIN: f64 = 2.0;
+
+/// Standard errors by which the rule's plan must score above another's for the other to replace
+/// it (`plan::decision`): a one-sided test at about 2% per comparison, on the mean of the pilot
+/// pixels' paired differences, so that a score led by a few bright pixels does not decide.
+pub const SEPARATION: f64 = 2.0;
 
 /// Share of the render's work (in MIS pixels, the candidates weighted by their cost) the pilot
 /// aims to spend, both repetitions of every candidate. A larger pilot costs more than its
@@ -77,6 +93,15 @@ pub const MAX_PIXELS: usize = 64;
 /// 0.14, Phong n ≤ 98 (Lambert: 1/π).
 const ENV_ONLY_LOBE_PEAK: f32 = 16.0;
 
+/// A pilot pixel takes 1/this of a render pixel's shading points (at the render's samples per
+/// shading point): every plan's variance grows alike, so their scores keep their order, while
+/// the pilot's budget buys this many times the pixels — and the pixels, each lit its own way,
+/// are what a score's noise comes from.
+pub const PILOT_SHADING_POINT_DIVISOR: usize = 4;
+
+/// Shading points of a pilot pixel, at least (the render's, where it has fewer).
+const MIN_PILOT_SHADING_POINTS: usize = 4;
+
 /// Pixels looked at (centre rays) to find each material's pilot pixels.
 const MAX_SCANNED: usize = 1 << 14;
 
@@ -87,7 +112,7 @@ pub struct PilotResult {
     pub material: usize,
     /// Pilot pixels (each rendered twice per candidate).
     pub pixels: usize,
-    /// Per candidate of [`PLANS`]: relative variance × cost (`None`: not measured or not
+    /// Per candidate of [`PLANS`]: relative variance × cost per shading point (`None`: not measured or not
     /// trusted — its pilot mean disagrees with the others', the sign of rare large samples it
     /// missed).
     pub scores: Vec<Option<f64>>,
@@ -113,7 +138,9 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         }
         Strategy::Brdf => env_peak < SMOOTH_LIGHTING_PEAK,
         Strategy::Mis { env_share } => env_share == auto_env_share(bsdf, env_peak) || env_share == 0.5,
-        Strategy::ProductMis { product_share: share } => share == product_share(bsdf, env_peak),
+        Strategy::ProductMis { product_share: share } => {
+            !bsdf.as_brdf().is_diffuse() && share == product_share(bsdf, env_peak)
+        }
         Strategy::TwoLevelMis { .. } => true,
         Strategy::Product
         | Strategy::Wavelet
@@ -139,8 +166,10 @@ pub(crate) fn choose(
     let defaults = ctx.plans;
     let Some((found, tasks)) = pilot_tasks(ctx, env_peak) else { return (defaults.to_vec(), Vec::new()) };
     // The two-level candidates read the cell cones, which the rules' plans do not build.
-    let candidates: Vec<MaterialPlan> =
-        tasks.iter().map(|&(m, c)| MaterialPlan { strategy: PLANS[c].strategy, ..defaults[m] }).collect();
+    let env_budget = budgets(ctx).0;
+    let plan =
+        |m: usize, c: usize| at_equal_cost(MaterialPlan { strategy: PLANS[c].strategy, ..defaults[m] }, env_budget);
+    let candidates: Vec<MaterialPlan> = tasks.iter().map(|&(m, c)| plan(m, c)).collect();
     let cones = if ctx.cones.is_none() { two_level_cones(env, &candidates) } else { None };
     let ctx = &Context { cones: ctx.cones.or(cones.as_deref()), ..*ctx };
     let v = samples_per_point(ctx.options);
@@ -155,10 +184,11 @@ pub(crate) fn choose(
             continue;
         }
         let pairs: Vec<(usize, &[[[f64; 3]; 2]])> = measured[m].iter().map(|(c, v)| (*c, v.as_slice())).collect();
-        let scores = score(&pairs, pixels.len(), v);
+        let scores = score(&pairs, pixels.len(), env_budget);
         let rule = PLANS.iter().position(|p| p.strategy == defaults[m].strategy);
         let Some(chosen) = decide(&scores, rule, v) else { continue };
-        plans[m] = MaterialPlan { strategy: PLANS[chosen].strategy, ..defaults[m] };
+        plans[m] = plan(m, chosen);
+        let scores = scores.iter().map(|s| s.as_ref().map(|s| s.value)).collect();
         results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
     }
     (plans, results)
@@ -194,7 +224,9 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
             (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak) && affordable(c, v)).map(move |c| (m, c))
         })
         .collect();
-    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost_at(v)).sum();
+    let pilot = pilot_options(ctx.options, &tasks);
+    let share = pilot.shading_points as f64 / ctx.options.shading_points.max(1) as f64;
+    let cost_per_pixel: f64 = tasks.iter().map(|&(_, c)| 2.0 * PLANS[c].cost_per_point(v) * share).sum();
     let per_material = ((PILOT_SHARE * n as f64 / cost_per_pixel.max(1.0)) as usize).clamp(MIN_PIXELS, MAX_PIXELS);
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
         return None;
@@ -214,6 +246,7 @@ fn measure(
     found: &[Vec<(usize, usize)>],
     tasks: &[(usize, usize)],
 ) -> Vec<Vec<[[f64; 3]; 2]>> {
+    let env_budget = budgets(ctx).0;
     let jobs: Vec<(usize, (usize, usize))> =
         tasks.iter().enumerate().flat_map(|(t, &(m, _))| found[m].iter().map(move |&p| (t, p))).collect();
     let rendered: Vec<[[f64; 3]; 2]> = jobs
@@ -221,9 +254,12 @@ fn measure(
         .map(|&(t, (x, y))| {
             let (m, c) = tasks[t];
             let mut plans: Vec<MaterialPlan> = ctx.plans.to_vec();
-            plans[m] = MaterialPlan { strategy: PLANS[c].strategy, ..ctx.plans[m] };
+            plans[m] = at_equal_cost(MaterialPlan { strategy: PLANS[c].strategy, ..ctx.plans[m] }, env_budget);
             [0u64, 1].map(|rep| {
-                let options = Options { seed: hash_combine(ctx.options.seed, 0x9170_0000 + rep), ..*ctx.options };
+                let options = Options {
+                    seed: hash_combine(ctx.options.seed, 0x9170_0000 + rep),
+                    ..pilot_options(ctx.options, tasks)
+                };
                 let job = Context { env: Some(env), options: &options, plans: &plans, ..*ctx };
                 // A fresh scratch: no product sampler carried over from another pixel or
                 // repetition (that would correlate the pair).
@@ -237,6 +273,19 @@ fn measure(
         values[*t].push(v);
     }
     values
+}
+
+/// How a pilot pixel of a render of `options` is sampled: [`PILOT_SHADING_POINT_DIVISOR`]
+/// times fewer shading points (at least [`MIN_PILOT_SHADING_POINTS`]), as many samples each —
+/// unless a task measures product-MIS, whose sampler a pilot pixel builds afresh (the image's
+/// serves a pixel and its neighbours): fewer shading points would not amortise that build,
+/// and the pilot would cost more than its share. Then the render's own shading points.
+fn pilot_options(options: &Options, tasks: &[(usize, usize)]) -> Options {
+    let p = options.shading_points.max(1);
+    let builds = tasks.iter().any(|&(_, c)| matches!(PLANS[c].strategy, Strategy::ProductMis { .. }));
+    let divisor = if builds { 1 } else { PILOT_SHADING_POINT_DIVISOR };
+    let shading_points = (p / divisor).max(MIN_PILOT_SHADING_POINTS).min(p);
+    Options { spp: samples_per_point(options) * shading_points, shading_points, ..*options }
 }
 
 /// Light samples per shading point of a render of `options`.

@@ -21,6 +21,7 @@ mod shade_lights;
 pub mod strategy;
 pub mod tiles;
 pub use shade_cuts::Lightcuts;
+pub(crate) use shade_lights::budgets;
 pub(crate) mod wavefront;
 
 use crate::scene::Scene;

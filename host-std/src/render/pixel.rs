@@ -196,8 +196,8 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material: usize, in
     })
 }
 
-/// Samples the environment's light with `budget` samples at every shading point of the group in
-/// `scratch`, adding to `sum`: one sampler per shading point, or for product-MIS one per
+/// Samples the environment's light with `budget` samples (or its material plan's own) at every
+/// shading point of the group in `scratch`, adding to `sum`: one sampler per shading point, or for product-MIS one per
 /// material, built at its first point. Where a material's sampler is the same at all its points (the environment, or the shared
 /// product-MIS sampler) and each point takes few samples, its points are shaded as one
 /// wavefront. The points' estimates are added in the order of the per-point path: hit order,
@@ -223,6 +223,7 @@ fn sample_light(
         }
         let lead = &hits[first];
         let group = lead.material;
+        let budget = ctx.plans[group].env_budget.unwrap_or(budget);
         let lead_sp = shading_point(ctx.scene, lead);
         let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
         let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });

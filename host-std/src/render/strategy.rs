@@ -76,6 +76,10 @@ pub struct MaterialPlan {
     pub reuse_cosine: f32,
     /// BRDF samples its product samplers are built from.
     pub brdf_samples: usize,
+    /// Visibility samples from the environment per shading point where the plan sets its own
+    /// (`auto`: fewer for a plan that costs more per sample, `plan::candidates`); `None`: the
+    /// render's.
+    pub env_budget: Option<usize>,
 }
 
 impl MaterialPlan {
@@ -83,6 +87,11 @@ impl MaterialPlan {
     /// `brdf_samples`' K for it.
     #[must_use]
     pub fn new(strategy: Strategy, bsdf: &Bsdf, brdf_samples: BrdfSamples) -> Self {
-        Self { strategy, reuse_cosine: reuse_cosine(bsdf.as_brdf()), brdf_samples: brdf_samples.for_bsdf(bsdf) }
+        Self {
+            strategy,
+            reuse_cosine: reuse_cosine(bsdf.as_brdf()),
+            brdf_samples: brdf_samples.for_bsdf(bsdf),
+            env_budget: None,
+        }
     }
 }

@@ -109,11 +109,12 @@ fn a_matte_studio_can_be_env_sampled() {
     })
     .unwrap();
     let env = Environment::build(&EnvSource::File(path), Placement::default()).unwrap();
-    // Near the margin, and the scores of a few dozen pixel pairs are noisy: some seeds, not
-    // all; never a third plan.
+    // Near the margin, and the scores of a few dozen pixel pairs are noisy: env sampling
+    // replaces the rule's plan where it also separates by `pilot::SEPARATION` standard errors,
+    // on some seeds, not all; never a third plan.
     let plans: Vec<String> = (0..6).map(|seed| chosen(&scene, &env, 1024, seed)).collect();
     let env_sampled = plans.iter().filter(|p| *p == "env").count();
-    assert!(env_sampled >= 2 && plans.iter().all(|p| p == "env" || p == "mis 3:1"), "{plans:?}");
+    assert!(env_sampled >= 1 && plans.iter().all(|p| p == "env" || p == "mis 3:1"), "{plans:?}");
 }
 
 /// What `auto`'s pilot measured on the scene's one material at `spp` and `shading_points`.
