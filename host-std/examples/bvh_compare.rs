@@ -109,7 +109,10 @@ fn main() {
     let mut scene = match path {
         None => host_std::scene::builtin::scene(),
         Some(p) if p.ends_with(".json") => host_std::scene::json::load(p.as_ref()).unwrap(),
+        #[cfg(feature = "usd")]
         Some(p) => host_std::scene::usd::load(p.as_ref(), &Default::default()).unwrap().scene,
+        #[cfg(not(feature = "usd"))]
+        Some(p) => panic!("{p}: USD scenes need the `usd` feature"),
     };
     let tris = triangles(&scene);
     let aspect = scene.camera.width as f32 / scene.camera.height as f32;

@@ -27,6 +27,8 @@ use crate::render::crop::Crop;
 use crate::render::tiles::TILE;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
+use sampler_core::estimator::luminance64;
+use sampler_core::glam::Vec3;
 use sampler_core::light::{Light, SceneLight};
 use sampler_core::rng::hash_combine;
 use std::time::Instant;
@@ -182,7 +184,7 @@ fn pilot_tiles(width: usize, height: usize) -> Vec<Crop> {
 /// halved squared luminance difference over the squared mean luminance of all four renders
 /// (plus 0.01, relMSE's guard against dark pixels).
 fn pair_scores(renders: [[&[[f32; 3]]; 2]; 2]) -> [f64; 2] {
-    let lum = |c: [f32; 3]| 0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2]);
+    let lum = |c: [f32; 3]| luminance64(Vec3::from(c).as_dvec3());
     let n = renders[0][0].len();
     let mut scores = [0.0; 2];
     for p in 0..n {

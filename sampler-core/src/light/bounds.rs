@@ -7,6 +7,7 @@
 //! the receiver.
 
 use super::{Light, LightSurface, SceneLight};
+use crate::env::luminance;
 use glam::Vec3;
 
 /// What many-light sampling knows of a group of lights.
@@ -30,11 +31,6 @@ pub struct LightBounds {
 
 /// Radians added to a shaped light's emission spread in its bounds.
 const SHAPED_MARGIN: f32 = 1e-3;
-
-/// Luminance of linear RGB.
-fn luminance(c: Vec3) -> f32 {
-    0.212_671 * c.x + 0.715_160 * c.y + 0.072_169 * c.z
-}
 
 /// The cosine of max(0, θa − θb) from the sines and cosines of θa and θb.
 #[inline]

@@ -8,6 +8,7 @@
 //! the directions [`square_to_sphere`] gives for its points.
 
 use crate::env::MAX_LEVEL;
+use crate::estimator::luminance64;
 use crate::mapping::{sphere_to_square, square_to_sphere, texel_of};
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};
@@ -60,7 +61,7 @@ pub fn equal_area_level(width: usize, height: usize) -> u32 {
 }
 
 fn luminance(t: [f32; 3]) -> f64 {
-    0.212_671 * f64::from(t[0]) + 0.715_160 * f64::from(t[1]) + 0.072_169 * f64::from(t[2])
+    luminance64(Vec3::from(t).as_dvec3())
 }
 
 /// Mean radiance over the sphere of a lat-long map, each row weighted by its solid angle.
