@@ -154,6 +154,20 @@ impl<'a> EnvHierarchy<'a> {
         [q[0] * s, q[1] * s, q[2] * s, q[3] * s]
     }
 
+    /// Asks the memory system for the 16 grandchildren of the node of `level` whose Morton
+    /// index within its level is `morton` (what [`children_relative_at`](Self::children_relative_at)
+    /// of its children reads), ahead of reading them: a hint that changes no result, and nothing
+    /// where the node has no grandchildren in the map.
+    #[inline]
+    pub fn prefetch_grandchildren_at(&self, level: u32, morton: usize) {
+        if level + 2 <= self.finest {
+            let base = level_offset(level + 2) + 16 * morton;
+            if let Some(block) = self.pyramid.get(base..base + 16) {
+                prefetch(block);
+            }
+        }
+    }
+
     /// How peaked the lighting is at a scale: the largest node of `level` (clamped to the
     /// finest) relative to the mean — 1 for a constant map, and in the hundreds for a sky with
     /// a sun at level 5 (cells ~6.4° wide). A cheap test of whether sampling the lighting can

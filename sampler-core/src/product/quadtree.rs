@@ -190,6 +190,9 @@ where
         if hi - lo == 1 || cell.level >= self.max_depth || !room {
             return self.leaf(index, cell, env, lo, hi);
         }
+        // The children's environment blocks, which their own splits read: the loads miss the
+        // caches at large maps, and asking now overlaps them with this node's work.
+        self.env.prefetch_grandchildren_at(cell.level, code);
         let first = self.push_children(index, cell);
         let bounds = self.split(cell.level, lo, hi);
         // The environment over the four children: one 2×2 block of the pyramid (or the texel
