@@ -1,10 +1,10 @@
 //! The scene's environment light, owned by the host: the equal-area RGB map and its importance
 //! pyramid, built once; `sampler-core` borrows both through an `EnvHierarchy`.
 
+use super::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::light::image_file::{self, LoadError, RgbImage};
 use crate::light::resample;
 use crate::light::sky::Sky;
-use super::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
 use sampler_core::glam::Mat3;
 use std::path::{Path, PathBuf};

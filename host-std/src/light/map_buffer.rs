@@ -47,7 +47,7 @@ impl<T: Copy + Default> MapBuffer<T> {
         let from = if huge { base.next_multiple_of(HUGE_PAGE) } else { base };
         // The first index from there whose value `first_aligned` starts a line.
         let mut start = (from - base) / size;
-        while start < spare && (base + (start + first_aligned) * size) % LINE != 0 {
+        while start < spare && !(base + (start + first_aligned) * size).is_multiple_of(LINE) {
             start += 1;
         }
         let start = if start < spare { start } else { 0 };
