@@ -1,4 +1,4 @@
-//! Env-only descents side by side: many points warped [`LANES`] at a time, branch-free within a
+//! Env-only descents side by side: many points warped [`IN_FLIGHT`] at a time, branch-free within a
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
 //! waiting on its own mispredicted branches (one per level and axis, each a coin flip). The
 //! product's lanes (`product/lanes.rs`) continue below their leaves with the same
@@ -13,8 +13,8 @@ use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
 
-/// Descents advanced side by side: enough that the loads of the map's deep levels, which miss
-/// the caches, overlap.
+/// Lookups side by side where each is short (the texel table's) and the products' descents
+/// below their leaves, whose trees are walked this many (twice) at a time.
 pub(crate) const LANES: usize = 8;
 
 /// Env-only descents [`EnvHierarchy::sample_many`] advances together: the deep levels miss the

@@ -3,8 +3,9 @@
 //! same choices and rescaled points, bit for bit. The lanes' ξ, Morton indices and cells stay
 //! in registers from the root down; per step only the four addresses of the next sixteen
 //! grandchildren leave them. Up to [`IN_FLIGHT`] lanes descend together, level by level, every
-//! group's loads asked for before any group's arithmetic, so that their cache misses overlap. A lane whose chosen side holds no mass (rounding at a row's end)
-//! takes the scalar step instead.
+//! group's loads asked for before any group's arithmetic, so that their cache misses overlap.
+//! A lane whose chosen side holds no mass (rounding at a row's end) takes the scalar step
+//! instead.
 
 use super::EnvHierarchy;
 use super::lanes::{IN_FLIGHT, WarpLane};
