@@ -1,6 +1,7 @@
 //! The scene's environment light, owned by the host: the equal-area RGB map and its importance
 //! pyramid, built once; `sampler-core` borrows both through an `EnvHierarchy`.
 
+use super::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::light::image_file::{self, LoadError, RgbImage};
 use crate::light::resample;
 use crate::light::sky::Sky;
@@ -89,9 +90,9 @@ pub struct Environment {
     /// Equal-area resolution: 2^level texels square.
     pub level: u32,
     /// The equal-area map's linear RGB texels, row by row.
-    pub rgb: Vec<[f32; 3]>,
+    pub rgb: MapBuffer<[f32; 3]>,
     /// The importance pyramid over the map's luminance (sampler-core's layout).
-    pub pyramid: Vec<f32>,
+    pub pyramid: MapBuffer<f32>,
     /// Directions of the map's frame into the world's.
     pub map_to_world: Mat3,
     /// What building it found and took.
@@ -167,7 +168,8 @@ impl Environment {
             rgb.iter_mut().for_each(|t| *t = [t[0] * gain[0], t[1] * gain[1], t[2] * gain[2]]);
         }
         sampler_core::env::sanitize_rgb(&mut rgb);
-        let mut pyramid = vec![0.0f32; pyramid_len(level)];
+        let rgb = MapBuffer::from_slice(&rgb, 0);
+        let mut pyramid = MapBuffer::new(pyramid_len(level), PYRAMID_LINE_START);
         build_pyramid(level, &rgb, &mut pyramid)?;
         stats.level = level;
         stats.map_mean = resample::equal_area_mean(&rgb);

@@ -10,5 +10,6 @@ pub use distant_in_env::move_distant_lights;
 pub mod environment;
 pub mod image_file;
 pub mod lights;
+pub mod map_buffer;
 pub mod resample;
 pub mod sky;

@@ -24,6 +24,7 @@ pub use shade_cuts::Lightcuts;
 pub(crate) use shade_lights::budgets;
 pub(crate) mod wavefront;
 
+use crate::light::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
@@ -119,12 +120,12 @@ pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option
 /// samples MIS or `auto`'s pilot may choose it, and `env` has none attached; `None` also where
 /// nothing of the map stands above its mean (the plain pyramid then serves MIS).
 #[must_use]
-pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<Vec<f32>> {
+pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<MapBuffer<f32>> {
     let mis = pilot || plans.iter().any(|p| matches!(p.strategy, strategy::Strategy::Mis { .. }));
     if !mis || env.has_compensated() {
         return None;
     }
-    let mut out = vec![0.0f32; sampler_core::env::pyramid_len(env.finest_level())];
+    let mut out = MapBuffer::new(sampler_core::env::pyramid_len(env.finest_level()), PYRAMID_LINE_START);
     env.compensate_into(&mut out).expect("a view's own pyramid has its level's length").then_some(out)
 }
 

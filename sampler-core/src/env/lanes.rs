@@ -1,4 +1,4 @@
-//! Env-only descents side by side: many points warped [`LANES`] at a time, branch-free within a
+//! Env-only descents side by side: many points warped [`IN_FLIGHT`] at a time, branch-free within a
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
 //! waiting on its own mispredicted branches (one per level and axis, each a coin flip). The
 //! product's lanes (`product/lanes.rs`) continue below their leaves with the same
@@ -13,9 +13,14 @@ use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
 
-/// Descents advanced side by side: enough that the loads of the map's deep levels, which miss
-/// the caches, overlap.
+/// Lookups side by side where each is short (the texel table's) and the products' descents
+/// below their leaves, whose trees are walked this many (twice) at a time.
 pub(crate) const LANES: usize = 8;
+
+/// Env-only descents [`EnvHierarchy::sample_many`] advances together: the deep levels miss the
+/// caches on nearly every read, and only many independent descents, each a chain of dependent
+/// loads, keep enough of those misses in flight to cover their latency.
+pub(crate) const IN_FLIGHT: usize = 64;
 
 /// One descent of [`EnvHierarchy::warp_down_lanes`]: the node it is at and its point ξ.
 #[derive(Clone, Copy, Debug, Default)]
@@ -44,7 +49,7 @@ impl WarpLane {
 }
 
 impl EnvHierarchy<'_> {
-    /// Env samples for many points, eight descents side by side (each level's loads and
+    /// Env samples for many points, up to [`IN_FLIGHT`] descents side by side (each level's loads and
     /// arithmetic of the lanes are independent, so they overlap), branch-free within a level.
     /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
@@ -52,19 +57,19 @@ impl EnvHierarchy<'_> {
         if let Some(cdf) = &self.cdf {
             return self.sample_many_by_table(cdf, u, out);
         }
-        for (us, os) in u.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        for (us, os) in u.chunks(IN_FLIGHT).zip(out.chunks_mut(IN_FLIGHT)) {
             let n = us.len().min(os.len());
-            let mut lanes = [WarpLane::default(); LANES];
+            let mut lanes = [WarpLane::default(); IN_FLIGHT];
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = WarpLane::new(Cell::ROOT, *u);
             }
             self.warp_down_lanes(&mut lanes[..n]);
             // The points and densities, then the directions at once.
-            let mut points = [(Vec2::ZERO, 0.0); LANES];
+            let mut points = [(Vec2::ZERO, 0.0); IN_FLIGHT];
             for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
                 *p = self.point_in_texel(lane.cell, lane.xi);
             }
-            let mut dirs = [Vec3::ZERO; LANES];
+            let mut dirs = [Vec3::ZERO; IN_FLIGHT];
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
             for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
                 let (uv, pdf) = points[k];

@@ -2,19 +2,26 @@
 //! descents at once in AVX2 (four f64 lanes), with the same operations in the same order — the
 //! same choices and rescaled points, bit for bit. The lanes' ξ, Morton indices and cells stay
 //! in registers from the root down; per step only the four addresses of the next sixteen
-//! grandchildren leave them. Two groups of four interleave, so that one group's loads overlap
-//! the other's arithmetic. A lane whose chosen side holds no mass (rounding at a row's end)
-//! takes the scalar step instead.
+//! grandchildren leave them. Up to [`IN_FLIGHT`] lanes descend together, level by level, every
+//! group's loads asked for before any group's arithmetic, so that their cache misses overlap.
+//! A lane whose chosen side holds no mass (rounding at a row's end) takes the scalar step
+//! instead.
 
 use super::EnvHierarchy;
-use super::lanes::WarpLane;
+use super::lanes::{IN_FLIGHT, WarpLane};
 use super::pyramid::level_offset;
 use crate::cell::Cell;
+use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, choose_grandchild_branchless, grandchild_index};
 use core::arch::x86_64::*;
 
 /// Masses of a lane that takes no part (dead, or past the end): no mass, so it picks nothing.
 static EMPTY: [f32; 16] = [0.0; 16];
+
+/// Groups of four lanes a descent advances level by level together: every group's next loads
+/// are asked for before any group's arithmetic, so that the deep levels' cache misses of all
+/// of them are in flight at once.
+const GROUPS: usize = IN_FLIGHT / 4;
 
 impl EnvHierarchy<'_> {
     /// Descends `lanes`, each from its own node, two levels at a time while two remain, four
@@ -25,37 +32,51 @@ impl EnvHierarchy<'_> {
         if !crate::cpu::has_avx2() {
             return;
         }
-        for eight in lanes.chunks_mut(8) {
+        for chunk in lanes.chunks_mut(IN_FLIGHT) {
             // SAFETY: AVX2 is available (checked above).
-            unsafe { self.descend_x8(eight) };
+            unsafe { self.descend_groups(chunk) };
         }
     }
 
-    /// Up to eight lanes down to the last even step above the finest level, as two groups of
-    /// four whose loads and arithmetic interleave.
+    /// Up to [`IN_FLIGHT`] lanes down to the last even step above the finest level, in groups
+    /// of four advanced a level pair at a time: first every group's sixteen grandchildren per
+    /// lane are asked for, then each group steps.
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    unsafe fn descend_x8(&self, lanes: &mut [WarpLane]) {
-        let (a, b) = lanes.split_at_mut(lanes.len().min(4));
-        let mut groups = [Group::load(a), Group::load(b)];
+    unsafe fn descend_groups(&self, lanes: &mut [WarpLane]) {
+        let n = lanes.len().div_ceil(4).min(GROUPS);
+        let mut groups = [Group::load(&[]); GROUPS];
+        for (g, four) in groups.iter_mut().zip(lanes.chunks(4)) {
+            *g = Group::load(four);
+        }
+        let mut active = [0i32; GROUPS];
+        let mut blocks = [[&EMPTY; 4]; GROUPS];
         loop {
             // No closures through generic code here: they would not inherit AVX2 and so
             // would not inline.
-            let active = [groups[0].active(self.finest), groups[1].active(self.finest)];
-            if active == [0, 0] {
+            let mut any = false;
+            for k in 0..n {
+                active[k] = groups[k].active(self.finest);
+                if active[k] != 0 {
+                    blocks[k] = groups[k].blocks(self.pyramid, active[k]);
+                    blocks[k].iter().for_each(|b| prefetch(&b[..]));
+                    any = true;
+                }
+            }
+            if !any {
                 break;
             }
-            let blocks = [groups[0].blocks(self.pyramid, active[0]), groups[1].blocks(self.pyramid, active[1])];
-            for ((g, blocks), active) in groups.iter_mut().zip(blocks).zip(active) {
-                if active != 0 {
-                    g.step(active, blocks);
+            for k in 0..n {
+                if active[k] != 0 {
+                    groups[k].step(active[k], blocks[k]);
                 }
             }
         }
-        groups[0].store(a);
-        groups[1].store(b);
+        for (g, four) in groups.iter().zip(lanes.chunks_mut(4)) {
+            g.store(four);
+        }
     }
 }
 

@@ -110,22 +110,9 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
 ) {
     let n = samples.len().min(WAVE);
     let env = sampler.env();
-    // The sampler's draws, all in one batch (its descents side by side).
-    let mut u_sampler = [DVec2::ZERO; WAVE];
-    let mut drawn = [None; WAVE];
-    let mut n_sampler = 0;
-    for s in samples.iter().filter(|s| s.technique == Technique::Sampler) {
-        u_sampler[n_sampler] = s.u;
-        n_sampler += 1;
-    }
-    sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
-    // Their texels' radiance is read below, after the BRDF's draws: asked for now, it arrives
-    // meanwhile.
-    for d in drawn[..n_sampler].iter().flatten() {
-        env.prefetch_texel(d.uv);
-    }
-    // The BRDF's draws, each at its own shading point, then their points of the square and the
-    // other technique's densities there in one batch.
+    // The BRDF's draws first, each at its own shading point, and their points of the square:
+    // the texels they read (radiance, the sampler's density) are asked for now and arrive
+    // while the sampler's descents below run.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
     let mut dirs = [Vec3::Z; WAVE];
     let mut n_brdf = 0;
@@ -142,15 +129,23 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     for uv in &uvs[..n_brdf] {
         env.prefetch_texel(*uv);
     }
+    // The sampler's draws, all in one batch (its descents side by side).
+    let mut u_sampler = [DVec2::ZERO; WAVE];
+    let mut drawn = [None; WAVE];
+    let mut n_sampler = 0;
+    for s in samples.iter().filter(|s| s.technique == Technique::Sampler) {
+        u_sampler[n_sampler] = s.u;
+        n_sampler += 1;
+    }
+    sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
+    // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
+    // for now, it arrives meanwhile.
+    for d in drawn[..n_sampler].iter().flatten() {
+        env.prefetch_texel(d.uv);
+    }
     let mut p_square = [0.0f32; WAVE];
     if weighting != Weighting::Single {
         sampler.pdf_square_many(&uvs[..n_brdf], &mut p_square[..n_brdf]);
-    }
-    // The map's radiance at every sample, gathered in one tight loop so that the lookups, which
-    // miss the caches, are in flight together rather than one per sample's arithmetic.
-    let mut radiance_sampler = [Vec3::ZERO; WAVE];
-    for (r, d) in radiance_sampler.iter_mut().zip(&drawn[..n_sampler]) {
-        *r = d.map_or(Vec3::ZERO, |d| env.radiance_at(d.uv));
     }
     let mut radiance_brdf = [Vec3::ZERO; WAVE];
     for (r, uv) in radiance_brdf.iter_mut().zip(&uvs[..n_brdf]) {
@@ -164,7 +159,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
             Technique::Sampler => {
                 let k = i_sampler;
                 i_sampler += 1;
-                drawn[k].map_or(Candidate::default(), |d| sampler_candidate(sp, d, radiance_sampler[k], weighting))
+                drawn[k].map_or(Candidate::default(), |d| sampler_candidate(sp, d, env.radiance_at(d.uv), weighting))
             }
             Technique::Brdf => {
                 let k = i_brdf;
