@@ -19,10 +19,13 @@
 //! samples draws from a compensated pyramid (`compensation.rs`) where one is attached.
 
 mod compensation;
+mod frame;
 mod hierarchy;
 mod lanes;
 #[cfg(target_arch = "x86_64")]
 mod lanes_avx2;
+#[cfg(target_arch = "x86_64")]
+mod lanes_avx2_ops;
 mod pyramid;
 mod sample;
 mod texel_cdf;
