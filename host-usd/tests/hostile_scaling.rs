@@ -73,7 +73,11 @@ fn write_shape(shape: &str, n: usize, dir: &Path) -> std::path::PathBuf {
                 list(n, |i| format!("string s{i} = \"v\"")).replace(", ", "; "),
                 list(n, |i| format!("\"s{i}\""))
             ),
-            &lines(n, |i| format!("    variantSet \"s{i}\" = {{\n        \"v\" {{\n            float a{i} = {i}\n        }}\n    }}")),
+            &lines(n, |i| {
+                format!(
+                    "    variantSet \"s{i}\" = {{\n        \"v\" {{\n            float a{i} = {i}\n        }}\n    }}"
+                )
+            }),
         ),
         "inherits" => format!(
             "#usda 1.0\n{}def Xform \"P\" (\n    prepend inherits = [{}]\n)\n{{\n}}\n",
