@@ -2,13 +2,14 @@
 //!
 //! Each shape puts `n` of one thing on one prim where a real asset has a few: properties,
 //! children, time samples, relationship targets, connections, dictionary entries, variants,
-//! apiSchemas entries, sublayers, references. Importing the shape at `8n` once must take
-//! less than 3.75 times the CPU time of importing it at `n` eight times (a ratio under 30 for
-//! 8× the size): linear growth gives about 1, quadratic 8. Only user CPU time of the import
-//! itself counts (not writing the files, not the kernel's file opens), summed over the
-//! process's threads since the usda parser runs on a thread of its own; this test is alone in
-//! its binary so no other test adds to it. Noise only slows one side, so a shape passes if
-//! any of three attempts does; a quadratic path fails all three. The sizes and the growth
+//! variant sets (each selected), inherited classes, apiSchemas entries, sublayers,
+//! references. Importing the shape at `8n` once must take less than 3.75 times the CPU time
+//! of importing it at `n` eight times (a ratio under 30 for 8× the size): linear growth
+//! gives about 1, quadratic 8. Only user CPU time of the import itself counts (not writing
+//! the files, not the kernel's file opens), summed over the process's threads since the
+//! usda parser runs on a thread of its own; this test is alone in its binary so no other
+//! test adds to it. Noise only slows one side, so a shape passes if any of three attempts
+//! does; a quadratic path fails all three. The sizes and the growth
 //! before and after the fixes are in docs/usd.md ("Hostile files: time linear in size").
 
 #![cfg(target_os = "linux")]
@@ -65,6 +66,23 @@ fn write_shape(shape: &str, n: usize, dir: &Path) -> std::path::PathBuf {
         "variants" => prim(
             "    variants = { string s = \"v0\" }\n    prepend variantSets = \"s\"",
             &format!("    variantSet \"s\" = {{\n{}    }}\n", lines(n, |i| format!("        \"v{i}\" {{\n        }}"))),
+        ),
+        "variant sets" => prim(
+            &format!(
+                "    variants = {{ {} }}\n    prepend variantSets = [{}]",
+                list(n, |i| format!("string s{i} = \"v\"")).replace(", ", "; "),
+                list(n, |i| format!("\"s{i}\""))
+            ),
+            &lines(n, |i| {
+                format!(
+                    "    variantSet \"s{i}\" = {{\n        \"v\" {{\n            float a{i} = {i}\n        }}\n    }}"
+                )
+            }),
+        ),
+        "inherits" => format!(
+            "#usda 1.0\n{}def Xform \"P\" (\n    prepend inherits = [{}]\n)\n{{\n}}\n",
+            lines(n, |i| format!("class \"C{i}\"\n{{\n    float a{i} = {i}\n}}")),
+            list(n, |i| format!("</C{i}>"))
         ),
         "apiSchemas" => prim(&format!("    prepend apiSchemas = [{}]", list(n, |i| format!("\"S{i}API\""))), ""),
         "sublayers" => {
@@ -125,6 +143,8 @@ fn import_time_grows_linearly_with_hostile_sizes() {
         ("connections", 40_000),
         ("dictionary", 20_000),
         ("variants", 4_000),
+        ("variant sets", 1_000),
+        ("inherits", 1_000),
         ("apiSchemas", 40_000),
         ("sublayers", 500),
         ("references", 500),

@@ -34,6 +34,11 @@ use std::ops::Deref;
 use std::path::{Component, Path, PathBuf};
 use std::time::SystemTime;
 
+mod stored_entry;
+
+pub use stored_entry::{FileRegion, StoredEntry};
+pub(crate) use stored_entry::invalid_checksum;
+
 /// A resolved asset path representing the physical location of an asset.
 ///
 /// This is a newtype around a [`PathBuf`] that distinguishes resolved paths
@@ -125,9 +130,10 @@ pub trait Asset: Read + Seek + Send {
         Ok(buf)
     }
 
-    /// The file the asset reads, if it is one (ppis patch, see PATCHED.md): a reader may
-    /// map it rather than read it.
-    fn as_file(&self) -> Option<&fs::File> {
+    /// Where the asset's bytes lie in a file, if they lie in one as they are: the file
+    /// itself, or an entry stored unpacked in a package (ppis patch, see PATCHED.md). A
+    /// reader may map them rather than read them.
+    fn file_region(&self) -> Option<FileRegion<'_>> {
         None
     }
 }
@@ -137,8 +143,8 @@ impl Asset for fs::File {
         self.metadata().map(|m| m.len())
     }
 
-    fn as_file(&self) -> Option<&fs::File> {
-        Some(self)
+    fn file_region(&self) -> Option<FileRegion<'_>> {
+        Some(FileRegion { file: self, offset: 0, len: None, crc32: None })
     }
 }
 
@@ -432,6 +438,13 @@ impl Resolver for DefaultResolver {
             let package_len = fs::metadata(&package)?.len();
             let mut entry = archive.by_name(&inner).map_err(io::Error::other)?;
 
+            // An entry stored unpacked, as a usdz's are, is a range of the package file:
+            // handed on as that range (ppis patch, see PATCHED.md), read only if asked.
+            if let Some((offset, len, crc32)) = stored_range(&entry, package_len) {
+                drop(entry);
+                return Ok(Box::new(StoredEntry::new(archive.into_inner(), offset, len, crc32)));
+            }
+
             // Room for the entry as its header sizes it (ppis patch, see PATCHED.md): a
             // usdz stores its files unpacked, so the buffer is not grown by doubling and
             // copied. The header is the file's word, so the room is no more than the
@@ -486,6 +499,16 @@ fn normalize_search_path(path: PathBuf) -> PathBuf {
         path
     };
     lexically_normalize(&path)
+}
+
+/// The range of the package file that holds `entry`, and its CRC-32, if the entry is
+/// stored unpacked and lies within the package's `package_len` bytes. Anything else (a
+/// compressed entry, a range past the file's end) is read through the zip reader.
+fn stored_range(entry: &zip::read::ZipFile<'_, fs::File>, package_len: u64) -> Option<(u64, u64, u32)> {
+    let offset = entry.data_start()?;
+    let len = entry.compressed_size();
+    let stored = entry.compression() == zip::CompressionMethod::Stored && !entry.encrypted();
+    (stored && offset.checked_add(len)? <= package_len).then_some((offset, len, entry.crc32()))
 }
 
 /// Opens `package` as a ZIP archive, reading only its central directory.

@@ -1836,17 +1836,25 @@ impl<'a, 'f> Indexer<'a, 'f> {
         // The strongest node the set path maps to, and the path in its namespace
         // (C++ `Pcp_TranslatePathFromNodeToRootOrClosestNode`).
         let (start, path_in_start) = self.translate_path_to_root_or_closest(origin, vset_path);
-        // TODO(perf): this rebuilds and re-sorts the subtree node list (each
-        // `compare_node_strength` walks parent chains) for every authored-variant
-        // task. A prim with several variant sets re-sorts once per set; the order
-        // is stable between grafts, so it could be computed once per drain pass.
-        let mut nodes: Vec<NodeId> = self
-            .subtree_nodes(start)
-            .into_iter()
-            .filter(|&n| !self.node(n).is_inert())
-            .collect();
-        nodes.sort_by(|&a, &b| self.output.compare_node_strength(a, b));
-        for n in nodes {
+        // The subtree's nodes in strength order (a pre-order walk, each node's children
+        // ordered by sibling strength), taken one at a time (ppis patch, see
+        // PATCHED.md): the search nearly always stops at the first node that authors
+        // the selection, so sorting the whole subtree for every set made a prim of `n`
+        // selected variant sets cost `n²` (each selected variant adds a node).
+        let mut pending = vec![start];
+        let mut visited: Option<NodeId> = None;
+        loop {
+            // The last node's children follow it, the strongest first.
+            if let Some(parent) = visited.take() {
+                let mut children = self.node(parent).children().to_vec();
+                children.sort_by(|&a, &b| self.output.compare_sibling_node_strength(b, a));
+                pending.extend(children);
+            }
+            let Some(n) = pending.pop() else { break };
+            visited = Some(n);
+            if self.node(n).is_inert() {
+                continue;
+            }
             let node = self.node(n);
             // Each candidate's site is the set path mapped from `start` down the
             // arc chain to that candidate (C++ `_ComposeVariantSelectionAcrossNodes`).
@@ -1883,7 +1891,8 @@ impl<'a, 'f> Indexer<'a, 'f> {
                 else {
                     continue;
                 };
-                if let Value::VariantSelectionMap(map) = value.into_owned() {
+                // Borrowed, not copied: a prim's selections are one map, read once per set.
+                if let Value::VariantSelectionMap(map) = &*value {
                     if let Some(sel) = map.get(vset) {
                         // Evaluate against the reading node's own stack
                         // variables (C++ `PcpComposeSiteVariantSelection`);
@@ -2106,17 +2115,13 @@ impl<'a, 'f> Indexer<'a, 'f> {
     /// (C++ `RetryVariantTasks`): a newly selected variant may have introduced
     /// authored selections that those sets should now see.
     fn retry_variant_tasks(&mut self) {
-        for task in self.tasks.scanned_mut() {
-            task.kind = match task.kind {
-                TaskKind::EvalNodeVariantFallback | TaskKind::EvalNodeVariantNoneFound => {
-                    TaskKind::EvalNodeVariantAuthored
-                }
-                TaskKind::EvalNodeAncestralVariantFallback | TaskKind::EvalNodeAncestralVariantNoneFound => {
-                    TaskKind::EvalNodeAncestralVariantAuthored
-                }
-                other => other,
-            };
-        }
+        self.tasks.retry_kinds(|kind| match kind {
+            TaskKind::EvalNodeVariantFallback | TaskKind::EvalNodeVariantNoneFound => TaskKind::EvalNodeVariantAuthored,
+            TaskKind::EvalNodeAncestralVariantFallback | TaskKind::EvalNodeAncestralVariantNoneFound => {
+                TaskKind::EvalNodeAncestralVariantAuthored
+            }
+            other => other,
+        });
     }
 
     /// Marks `node` as a culled empty arc target (C++ culling): it stays in the
@@ -3199,20 +3204,20 @@ impl<'a, 'f> Indexer<'a, 'f> {
     /// layer stack, keeping declaration order and dropping duplicates. Used to
     /// gather a site's variant set names and a set's variant options.
     fn compose_token_children(&self, node: NodeId, path: &Path, key: ChildrenKey) -> BuildResult<Vec<Token>> {
-        let mut out: Vec<Token> = Vec::new();
+        // Each name once, found by a hash set past a few (ppis patch, see PATCHED.md): a
+        // scan per name made a prim of `n` variant sets cost `n²`.
+        let mut out = crate::usda::names::OrderedNames::default();
         for &(layer, _) in self.inputs.stack.layer_stack(self.node(node).layer_stack_id()).iter() {
             let Some(value) = self.inputs.stack.layer(layer).data().try_field(path, key.as_str())? else {
                 continue;
             };
             if let Value::TokenVec(names) = value.into_owned() {
                 for name in names {
-                    if !out.contains(&name) {
-                        out.push(name);
-                    }
+                    out.push(name);
                 }
             }
         }
-        Ok(out)
+        Ok(out.into_vec())
     }
 
     /// Borrows the node behind a handle in the graph being grown.

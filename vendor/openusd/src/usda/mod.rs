@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 
 #[cfg(unix)]
 mod mapped;
-mod names;
+pub(crate) mod names;
 pub mod parser;
 pub mod token;
 mod writer;
@@ -66,7 +66,7 @@ impl sdf::FileFormat for UsdaFileFormat {
     fn read(&self, resolver: &dyn ar::Resolver, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
         let mut asset = resolver.open_asset(resolved)?;
         #[cfg(unix)]
-        if let Some(map) = asset.as_file().map(mapped::MappedText::map).transpose()?.flatten() {
+        if let Some(map) = asset.file_region().map(mapped::MappedText::map).transpose()?.flatten() {
             let text = map.text()?;
             let release = |offset: usize| map.release_before(offset);
             let mut parser = Parser::with_release(text, &release);

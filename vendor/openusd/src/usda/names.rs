@@ -4,7 +4,8 @@
 //! A property is declared by its default, its `.connect` and its `.timeSamples` lines, each
 //! of which names it again. A scan of the names so far per declaration made a body of `n`
 //! properties cost `n²` comparisons, minutes for a hostile file with 10⁵ properties on one
-//! prim; past a few names a hash set answers instead.
+//! prim; past a few names a hash set answers instead. The prim indexer composes a prim's
+//! variant set names across its layers the same way.
 
 use std::collections::HashSet;
 
@@ -15,7 +16,7 @@ const SCAN_LIMIT: usize = 16;
 
 /// Names in first-declared order, without repeats.
 #[derive(Debug, Default)]
-pub(super) struct OrderedNames {
+pub(crate) struct OrderedNames {
     names: Vec<tf::Token>,
     /// Every name in `names`, once there are more than [`SCAN_LIMIT`].
     seen: Option<HashSet<tf::Token>>,
@@ -23,7 +24,7 @@ pub(super) struct OrderedNames {
 
 impl OrderedNames {
     /// Appends `name` unless it is already there.
-    pub(super) fn push(&mut self, name: tf::Token) {
+    pub(crate) fn push(&mut self, name: tf::Token) {
         let is_new = match &mut self.seen {
             Some(seen) => seen.insert(name.clone()),
             None => !self.names.contains(&name),
@@ -45,7 +46,7 @@ impl OrderedNames {
     }
 
     /// The names, in the order they were first pushed.
-    pub(super) fn into_vec(self) -> Vec<tf::Token> {
+    pub(crate) fn into_vec(self) -> Vec<tf::Token> {
         self.names
     }
 }

@@ -3,23 +3,55 @@
 //! Picking the next task by scanning every open one made a prim of `n` references cost `n²`:
 //! each referenced node opens several tasks (references, payloads, inherits, specializes,
 //! variant sets) before the first drains. Most kinds order by kind and then node index,
-//! a total order that depends on nothing else, so they wait in a binary heap; the variant
-//! and implied-class tasks, which order by the graph's live node strength, are scanned as
-//! before. Tasks of different kinds order by kind, so the best task is the better of the
-//! heap's top and the scan's best.
+//! a total order that depends on nothing else, so they wait in a binary heap. The variant
+//! and implied-class tasks order by the graph's live node strength, so they are scanned;
+//! but tasks of one kind on one node order by their variant set alone (a prim of `n`
+//! variant sets opens `n` tasks on its node), so the scan is over groups of one kind and
+//! node, each a heap by variant set. Tasks of different kinds order by kind, so the best
+//! task is the better of the heap's top and the scan's best.
 
 use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use std::collections::{BTreeMap, BinaryHeap};
 
-use super::{Task, TaskKind};
+use super::{NodeId, Task, TaskKind};
 
 /// Open tasks, split by how their kind orders them.
 #[derive(Default)]
 pub(super) struct TaskQueue {
     /// Tasks ordered by kind, then node.
     by_node: BinaryHeap<ByNode>,
-    /// Tasks whose order the indexer's state decides.
-    scanned: Vec<Task>,
+    /// Tasks whose order the indexer's state decides, by kind and node.
+    scanned: BTreeMap<(TaskKind, NodeId), BinaryHeap<ByVariantSet>>,
+}
+
+/// A scanned task among those of its kind and node: the stronger variant set (the lower
+/// `(vset_path, vset_num)`, as the indexer's `task_priority_cmp` orders them) is greater.
+struct ByVariantSet(Task);
+
+impl ByVariantSet {
+    fn key(&self) -> Option<(&str, u16)> {
+        self.0.variant.as_ref().map(|v| (v.vset_path.as_str(), v.vset_num))
+    }
+}
+
+impl PartialEq for ByVariantSet {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for ByVariantSet {}
+
+impl PartialOrd for ByVariantSet {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for ByVariantSet {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.key().cmp(&self.key())
+    }
 }
 
 /// A task whose kind orders it by node index alone.
@@ -65,26 +97,47 @@ impl TaskQueue {
         if orders_by_node(task.kind) && task.variant.is_none() {
             self.by_node.push(ByNode(task));
         } else {
-            self.scanned.push(task);
+            self.scanned.entry((task.kind, task.node)).or_default().push(ByVariantSet(task));
         }
     }
 
     /// Removes and returns the greatest task under `priority` (the indexer's
-    /// `task_priority_cmp`).
+    /// `task_priority_cmp`), which orders tasks of one kind and node as
+    /// [`ByVariantSet`] does.
     pub(super) fn take_best(&mut self, priority: impl Fn(&Task, &Task) -> Ordering) -> Option<Task> {
-        let scanned = &self.scanned;
-        let best = (0..scanned.len()).max_by(|&i, &j| priority(&scanned[i], &scanned[j]));
+        let best = self
+            .scanned
+            .iter()
+            .filter_map(|(group, tasks)| Some((*group, &tasks.peek()?.0)))
+            .max_by(|(_, a), (_, b)| priority(a, b));
         match (best, self.by_node.peek()) {
-            (Some(at), Some(top)) if priority(&scanned[at], &top.0) == Ordering::Less => {
+            (Some((_, task)), Some(top)) if priority(task, &top.0) == Ordering::Less => {
                 self.by_node.pop().map(|t| t.0)
             }
-            (Some(at), _) => Some(self.scanned.swap_remove(at)),
+            (Some((group, _)), _) => {
+                let tasks = self.scanned.get_mut(&group).expect("a group just seen");
+                let task = tasks.pop().map(|t| t.0);
+                if tasks.is_empty() {
+                    self.scanned.remove(&group);
+                }
+                task
+            }
             (None, _) => self.by_node.pop().map(|t| t.0),
         }
     }
 
-    /// The tasks whose kind a retry may change (every task that does not order by node).
-    pub(super) fn scanned_mut(&mut self) -> impl Iterator<Item = &mut Task> {
-        self.scanned.iter_mut()
+    /// Gives every scanned task of a kind that `retry` changes that new kind (a retry of
+    /// variant tasks that found no selection).
+    pub(super) fn retry_kinds(&mut self, retry: impl Fn(TaskKind) -> TaskKind) {
+        let moved: Vec<(TaskKind, NodeId)> =
+            self.scanned.keys().filter(|(kind, _)| retry(*kind) != *kind).copied().collect();
+        for (kind, node) in moved {
+            let tasks = self.scanned.remove(&(kind, node)).expect("a listed group");
+            let into = self.scanned.entry((retry(kind), node)).or_default();
+            for ByVariantSet(mut task) in tasks {
+                task.kind = retry(kind);
+                into.push(ByVariantSet(task));
+            }
+        }
     }
 }
