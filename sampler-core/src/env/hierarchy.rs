@@ -78,7 +78,7 @@ impl<'a> EnvHierarchy<'a> {
     }
 
     /// Orients the map: `map_to_world` takes directions of the map's own frame (the frame
-    /// [`square_to_sphere`] works in) to world space. Must be a rotation.
+    /// [`square_to_sphere`](crate::mapping::square_to_sphere) works in) to world space. Must be a rotation.
     #[must_use]
     pub fn with_rotation(mut self, map_to_world: Mat3) -> Self {
         self.map_to_world = map_to_world;

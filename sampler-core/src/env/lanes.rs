@@ -49,7 +49,7 @@ impl WarpLane {
 }
 
 impl EnvHierarchy<'_> {
-    /// Env samples for many points, up to [`IN_FLIGHT`] descents side by side (each level's loads and
+    /// Env samples for many points, up to 64 descents side by side (each level's loads and
     /// arithmetic of the lanes are independent, so they overlap), branch-free within a level.
     /// The same distribution and pdf as [`sample`](Self::sample); the point within a cell can
     /// differ from it in the last bits (the sides are chosen by a count of prefix sums).
