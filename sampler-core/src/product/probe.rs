@@ -49,8 +49,7 @@ where
     /// surface), the largest of its four corners (inset by 1/64 of the cell), so that a cell
     /// straddling the horizon is not zeroed. NaN reads as unknown (+∞: keep the count fill).
     pub(super) fn probe(&mut self, cell: Cell) -> f32 {
-        let Cell { level: depth, x, y } = cell;
-        let inv = cell_side(depth);
+        let (Cell { x, y, .. }, inv) = (cell, cell.side());
         let at = |s: f32, t: f32| Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv);
         let centre = read_probe((self.eval)(at(0.5, 0.5)));
         if centre > 0.0 {
@@ -64,8 +63,7 @@ where
     /// evaluated side by side and the corners of each whose centre reads 0 four at a time.
     pub(super) fn probe4(&mut self, cells: &[Cell]) -> [f32; 4] {
         let at = |cell: Cell, s: f32, t: f32| {
-            let Cell { level: depth, x, y } = cell;
-            let inv = cell_side(depth);
+            let (Cell { x, y, .. }, inv) = (cell, cell.side());
             Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv)
         };
         let lanes = |p: [Vec2; 4]| (Vec4::from_array(p.map(|q| q.x)), Vec4::from_array(p.map(|q| q.y)));
@@ -90,21 +88,4 @@ where
 #[inline(always)]
 fn read_probe(v: f32) -> f32 {
     if v.is_nan() { f32::INFINITY } else { v.max(0.0) }
-}
-
-/// The side 2^-depth of a cell of `depth` ≤ 24: `1.0 / (1 << depth) as f32` exactly (a power of
-/// two), without the division.
-#[inline(always)]
-fn cell_side(depth: u32) -> f32 {
-    f32::from_bits((127 - depth) << 23)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn cell_side_is_the_division() {
-        for depth in 0..=super::super::keys::COORD_BITS {
-            assert_eq!(super::cell_side(depth).to_bits(), (1.0 / (1u64 << depth) as f32).to_bits(), "{depth}");
-        }
-    }
 }

@@ -59,6 +59,13 @@ impl Cell {
         morton2(self.x, self.y)
     }
 
+    /// 2^−level exactly, without a division: the cell's side (levels ≤ 126).
+    #[inline(always)]
+    #[must_use]
+    pub fn side(self) -> f32 {
+        f32::from_bits((127 - self.level) << 23)
+    }
+
     /// 4^level exactly (no_std has no powi): the inverse of the cell's area.
     #[inline(always)]
     #[must_use]
@@ -108,6 +115,14 @@ fn next_down(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn side_is_the_division() {
+        for level in 0..=24 {
+            let side = Cell::new(level, 0, 0).side();
+            assert_eq!(side.to_bits(), (1.0 / (1u64 << level) as f32).to_bits(), "{level}");
+        }
+    }
 
     #[test]
     fn children_and_ancestors_are_inverse() {
