@@ -4,7 +4,8 @@
 Each shape puts N of one thing where a real asset has a few: properties on one prim, children
 of one prim, time samples of one attribute, relationship targets, attribute connections,
 entries of one dictionary, variants of one variant set, variant sets of one prim (each
-selected), classes one prim inherits, apiSchemas entries, sublayers and
+selected), classes one prim inherits, apiSchemas entries, GeometryLights (each taking a
+mesh met before it out of the surfaces), sublayers and
 references (each to a small file of its own). For each shape and N, `ppis info FILE` is run
 R times and the least user CPU time is printed (the kernel's time is mostly opening files),
 with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
@@ -68,6 +69,14 @@ def inherits(n):
     return f'#usda 1.0\n{classes}def Xform "P" (\n    prepend inherits = [{body}]\n)\n{{\n}}\n'
 
 
+def geometry_lights(n):
+    mesh = ('    def Mesh "m{i}"\n    {{\n        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]\n'
+            '        int[] faceVertexCounts = [3]\n        int[] faceVertexIndices = [0, 1, 2]\n    }}\n')
+    light = '    def GeometryLight "g{i}"\n    {{\n        rel geometry = </P/m{i}>\n    }}\n'
+    body = "".join(mesh.format(i=i) for i in range(n)) + "".join(light.format(i=i) for i in range(n))
+    return f'#usda 1.0\ndef Xform "P"\n{{\n{body}}}\n'
+
+
 def api_schemas(n):
     body = ", ".join(f'"S{i}API"' for i in range(n))
     return f'#usda 1.0\ndef Xform "P" (\n    prepend apiSchemas = [{body}]\n)\n{{\n}}\n'
@@ -93,7 +102,8 @@ def references(n, out):
 
 SHAPES = {"props": props, "children": children, "samples": samples, "targets": targets,
           "connections": connections, "dictionary": dictionary, "variants": variants,
-          "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas}
+          "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas,
+          "geometryLights": geometry_lights}
 FILE_SHAPES = {"sublayers": sublayers, "references": references}
 
 

@@ -8,7 +8,7 @@ use crate::stage::{PrimPath, Stage, TimeCode, Value};
 use crate::xform::{WorldTransforms, up_axis_conversion};
 use crate::{camera, dome, render_settings};
 use glam::DMat4;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
 
@@ -79,8 +79,8 @@ struct Importer<'a> {
     /// The RenderSettings prims in walk order.
     settings: Vec<PrimPath>,
     /// The gprims GeometryLights have made lights, which the walk does not also import as
-    /// surfaces.
-    light_geometry: HashSet<String>,
+    /// surfaces, each with whether it is a Mesh prim.
+    light_geometry: HashMap<String, bool>,
 }
 
 /// Imports a USD file with default options.
@@ -217,7 +217,7 @@ impl<'a> Importer<'a> {
             prototypes,
             cameras: Vec::new(),
             settings: Vec::new(),
-            light_geometry: HashSet::new(),
+            light_geometry: HashMap::new(),
         }
     }
 

@@ -7,6 +7,7 @@
 use super::lights::LightPrim;
 use super::{GPRIMS, Importer};
 use crate::stage::PrimPath;
+use std::collections::HashMap;
 
 impl Importer<'_> {
     /// A GeometryLight prim: each gprim it targets becomes a mesh light (a note for a target
@@ -38,9 +39,7 @@ impl Importer<'_> {
                 self.skip(prim, why);
                 continue;
             }
-            let name = target.to_string();
-            self.drop_surface(&name, &t);
-            self.light_geometry.insert(name);
+            self.light_geometry.insert(target.to_string(), t == "Mesh");
             let m = self.conversion * self.worlds.world(stage, target)?;
             let light = LightPrim { prim, type_name: "GeometryLight", world: &light_world };
             let label = if targets.len() == 1 { prim.to_string() } else { format!("{prim} ({target})") };
@@ -49,26 +48,35 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// A GeometryLight's target is a light only: takes back the surface the walk imported
-    /// for it before it met the GeometryLight (nothing when the walk has not reached it yet:
-    /// the walk then leaves it out by [`Importer::light_geometry`]).
-    fn drop_surface(&mut self, path: &str, type_name: &str) {
-        let counts = &mut self.scene.counts;
-        let meshes_before = self.scene.meshes.len();
-        let mut triangles = 0;
-        self.scene.meshes.retain(|m| {
-            let keep = m.path != path;
-            if !keep {
-                triangles += m.triangles.len();
+    /// A GeometryLight's target is a light only: takes back, in one pass after the walk, the
+    /// surfaces the walk imported for targets before it met their GeometryLight (the walk
+    /// leaves out the targets it meets after, by [`Importer::light_geometry`]). One pass keeps
+    /// a stage of many GeometryLights linear in its gprims.
+    pub(super) fn drop_light_surfaces(&mut self) {
+        if self.light_geometry.is_empty() {
+            return;
+        }
+        let targets = &self.light_geometry;
+        // Triangles taken back per target path.
+        let mut dropped: HashMap<&str, usize> = HashMap::new();
+        self.scene.meshes.retain(|m| match targets.get_key_value(m.path.as_str()) {
+            Some((path, _)) => {
+                *dropped.entry(path).or_default() += m.triangles.len();
+                false
             }
-            keep
+            None => true,
         });
-        let spheres_before = self.scene.spheres.len();
-        self.scene.spheres.retain(|s| s.path != path);
-        let dropped = self.scene.meshes.len() < meshes_before || self.scene.spheres.len() < spheres_before;
-        if dropped {
+        self.scene.spheres.retain(|s| match targets.get_key_value(s.path.as_str()) {
+            Some((path, _)) => {
+                dropped.entry(path).or_default();
+                false
+            }
+            None => true,
+        });
+        let counts = &mut self.scene.counts;
+        for (path, triangles) in dropped {
             counts.gprims -= 1;
-            counts.meshes -= usize::from(type_name == "Mesh");
+            counts.meshes -= usize::from(targets[path]);
             counts.triangles -= triangles;
         }
     }

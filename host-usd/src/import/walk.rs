@@ -45,7 +45,9 @@ impl Importer<'_> {
             Step::Enter(prim) => self.enter(&prim),
             Step::Leave(prim) => Ok(self.instancers_after(Some(&prim))?),
         })?;
-        Ok(self.instancers_after(None)?)
+        self.instancers_after(None)?;
+        self.drop_light_surfaces();
+        Ok(())
     }
 
     fn enter(&mut self, prim: &PrimPath) -> Result<(), Stop> {
@@ -78,7 +80,7 @@ impl Importer<'_> {
                 if stage.applied_schemas(prim).map_err(fail(prim))?.iter().any(|s| s == "MeshLightAPI") {
                     return Ok(self.mesh_light(prim, t).map_err(fail(prim))?);
                 }
-                if !self.light_geometry.is_empty() && self.light_geometry.contains(&prim.to_string()) {
+                if !self.light_geometry.is_empty() && self.light_geometry.contains_key(&prim.to_string()) {
                     // A GeometryLight met earlier made it a light.
                     return Ok(());
                 }
