@@ -63,6 +63,9 @@ impl Importer<'_> {
             let kept = GPRIMS.contains(&t) || crate::lights::KINDS.contains(&t);
             if kept && !self.hidden(prim).map_err(fail(prim))? {
                 self.prototype_gprim(prim, t).map_err(fail(prim))?;
+            } else if !kept && !STRUCTURE.contains(&t) && t != "PointInstancer" {
+                // A dome, GeometryLight, portal or any other prim an instance cannot carry.
+                self.skip(prim, format!("{t} inside a PointInstancer prototype: not rendered"));
             }
             return Ok(());
         }

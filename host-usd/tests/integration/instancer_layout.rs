@@ -76,3 +76,18 @@ fn an_instancer_inside_a_prototype_renders_only_through_the_outer_one() {
     let want = vec![(100.0, "/Outer/Protos/Inst/Protos/Ball[/Outer:0]".to_string())];
     assert_eq!(spheres(&scene), want);
 }
+
+#[test]
+fn what_a_prototype_holds_and_an_instance_cannot_carry_is_a_note() {
+    let prototype = PROTOTYPE.replace(
+        "}\n",
+        "    def GeometryLight \"Glow\" { rel geometry = </Protos/Ball> }\n    def DomeLight \"Sky\" {}\n}\n",
+    );
+    let scene = import(&format!("{prototype}{}", instancer("/Protos", "")));
+    for (path, t) in [("/Protos/Glow", "GeometryLight"), ("/Protos/Sky", "DomeLight")] {
+        let notes: Vec<&str> = scene.skipped.iter().filter(|k| k.path == path).map(|k| k.what.as_str()).collect();
+        assert_eq!(notes, [format!("{t} inside a PointInstancer prototype: not rendered")], "{:?}", scene.skipped);
+    }
+    assert!(scene.dome.is_none() && scene.lights.is_empty());
+    assert_eq!(spheres(&scene).len(), 2, "the ball still renders per instance");
+}
