@@ -5,9 +5,9 @@ Each shape puts N of one thing where a real asset has a few: properties on one p
 of one prim, time samples of one attribute, relationship targets, attribute connections,
 entries of one dictionary, variants of one variant set, variant sets of one prim (each
 selected), classes one prim inherits, apiSchemas entries, GeometryLights (each taking a
-mesh met before it out of the surfaces), sublayers and
-references (each to a small file of its own). For each shape and N, `ppis info FILE` is run
-R times and the least user CPU time is printed (the kernel's time is mostly opening files),
+mesh met before it out of the surfaces), a PointInstancer's prototypes (each a root prim
+beside it), sublayers and references (each to a small file of its own). For each shape and N,
+`ppis info FILE` is run R times and the least user CPU time is printed (the kernel's time is mostly opening files),
 with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
 for linear growth, 2 for quadratic (shown where the smaller time is 0.02 s or more).
 
@@ -77,6 +77,15 @@ def geometry_lights(n):
     return f'#usda 1.0\ndef Xform "P"\n{{\n{body}}}\n'
 
 
+def prototypes(n):
+    targets = ", ".join(f"</s{i}>" for i in range(n))
+    indices = ", ".join(str(i) for i in range(n))
+    positions = ", ".join(f"({i}, 0, 0)" for i in range(n))
+    spheres = "".join(f'def Sphere "s{i}"\n{{\n}}\n' for i in range(n))
+    return (f'#usda 1.0\ndef PointInstancer "P"\n{{\n    rel prototypes = [{targets}]\n'
+            f'    int[] protoIndices = [{indices}]\n    point3f[] positions = [{positions}]\n}}\n{spheres}')
+
+
 def api_schemas(n):
     body = ", ".join(f'"S{i}API"' for i in range(n))
     return f'#usda 1.0\ndef Xform "P" (\n    prepend apiSchemas = [{body}]\n)\n{{\n}}\n'
@@ -103,7 +112,7 @@ def references(n, out):
 SHAPES = {"props": props, "children": children, "samples": samples, "targets": targets,
           "connections": connections, "dictionary": dictionary, "variants": variants,
           "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas,
-          "geometryLights": geometry_lights}
+          "geometryLights": geometry_lights, "prototypes": prototypes}
 FILE_SHAPES = {"sublayers": sublayers, "references": references}
 
 

@@ -8,8 +8,9 @@
 
 use super::{Failure, Importer, Stop, fail};
 use crate::instancer;
-use crate::stage::{PrimPath, Stage, Step};
+use crate::stage::{PrimMap, PrimPath, Stage, Step};
 use glam::DMat4;
+use std::collections::hash_map::Entry;
 
 /// A renderable gprim or a light under a prototype root: its path, type, transform relative
 /// to the root's parent, and whether it is a mesh light (MeshLightAPI).
@@ -20,6 +21,11 @@ type Part = (PrimPath, String, DMat4, bool);
 #[derive(Default)]
 pub(super) struct Prototypes {
     roots: Vec<PrimPath>,
+    /// Each root's place in `roots`: a prim finds the roots over it by its ancestors, not by
+    /// a scan of every root, so a stage of many prototypes stays linear in them.
+    index: PrimMap<usize>,
+    /// The shallowest root's depth: no prim above it lies in a prototype.
+    min_depth: usize,
     parts: Vec<Vec<Part>>,
     /// Visible instancers met by the walk, with their world transforms.
     waiting: Vec<(PrimPath, DMat4)>,
@@ -28,13 +34,41 @@ pub(super) struct Prototypes {
 impl Prototypes {
     /// Knowing `roots` from the start.
     pub(super) fn known(roots: Vec<PrimPath>) -> Self {
-        let parts = vec![Vec::new(); roots.len()];
-        Self { roots, parts, waiting: Vec::new() }
+        let mut known = Self::default();
+        roots.into_iter().for_each(|r| known.add(r));
+        known
+    }
+
+    /// Adds `root` unless it is known.
+    fn add(&mut self, root: PrimPath) {
+        if self.index.contains_key(&root) {
+            return;
+        }
+        self.min_depth = if self.roots.is_empty() { root.depth() } else { self.min_depth.min(root.depth()) };
+        self.index.insert(root.clone(), self.roots.len());
+        self.roots.push(root);
+        self.parts.push(Vec::new());
+    }
+
+    /// The place in `roots` of each root at or above `prim`, nearest first.
+    fn over(&self, prim: &PrimPath) -> impl Iterator<Item = usize> + '_ {
+        let mut next = (!self.roots.is_empty()).then(|| prim.clone());
+        std::iter::from_fn(move || {
+            while let Some(p) = next.take() {
+                if p.depth() > self.min_depth {
+                    next = p.parent();
+                }
+                if let Some(&i) = self.index.get(&p) {
+                    return Some(i);
+                }
+            }
+            None
+        })
     }
 
     /// Whether `prim` is at or below a prototype root.
     pub(super) fn contains(&self, prim: &PrimPath) -> bool {
-        self.roots.iter().any(|r| prim.is_at_or_below(r))
+        self.over(prim).next().is_some()
     }
 
     /// Expands `instancer` (at `world`) once its prototypes are walked.
@@ -46,11 +80,12 @@ impl Prototypes {
 /// Every PointInstancer's prototype roots, by a walk of the stage that reads nothing else.
 pub(super) fn prototype_roots(stage: &Stage) -> Result<Vec<PrimPath>, Failure> {
     let mut roots: Vec<PrimPath> = Vec::new();
+    let mut seen = PrimMap::default();
     let walked = stage.walk(|step| -> Result<(), Stop> {
         let Step::Enter(prim) = step else { return Ok(()) };
         if stage.type_name(&prim).map_err(fail(&prim))? == "PointInstancer" {
             for target in stage.targets(&prim, "prototypes").map_err(fail(&prim))? {
-                if !roots.contains(&target) {
+                if seen.insert(target.clone(), ()).is_none() {
                     roots.push(target);
                 }
             }
@@ -62,8 +97,15 @@ pub(super) fn prototype_roots(stage: &Stage) -> Result<Vec<PrimPath>, Failure> {
 }
 
 /// Whether the walk, now at `current`, has already passed `root`: an ancestor of
-/// `current`, or a subtree of an earlier sibling of one of `current`'s ancestors.
-fn walked_before(stage: &Stage, root: &PrimPath, current: &PrimPath) -> Result<bool, String> {
+/// `current`, or a subtree of an earlier sibling of one of `current`'s ancestors. `order`
+/// keeps each common ancestor's children's places, read once for all of an instancer's
+/// roots (a stage of many prototypes beside their instancer stays linear in them).
+fn walked_before(
+    stage: &Stage,
+    root: &PrimPath,
+    current: &PrimPath,
+    order: &mut PrimMap<PrimMap<usize>>,
+) -> Result<bool, String> {
     if current.is_at_or_below(root) {
         return Ok(true);
     }
@@ -76,9 +118,14 @@ fn walked_before(stage: &Stage, root: &PrimPath, current: &PrimPath) -> Result<b
     }
     let depth = common.depth() + 1;
     let (r, c) = (root.ancestor_at(depth), current.ancestor_at(depth));
-    let children = stage.children(&common)?;
-    let at = |p: &PrimPath| children.iter().position(|x| x == p);
-    Ok(matches!((at(&r), at(&c)), (Some(r), Some(c)) if r < c))
+    let places = match order.entry(common) {
+        Entry::Occupied(e) => e.into_mut(),
+        Entry::Vacant(e) => {
+            let children = stage.children(e.key())?;
+            e.insert(children.into_iter().enumerate().map(|(i, p)| (p, i)).collect())
+        }
+    };
+    Ok(matches!((places.get(&r), places.get(&c)), (Some(r), Some(c)) if r < c))
 }
 
 impl Importer<'_> {
@@ -86,15 +133,15 @@ impl Importer<'_> {
     /// the import.
     pub(super) fn register_instancer(&mut self, instancer: &PrimPath) -> Result<(), Stop> {
         let stage = self.stage;
+        let mut order = PrimMap::default();
         for root in stage.targets(instancer, "prototypes").map_err(fail(instancer))? {
-            if self.prototypes.roots.contains(&root) {
+            if self.prototypes.index.contains_key(&root) {
                 continue;
             }
-            if walked_before(stage, &root, instancer).map_err(fail(instancer))? {
+            if walked_before(stage, &root, instancer, &mut order).map_err(fail(instancer))? {
                 return Err(Stop::Restart);
             }
-            self.prototypes.roots.push(root);
-            self.prototypes.parts.push(Vec::new());
+            self.prototypes.add(root);
         }
         Ok(())
     }
@@ -104,12 +151,11 @@ impl Importer<'_> {
         let stage = self.stage;
         let mesh_light = !crate::lights::KINDS.contains(&type_name)
             && stage.applied_schemas(prim)?.iter().any(|s| s == "MeshLightAPI");
-        for i in 0..self.prototypes.roots.len() {
+        let over: Vec<usize> = self.prototypes.over(prim).collect();
+        for i in over {
             let root = &self.prototypes.roots[i];
-            if prim.is_at_or_below(root) {
-                let rel = self.worlds.relative_to(stage, prim, root)?;
-                self.prototypes.parts[i].push((prim.clone(), type_name.to_string(), rel, mesh_light));
-            }
+            let rel = self.worlds.relative_to(stage, prim, root)?;
+            self.prototypes.parts[i].push((prim.clone(), type_name.to_string(), rel, mesh_light));
         }
         Ok(())
     }
@@ -144,8 +190,8 @@ impl Importer<'_> {
     fn instancer(&mut self, prim: &PrimPath, world: &DMat4) -> Result<(), Failure> {
         let stage = self.stage;
         let (protos, instances) = instancer::read(stage, prim).map_err(fail(prim))?;
-        let roots = &self.prototypes.roots;
-        let index: Vec<Option<usize>> = protos.iter().map(|p| roots.iter().position(|r| r == p)).collect();
+        let known = &self.prototypes.index;
+        let index: Vec<Option<usize>> = protos.iter().map(|p| known.get(p).copied()).collect();
         // Out of `self` while `gprim` adds to the scene.
         let parts = std::mem::take(&mut self.prototypes.parts);
         let expanded = instances.iter().try_for_each(|inst| {
