@@ -6,6 +6,8 @@
 //! passed before reaching its instancer cannot be taken back: the import then walks again
 //! knowing every instancer's prototypes from a first walk ([`prototype_roots`]).
 
+#![allow(clippy::mutable_key_type, reason = "a path's interior mutability is its text cache, outside Eq and Hash")]
+
 use super::{Failure, Importer, Stop, fail};
 use crate::instancer;
 use crate::stage::{PrimMap, PrimPath, Stage, Step};
