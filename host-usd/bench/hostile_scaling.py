@@ -6,9 +6,9 @@ of one prim, time samples of one attribute, relationship targets, attribute conn
 entries of one dictionary, variants of one variant set, variant sets of one prim (each
 selected), classes one prim inherits, apiSchemas entries, GeometryLights (each taking a
 mesh met before it out of the surfaces), a PointInstancer's prototypes (each a root prim
-beside it), sublayers and references (each to a small file of its own). For each shape and N,
-`ppis info FILE` is run R times and the least user CPU time is printed (the kernel's time is mostly opening files),
-with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
+beside it), a mesh's materialBind GeomSubsets (one face and material each), sublayers and
+references (each to a small file of its own). For each shape and N, `ppis info FILE` is run
+R times and the least user CPU time is printed (the kernel's time is mostly opening files), with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
 for linear growth, 2 for quadratic (shown where the smaller time is 0.02 s or more).
 
     python3 host-usd/bench/hostile_scaling.py PPIS DIR [--sizes 1000,10000,100000] [--repeat R]
@@ -86,6 +86,22 @@ def prototypes(n):
             f'    int[] protoIndices = [{indices}]\n    point3f[] positions = [{positions}]\n}}\n{spheres}')
 
 
+def subsets(n):
+    material = ('def Material "M{i}"\n{{\n    token outputs:surface.connect = </M{i}/S.outputs:surface>\n'
+                '    def Shader "S"\n    {{\n        uniform token info:id = "UsdPreviewSurface"\n'
+                '        token outputs:surface\n    }}\n}}\n')
+    subset = ('    def GeomSubset "g{i}" (\n        prepend apiSchemas = ["MaterialBindingAPI"]\n    )\n    {{\n'
+              '        uniform token elementType = "face"\n        uniform token familyName = "materialBind"\n'
+              '        int[] indices = [{i}]\n        rel material:binding = </M{i}>\n    }}\n')
+    points = ", ".join(f"({i}, 0, 0), ({i + 1}, 0, 0), ({i}, 1, 0)" for i in range(n))
+    counts = ", ".join("3" for _ in range(n))
+    indices = ", ".join(str(i) for i in range(3 * n))
+    body = "".join(subset.format(i=i) for i in range(n))
+    mesh = (f'def Mesh "big"\n{{\n    point3f[] points = [{points}]\n    int[] faceVertexCounts = [{counts}]\n'
+            f'    int[] faceVertexIndices = [{indices}]\n{body}}}\n')
+    return "#usda 1.0\n" + "".join(material.format(i=i) for i in range(n)) + mesh
+
+
 def api_schemas(n):
     body = ", ".join(f'"S{i}API"' for i in range(n))
     return f'#usda 1.0\ndef Xform "P" (\n    prepend apiSchemas = [{body}]\n)\n{{\n}}\n'
@@ -112,7 +128,8 @@ def references(n, out):
 SHAPES = {"props": props, "children": children, "samples": samples, "targets": targets,
           "connections": connections, "dictionary": dictionary, "variants": variants,
           "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas,
-          "geometryLights": geometry_lights, "prototypes": prototypes}
+          "geometryLights": geometry_lights, "prototypes": prototypes,
+          "subsets": subsets}
 FILE_SHAPES = {"sublayers": sublayers, "references": references}
 
 

@@ -33,12 +33,12 @@ impl Importer<'_> {
             return Ok(());
         }
         // Per-face materials from GeomSubsets of the materialBind family.
-        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Vec::new() };
+        let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Default::default() };
         let local = if type_name == "Mesh" {
             self.scene.counts.meshes += 1;
             // Texture coordinates only for a mesh whose materials read textures.
             let uv = std::iter::once(material)
-                .chain(face_materials.iter().map(|f| f.1))
+                .chain(face_materials.materials().iter().copied())
                 .find_map(|m| self.scene.materials[m].textures.first().map(|t| t.source.varname.clone()));
             mesh::read(stage, prim, uv.as_deref())?
         } else {
@@ -46,7 +46,7 @@ impl Importer<'_> {
         };
         let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
         for (i, &face) in local.faces.iter().enumerate() {
-            let mat = face_materials.iter().find(|(faces, _)| faces.contains(&(face as i64))).map_or(material, |f| f.1);
+            let mat = face_materials.get(face).unwrap_or(material);
             groups.entry(mat).or_default().push(i);
         }
         let mut keys: Vec<usize> = groups.keys().copied().collect();

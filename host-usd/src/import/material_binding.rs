@@ -6,12 +6,34 @@ use super::Importer;
 use crate::material::Material;
 use crate::stage::{PrimPath, Value};
 use glam::Vec3;
-use std::collections::HashSet;
+use std::collections::HashMap;
+
+/// A mesh's per-face materials from its `materialBind` GeomSubsets that bind a material: where
+/// subsets overlap, the first in namespace order binds the face. One map for all subsets, so
+/// a mesh's faces find theirs in time linear in faces and subsets together.
+#[derive(Default)]
+pub(super) struct FaceMaterials {
+    by_face: HashMap<i64, usize>,
+    /// Each subset's material, in namespace order.
+    materials: Vec<usize>,
+}
+
+impl FaceMaterials {
+    /// The material bound to `face`, if a subset binds one.
+    pub(super) fn get(&self, face: u32) -> Option<usize> {
+        if self.by_face.is_empty() { None } else { self.by_face.get(&i64::from(face)).copied() }
+    }
+
+    /// Each subset's material, in namespace order.
+    pub(super) fn materials(&self) -> &[usize] {
+        &self.materials
+    }
+}
 
 impl Importer<'_> {
-    /// (faces, material) of the mesh's `materialBind` GeomSubsets that bind a material.
-    pub(super) fn subset_materials(&mut self, prim: &PrimPath) -> Result<Vec<(HashSet<i64>, usize)>, String> {
-        let mut out = Vec::new();
+    /// The per-face materials of the mesh's `materialBind` GeomSubsets.
+    pub(super) fn subset_materials(&mut self, prim: &PrimPath) -> Result<FaceMaterials, String> {
+        let mut out = FaceMaterials::default();
         for child in self.stage.children(prim)? {
             if self.stage.type_name(&child)? != "GeomSubset" {
                 continue;
@@ -23,12 +45,13 @@ impl Importer<'_> {
             if self.stage.bound_material(&child)?.is_none() {
                 continue;
             }
-            let faces = match self.stage.value(&child, "indices")? {
-                Some(Value::Numbers { values, .. }) => values.iter().map(|&x| x as i64).collect(),
-                _ => Default::default(),
-            };
             let mat = self.material_for(&child)?;
-            out.push((faces, mat));
+            if let Some(Value::Numbers { values, .. }) = self.stage.value(&child, "indices")? {
+                values.iter().for_each(|&x| {
+                    out.by_face.entry(x as i64).or_insert(mat);
+                });
+            }
+            out.materials.push(mat);
         }
         Ok(out)
     }
