@@ -102,6 +102,25 @@ static SOBOL_TABLES: [[[u32; 256]; 4]; 2] = [byte_tables(0), byte_tables(1)];
 /// with XOR, so these give the reversed point that Owen scrambling starts from.
 static SOBOL_DIM1_REVERSED: [[u32; 256]; 4] = reversed(byte_tables(1));
 
+/// Per dimension, entry m: the point of the index whose m + 1 lowest bits are set (all 32 for
+/// m = 32). From index i to i + 1 the trailing ones of i and the bit above them flip, so by
+/// linearity x(i + 1) = x(i) ⊕ `SOBOL_STEPS[dim][trailing_ones(i)]`.
+static SOBOL_STEPS: [[u32; 33]; 2] = [steps(0), steps(1)];
+
+const fn steps(dim: usize) -> [u32; 33] {
+    let v = generator(dim);
+    let mut t = [0u32; 33];
+    let (mut m, mut x) = (0, 0u32);
+    while m < 33 {
+        if m < 32 {
+            x ^= v[m];
+        }
+        t[m] = x;
+        m += 1;
+    }
+    t
+}
+
 const fn reversed(mut t: [[u32; 256]; 4]) -> [[u32; 256]; 4] {
     let mut b = 0;
     while b < 4 {
@@ -201,9 +220,13 @@ pub fn sobol02_shifted(seed: u64, first: u32, out: &mut [Vec2]) {
     const INV_2_24: f32 = 1.0 / (1u32 << 24) as f32;
     let h = hash_combine(seed, 0x5eed_0002);
     let (s0, s1) = (h as u32, (h >> 32) as u32);
-    for (k, p) in out.iter_mut().enumerate() {
-        let i = first.wrapping_add(k as u32);
-        *p = Vec2::new(((sobol_dim0(i) ^ s0) >> 8) as f32 * INV_2_24, ((sobol_dim1(i) ^ s1) >> 8) as f32 * INV_2_24);
+    // Each point from the one before by a single lookup per dimension (`SOBOL_STEPS`): the same
+    // points as the byte tables give at every index.
+    let (mut x, mut y, mut i) = (sobol_dim0(first) ^ s0, sobol_dim1(first) ^ s1, first);
+    for p in out.iter_mut() {
+        *p = Vec2::new((x >> 8) as f32 * INV_2_24, (y >> 8) as f32 * INV_2_24);
+        let flips = i.trailing_ones() as usize;
+        (x, y, i) = (x ^ SOBOL_STEPS[0][flips], y ^ SOBOL_STEPS[1][flips], i.wrapping_add(1));
     }
 }
 
@@ -310,6 +333,21 @@ mod tests {
                 let x = nested_uniform_scramble(sobol_dim0(i), seq.s0) as f64 * INV_2_32;
                 let y = nested_uniform_scramble(sobol_dim1(i), seq.s1) as f64 * INV_2_32;
                 assert_eq!(*p, DVec2::new(x, y), "point {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_shifted_sequence_is_the_shifted_sobol_points() {
+        let mut pts = [Vec2::ZERO; 300];
+        for first in [0u32, 255, 65_530, 16_777_210, u32::MAX - 299, u32::MAX - 5] {
+            sobol02_shifted(9, first, &mut pts);
+            let h = hash_combine(9, 0x5eed_0002);
+            for (k, p) in pts.iter().enumerate() {
+                let i = first.wrapping_add(k as u32);
+                let at = |x: u32| (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+                let expected = Vec2::new(at(sobol_dim0(i) ^ h as u32), at(sobol_dim1(i) ^ (h >> 32) as u32));
+                assert_eq!(*p, expected, "point {i} from {first}");
             }
         }
     }

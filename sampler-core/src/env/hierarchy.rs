@@ -123,6 +123,14 @@ impl<'a> EnvHierarchy<'a> {
         self.pyramid[pyramid_index(node)] * self.inv_mean
     }
 
+    /// [`node_relative`](Self::node_relative) of the node of `level` whose Morton index within
+    /// its level is `morton`, for callers that carry it down a descent.
+    #[inline]
+    #[must_use]
+    pub fn node_relative_at(&self, level: u32, morton: usize) -> f32 {
+        self.pyramid[level_offset(level) + morton] * self.inv_mean
+    }
+
     /// The 16 grandchildren of a node of level < K − 1, as stored
     /// (not relative to the mean: for ratios), in the Morton order of
     /// [`crate::warp::choose_grandchild`] — one cache line.

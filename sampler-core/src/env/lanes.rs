@@ -27,7 +27,7 @@ pub(crate) const IN_FLIGHT: usize = 64;
 pub(crate) struct WarpLane {
     pub cell: Cell,
     /// Morton index of the cell within its level.
-    pub(super) morton: usize,
+    pub(crate) morton: usize,
     pub xi: DVec2,
     /// False once the descent met a node without mass (or never started).
     pub alive: bool,

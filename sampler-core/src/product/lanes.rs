@@ -74,10 +74,13 @@ impl ProductSampler<'_, '_> {
                 *e = WarpLane::new(t.cell, t.xi);
                 e.alive = t.alive;
             }
+            // Each leaf's Morton code, which the lane computed at its start: `finish` reads the
+            // leaf's environment by it.
+            let leaf_codes = below.map(|e| e.morton);
             self.env.warp_down_lanes(&mut below[..n]);
             let mut landed = [None; WARPS];
-            for ((l, t), e) in landed.iter_mut().zip(&tree[..n]).zip(&below[..n]) {
-                *l = self.finish(t, e);
+            for (k, l) in landed[..n].iter_mut().enumerate() {
+                *l = self.finish(&tree[k], &below[k], leaf_codes[k]);
             }
             // The defensive samples' densities: the product's descents side by side.
             let (mut points, mut which, mut count) = ([Vec2::ZERO; WARPS], [0; WARPS], 0);
@@ -129,12 +132,20 @@ impl ProductSampler<'_, '_> {
     /// The sample's point at the end of a tree descent `t` and the environment descent `e` below
     /// it, with its density (solid angle) as [`sample`](Self::sample) computes it — except for
     /// defensive samples, whose density (0 here) the caller looks up for a batch at once.
-    fn finish(&self, t: &TreeLane, e: &WarpLane) -> Option<(Vec2, f32)> {
+    /// `leaf_code`: the leaf's Morton index within its level (meaningful above the finest).
+    fn finish(&self, t: &TreeLane, e: &WarpLane, leaf_code: usize) -> Option<(Vec2, f32)> {
         if !t.alive || !e.alive {
             return None;
         }
         let (uv, pdf_square) = if t.defensive {
             (e.cell.point(e.xi), 0.0)
+        } else if t.cell.level < self.env.finest_level() {
+            // `land`'s values by the Morton codes the lane carries, the texel's at its end:
+            // no code recomputed from a cell.
+            let texel = self.env.node_relative_at(e.cell.level, e.morton);
+            let leaf_env = self.env.node_relative_at(t.cell.level, leaf_code);
+            let product = self.density_below_leaf(t.path, t.cell, leaf_env, texel);
+            (e.cell.point(e.xi), self.mixture(product, texel))
         } else {
             // Below a leaf finer than the map the env lane did not move: its cell and point are
             // the leaf's.

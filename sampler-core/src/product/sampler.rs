@@ -149,13 +149,19 @@ impl<'e> ProductSampler<'_, 'e> {
     /// whose texel has relative importance `texel`: the leaf's share spread over its area, and
     /// below it the environment's texels in proportion to their importance.
     pub(crate) fn leaf_density(&self, path: f64, leaf: Cell, texel: f32) -> f64 {
-        let area = leaf.inverse_area();
         if leaf.level < self.env.finest_level() {
-            let leaf_env = self.env.node_relative(leaf) as f64;
-            if leaf_env > 0.0 { path * area * texel as f64 / leaf_env } else { 0.0 }
+            self.density_below_leaf(path, leaf, self.env.node_relative(leaf), texel)
         } else {
-            path * area
+            path * leaf.inverse_area()
         }
+    }
+
+    /// [`leaf_density`](Self::leaf_density) in a leaf coarser than the map whose environment
+    /// (relative to the mean) is `leaf_env`, for callers that know it.
+    #[inline]
+    pub(crate) fn density_below_leaf(&self, path: f64, leaf: Cell, leaf_env: f32, texel: f32) -> f64 {
+        let (area, leaf_env) = (leaf.inverse_area(), leaf_env as f64);
+        if leaf_env > 0.0 { path * area * texel as f64 / leaf_env } else { 0.0 }
     }
 
     /// The product's density per unit square area at `uv`, from the product of the branch
