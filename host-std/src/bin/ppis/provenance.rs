@@ -9,6 +9,8 @@
 
 use crate::render_cmd::RenderArgs;
 use anyhow::{Context, Result};
+use clap::ValueEnum;
+use host_std::light::lights::LightSelection;
 use host_std::plan::Settings;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -49,6 +51,18 @@ pub(crate) fn settings_text(
     lines.push(("brdf_samples", settings.brdf_samples.to_string()));
     lines.push(("seed", settings.seed.to_string()));
     lines.push(("shadows", settings.shadows.to_string()));
+    let lights = &settings.lights;
+    let selection = match lights.selection {
+        LightSelection::Tree => "tree",
+        LightSelection::Power => "power",
+    };
+    lines.push(("light_selection", selection.into()));
+    // Floats as Rust writes them: the shortest text that reads back to the same bits.
+    lines.push(("light_share", lights.share.to_string()));
+    lines.push(("sis_lights", lights.sis_lights.to_string()));
+    lines.push(("lightcut_error", lights.lightcut_error.to_string()));
+    let carrier = args.sampling.carrier().to_possible_value().map(|v| v.get_name().to_string());
+    lines.push(("distant_carrier", carrier.unwrap_or_default()));
     // By name and content, not by folder or order: the same inputs on any machine.
     let own = scene.scene.as_ref().and_then(|p| p.canonicalize().ok());
     let mut reads = Vec::new();
