@@ -217,7 +217,7 @@ fn a_suns_carrier_is_measured_once_and_the_same_at_any_thread_count() {
             .current_dir(dir)
             .arg("render")
             .arg(&scene)
-            .args(["--width", "40", "--height", "24", "--spp", "8", "--threads", threads])
+            .args(["--width", "40", "--height", "24", "--spp", "8", "--shading-points", "2", "--threads", threads])
             .args(["--distant-carrier", carrier, "-o"])
             .arg(format!("{carrier}{threads}.exr"))
             .output()
@@ -232,7 +232,12 @@ fn a_suns_carrier_is_measured_once_and_the_same_at_any_thread_count() {
     let (cone, map) = (render("1", "cone"), render("1", "map"));
     assert!(!cone.1.contains("distant light:") && cone.0 != map.0, "a given carrier runs no pilot");
     let chosen = if said.contains("carried by the environment map") { &map.0 } else { &cone.0 };
-    assert!(one == *chosen, "auto renders the image of the carrier it names");
+    assert!(one == *chosen, "auto renders the image of the carrier it names, and records it");
+    // Tiles of the carrier `auto` chose merge with tiles given it, not with the other's.
+    let other = if said.contains("carried by the environment map") { "cone" } else { "map" };
+    let merged = ppis().current_dir(dir).args(["merge", "auto1.exr", &format!("{other}1.exr"), "-o", "m.exr"]).output();
+    let stderr = String::from_utf8_lossy(&merged.unwrap().stderr).into_owned();
+    assert!(stderr.contains(&format!("(distant_carrier={other} against distant_carrier=")), "{stderr}");
 }
 
 /// Runs `ppis report` on a tiny image (24×14, 2 samples per shading point, a 16-spp rendered

@@ -81,7 +81,6 @@ fn a_merge_refuses_overlapping_missing_foreign_and_truncated_tiles() {
     }
     run(dir, &with(&FRAME, &["--crop", "40,0,64,48", "--seed", "9", "-o", "seed9.exr"]));
     run(dir, &with(&FRAME, &["--crop", "40,0,64,48", "--light-share", "0.25", "-o", "share.exr"]));
-    run(dir, &with(&FRAME, &["--crop", "40,0,64,48", "--distant-carrier", "map", "-o", "carrier.exr"]));
     run(
         dir,
         &["render", "--width", "64", "--height", "40", "--spp", "4", "--crop", "40,0,64,40", "-o", "short.exr"]
@@ -102,7 +101,6 @@ fn a_merge_refuses_overlapping_missing_foreign_and_truncated_tiles() {
         &["left.exr", "share.exr"],
         "share.exr: a tile of another render than left.exr (light_share=0.25 against light_share=0.5)",
     );
-    fails_m(&["left.exr", "carrier.exr"], "(distant_carrier=map against distant_carrier=auto)");
     fails_m(&["left.exr", "short.exr"], "short.exr: a tile of another render than left.exr (a 64×40 frame");
     let bytes = std::fs::read(dir.join("rest.exr")).unwrap();
     std::fs::write(dir.join("cut.exr"), &bytes[..bytes.len() * 2 / 3]).unwrap();

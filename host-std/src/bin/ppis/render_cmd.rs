@@ -96,6 +96,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         lights: args.sampling.lights(),
     };
     let points = args.sampling.shading_points.map_or(ShadingPoints::Rule, |p| ShadingPoints::Given(p as usize));
+    let carries = prepared.environment.is_some() && carrier::has_wide_distant_light(&prepared.scene);
     let carrier = pool.install(|| carry_distant_lights(args.sampling.carrier(), &mut prepared, &settings, points));
     let lighting = Lighting::of(prepared.environment.is_some(), prepared.scene.lights.len());
     let shading_points = points.resolve(args.method, args.spp as usize, lighting) as u32;
@@ -103,7 +104,8 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
-    let record = provenance::settings_text(&args, &settings, frame, &prepared.files)?;
+    let used = carries.then(|| carrier.as_ref().map_or(args.sampling.carrier(), |c| c.carrier));
+    let record = provenance::settings_text(&args, &settings, frame, &prepared.files, used)?;
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
     let mut image =
         pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
