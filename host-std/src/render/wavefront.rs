@@ -142,8 +142,10 @@ pub(crate) fn shade_wavefront(
     // The shadow rays, all at once.
     buffers.rays.clear();
     let per_point = layout.len();
-    for (k, c) in buffers.candidates.iter().enumerate().filter(|(_, c)| c.needs_ray) {
-        buffers.rays.push(ShadowRay { origin: origins[k / per_point], dir: c.dir, t_min: 0.0, t_max: f32::INFINITY });
+    for (candidates, &origin) in buffers.candidates.chunks(per_point).zip(origins) {
+        for c in candidates.iter().filter(|c| c.needs_ray) {
+            buffers.rays.push(ShadowRay { origin, dir: c.dir, t_min: 0.0, t_max: f32::INFINITY });
+        }
     }
     buffers.blocked.clear();
     buffers.blocked.resize(buffers.rays.len(), false);

@@ -16,6 +16,7 @@ use crate::brdf::{Brdf, BrdfSample};
 use crate::direction::{DirectionSample, DirectionSampler};
 use crate::estimator::{ShadingPoint, times};
 use crate::mapping::SPHERE_AREA;
+use core::ops::Range;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 /// Samples drawn together: the sampler's descents and the map's lookups of this many samples
@@ -115,14 +116,22 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     // while the sampler's descents below run.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
     let mut dirs = [Vec3::Z; WAVE];
+    let mut u_brdf = [Vec2::ZERO; WAVE];
+    let mut brdf_points = [0usize; WAVE];
     let mut n_brdf = 0;
     for s in samples.iter().filter(|s| s.technique == Technique::Brdf) {
-        let sp = &points[s.point];
-        sp.brdf.sample_many(sp.frame.to_local(sp.wo), &[s.u.as_vec2()], &mut brdf[n_brdf..n_brdf + 1]);
-        if let Some(b) = brdf[n_brdf] {
-            dirs[n_brdf] = sp.frame.to_world(b.wi);
-        }
+        (u_brdf[n_brdf], brdf_points[n_brdf]) = (s.u.as_vec2(), s.point);
         n_brdf += 1;
+    }
+    // Each shading point's draws in one call: the BRDF's per-view work is done once per point.
+    for run in point_runs(&brdf_points[..n_brdf]) {
+        let sp = &points[brdf_points[run.start]];
+        sp.brdf.sample_many(sp.frame.to_local(sp.wo), &u_brdf[run.clone()], &mut brdf[run.clone()]);
+        for (d, b) in dirs[run.clone()].iter_mut().zip(&brdf[run]) {
+            if let Some(b) = b {
+                *d = sp.frame.to_world(b.wi);
+            }
+        }
     }
     let mut uvs = [Vec2::ZERO; WAVE];
     env.squares_of(&dirs[..n_brdf], &mut uvs[..n_brdf]);
@@ -131,10 +140,11 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
     // The sampler's draws, all in one batch (its descents side by side).
     let mut u_sampler = [DVec2::ZERO; WAVE];
+    let mut sampler_points = [0usize; WAVE];
     let mut drawn = [None; WAVE];
     let mut n_sampler = 0;
     for s in samples.iter().filter(|s| s.technique == Technique::Sampler) {
-        u_sampler[n_sampler] = s.u;
+        (u_sampler[n_sampler], sampler_points[n_sampler]) = (s.u, s.point);
         n_sampler += 1;
     }
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
@@ -146,6 +156,18 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     let mut p_square = [0.0f32; WAVE];
     if weighting != Weighting::Single {
         sampler.pdf_square_many(&uvs[..n_brdf], &mut p_square[..n_brdf]);
+    }
+    // Under MIS the BRDF's value and density at the sampler's draws, each point's in one call.
+    let mut evaluated = [(Vec3::ZERO, 0.0f32); WAVE];
+    if weighting != Weighting::Single {
+        let mut local = [Vec3::Z; WAVE];
+        for run in point_runs(&sampler_points[..n_sampler]) {
+            let sp = &points[sampler_points[run.start]];
+            for (l, d) in local[run.clone()].iter_mut().zip(&drawn[run.clone()]) {
+                *l = d.map_or(Vec3::Z, |d| sp.frame.to_local(d.dir));
+            }
+            sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[run.clone()], &mut evaluated[run]);
+        }
     }
     let mut radiance_brdf = [Vec3::ZERO; WAVE];
     for (r, uv) in radiance_brdf.iter_mut().zip(&uvs[..n_brdf]) {
@@ -159,7 +181,9 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
             Technique::Sampler => {
                 let k = i_sampler;
                 i_sampler += 1;
-                drawn[k].map_or(Candidate::default(), |d| sampler_candidate(sp, d, env.radiance_at(d.uv), weighting))
+                drawn[k].map_or(Candidate::default(), |d| {
+                    sampler_candidate(sp, d, env.radiance_at(d.uv), evaluated[k], weighting)
+                })
             }
             Technique::Brdf => {
                 let k = i_brdf;
@@ -179,21 +203,32 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
 }
 
+/// The ranges of equal consecutive entries of `owners`: the samples of one shading point.
+fn point_runs(owners: &[usize]) -> impl Iterator<Item = Range<usize>> + '_ {
+    let mut start = 0;
+    core::iter::from_fn(move || {
+        let first = *owners.get(start)?;
+        let end = start + owners[start..].iter().take_while(|&&p| p == first).count();
+        let run = start..end;
+        start = end;
+        Some(run)
+    })
+}
+
 /// The candidate of a direction the sampler drew at `sp`, where the map's radiance is
-/// `radiance`.
+/// `radiance` and, under MIS, the BRDF × cos and the BRDF's density there are `evaluated`.
 #[inline]
 fn sampler_candidate<B: Brdf + ?Sized>(
     sp: &ShadingPoint<'_, B>,
     d: DirectionSample,
     radiance: Vec3,
+    evaluated: (Vec3, f32),
     weighting: Weighting,
 ) -> Candidate {
     if weighting == Weighting::Single {
         return Candidate::new(times(radiance, sp.eval(d.dir)), d.pdf, d.dir);
     }
-    let mut evaluated = [(Vec3::ZERO, 0.0)];
-    sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &[sp.frame.to_local(d.dir)], &mut evaluated);
-    let (b, p_brdf) = evaluated[0];
+    let (b, p_brdf) = evaluated;
     let pdf = match weighting {
         Weighting::Split { sampler, brdf } => sampler * d.pdf + brdf * p_brdf,
         _ => d.pdf + p_brdf,
