@@ -2485,6 +2485,15 @@ impl<'a, 'f> Indexer<'a, 'f> {
     ) -> Option<NodeId> {
         let parent_is_relocate = self.node(parent).arc == ArcType::Relocate
             || (!self.root_contributes && parent == self.output.local_root());
+        // A large graph with no node at the site has no such child: the common
+        // case, a new class, needs no scan of the parent's children.
+        if !parent_is_relocate {
+            if let Some(sites) = self.output.site_index() {
+                if !sites.nodes_at(path).iter().any(|&c| self.node(c).layer_id() == rep_layer) {
+                    return None;
+                }
+            }
+        }
         let origin_depth = self.output.depth_below_introduction(origin);
         self.node(parent).children().iter().copied().find(|&c| {
             let cn = self.node(c);
