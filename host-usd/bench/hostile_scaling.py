@@ -4,7 +4,8 @@
 Each shape puts N of one thing where a real asset has a few: properties on one prim, children
 of one prim, time samples of one attribute, relationship targets, attribute connections,
 entries of one dictionary, variants of one variant set, variant sets of one prim (each
-selected), classes one prim inherits, apiSchemas entries, sublayers and
+selected), classes one prim inherits or specializes, prims it references in its own layer,
+apiSchemas entries, sublayers and
 references (each to a small file of its own). For each shape and N, `ppis info FILE` is run
 R times and the least user CPU time is printed (the kernel's time is mostly opening files),
 with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
@@ -68,6 +69,18 @@ def inherits(n):
     return f'#usda 1.0\n{classes}def Xform "P" (\n    prepend inherits = [{body}]\n)\n{{\n}}\n'
 
 
+def specializes(n):
+    classes = "".join(f'class "C{i}"\n{{\n    float a{i} = {i}\n}}\n' for i in range(n))
+    body = ", ".join(f"</C{i}>" for i in range(n))
+    return f'#usda 1.0\n{classes}def Xform "P" (\n    prepend specializes = [{body}]\n)\n{{\n}}\n'
+
+
+def internal_references(n):
+    prims = "".join(f'def Xform "R{i}"\n{{\n    float a{i} = {i}\n}}\n' for i in range(n))
+    body = ", ".join(f"</R{i}>" for i in range(n))
+    return f'#usda 1.0\n{prims}def Xform "P" (\n    prepend references = [{body}]\n)\n{{\n}}\n'
+
+
 def api_schemas(n):
     body = ", ".join(f'"S{i}API"' for i in range(n))
     return f'#usda 1.0\ndef Xform "P" (\n    prepend apiSchemas = [{body}]\n)\n{{\n}}\n'
@@ -93,7 +106,8 @@ def references(n, out):
 
 SHAPES = {"props": props, "children": children, "samples": samples, "targets": targets,
           "connections": connections, "dictionary": dictionary, "variants": variants,
-          "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas}
+          "variantSets": variant_sets, "inherits": inherits, "specializes": specializes,
+          "internalReferences": internal_references, "apiSchemas": api_schemas}
 FILE_SHAPES = {"sublayers": sublayers, "references": references}
 
 
