@@ -4,11 +4,13 @@
 Each shape puts N of one thing where a real asset has a few: properties on one prim, children
 of one prim, time samples of one attribute, relationship targets, attribute connections,
 entries of one dictionary, variants of one variant set, variant sets of one prim (each
-selected), classes one prim inherits, apiSchemas entries, GeometryLights (each taking a
-mesh met before it out of the surfaces), a PointInstancer's prototypes (each a root prim
-beside it), a mesh's materialBind GeomSubsets (one face and material each), sublayers and
+selected), classes one prim inherits or specializes, prims it references in its own layer,
+apiSchemas entries, GeometryLights (each taking a mesh met before it out of the surfaces), a
+PointInstancer's prototypes (each a root prim beside it), a mesh's materialBind GeomSubsets (one
+face and material each), sublayers and
 references (each to a small file of its own). For each shape and N, `ppis info FILE` is run
-R times and the least user CPU time is printed (the kernel's time is mostly opening files), with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
+R times and the least user CPU time is printed (the kernel's time is mostly opening files),
+with the exponent of its growth from each size to the next: log(t2 / t1) / log(n2 / n1), 1
 for linear growth, 2 for quadratic (shown where the smaller time is 0.02 s or more).
 
     python3 host-usd/bench/hostile_scaling.py PPIS DIR [--sizes 1000,10000,100000] [--repeat R]
@@ -102,6 +104,18 @@ def subsets(n):
     return "#usda 1.0\n" + "".join(material.format(i=i) for i in range(n)) + mesh
 
 
+def specializes(n):
+    classes = "".join(f'class "C{i}"\n{{\n    float a{i} = {i}\n}}\n' for i in range(n))
+    body = ", ".join(f"</C{i}>" for i in range(n))
+    return f'#usda 1.0\n{classes}def Xform "P" (\n    prepend specializes = [{body}]\n)\n{{\n}}\n'
+
+
+def internal_references(n):
+    prims = "".join(f'def Xform "R{i}"\n{{\n    float a{i} = {i}\n}}\n' for i in range(n))
+    body = ", ".join(f"</R{i}>" for i in range(n))
+    return f'#usda 1.0\n{prims}def Xform "P" (\n    prepend references = [{body}]\n)\n{{\n}}\n'
+
+
 def api_schemas(n):
     body = ", ".join(f'"S{i}API"' for i in range(n))
     return f'#usda 1.0\ndef Xform "P" (\n    prepend apiSchemas = [{body}]\n)\n{{\n}}\n'
@@ -127,9 +141,9 @@ def references(n, out):
 
 SHAPES = {"props": props, "children": children, "samples": samples, "targets": targets,
           "connections": connections, "dictionary": dictionary, "variants": variants,
-          "variantSets": variant_sets, "inherits": inherits, "apiSchemas": api_schemas,
-          "geometryLights": geometry_lights, "prototypes": prototypes,
-          "subsets": subsets}
+          "variantSets": variant_sets, "inherits": inherits, "specializes": specializes,
+          "internalReferences": internal_references, "apiSchemas": api_schemas,
+          "geometryLights": geometry_lights, "prototypes": prototypes, "subsets": subsets}
 FILE_SHAPES = {"sublayers": sublayers, "references": references}
 
 

@@ -2,8 +2,9 @@
 //!
 //! Each shape puts `n` of one thing on one prim where a real asset has a few: properties,
 //! children, time samples, relationship targets, connections, dictionary entries, variants,
-//! variant sets (each selected), inherited classes, apiSchemas entries, sublayers,
-//! references, a PointInstancer's prototypes (each a root prim beside it). Importing the shape at `8n` once must take less than 3.75 times the CPU time
+//! variant sets (each selected), inherited and specialized classes, internal references,
+//! apiSchemas entries, sublayers, references, a PointInstancer's prototypes (each a root prim
+//! beside it). Importing the shape at `8n` once must take less than 3.75 times the CPU time
 //! of importing it at `n` eight times (a ratio under 30 for 8× the size): linear growth
 //! gives about 1, quadratic 8. Only user CPU time of the import itself counts (not writing
 //! the files, not the kernel's file opens), summed over the process's threads since the
@@ -92,6 +93,16 @@ fn write_shape(shape: &str, n: usize, dir: &Path) -> std::path::PathBuf {
             list(n, |i| format!("({i}, 0, 0)")),
             lines(n, |i| format!("def Sphere \"s{i}\"\n{{\n}}"))
         ),
+        "specializes" => format!(
+            "#usda 1.0\n{}def Xform \"P\" (\n    prepend specializes = [{}]\n)\n{{\n}}\n",
+            lines(n, |i| format!("class \"C{i}\"\n{{\n    float a{i} = {i}\n}}")),
+            list(n, |i| format!("</C{i}>"))
+        ),
+        "internal references" => format!(
+            "#usda 1.0\n{}def Xform \"P\" (\n    prepend references = [{}]\n)\n{{\n}}\n",
+            lines(n, |i| format!("def Xform \"R{i}\"\n{{\n    float a{i} = {i}\n}}")),
+            list(n, |i| format!("</R{i}>"))
+        ),
         "apiSchemas" => prim(&format!("    prepend apiSchemas = [{}]", list(n, |i| format!("\"S{i}API\""))), ""),
         "sublayers" => {
             for i in 0..n {
@@ -153,6 +164,8 @@ fn import_time_grows_linearly_with_hostile_sizes() {
         ("variants", 4_000),
         ("variant sets", 1_000),
         ("inherits", 1_000),
+        ("specializes", 1_000),
+        ("internal references", 1_000),
         ("apiSchemas", 40_000),
         ("prototypes", 500),
         ("sublayers", 500),

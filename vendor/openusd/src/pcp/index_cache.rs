@@ -1951,7 +1951,10 @@ impl IndexCache {
             }
         }
 
+        // (ppis patch.) The targets keep their first-seen order; a set answers
+        // whether one is already listed, so a prim of many classes is linear.
         let mut targets_to_cache = Vec::new();
+        let mut listed = HashSet::new();
         for (scan_path, scan_layer) in &nodes_to_scan {
             for field in [FieldKey::InheritPaths, FieldKey::Specializes] {
                 let Ok(val) = graph.layer(*scan_layer).data().get_field(scan_path, field.as_str()) else {
@@ -1970,12 +1973,12 @@ impl IndexCache {
                     let arcs = ancestor_arcs.get_or_insert_with(|| self.collect_ancestor_arcs(&parent));
                     for a in arcs.iter() {
                         if let Some(composed) = a.map.map_source_to_target(&raw) {
-                            if composed != raw && !targets_to_cache.contains(&composed) {
+                            if composed != raw && listed.insert(composed.clone()) {
                                 targets_to_cache.push(composed);
                             }
                         }
                     }
-                    if !targets_to_cache.contains(&raw) {
+                    if listed.insert(raw.clone()) {
                         targets_to_cache.push(raw);
                     }
                 }

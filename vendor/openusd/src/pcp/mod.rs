@@ -304,6 +304,7 @@ pub(crate) mod prim_indexer;
 pub(crate) mod prim_resolve;
 mod property_kinds;
 mod relocates;
+mod site_index;
 
 use crate::sdf::schema::FieldKey;
 use crate::sdf::{self, Path, Value};

@@ -13,6 +13,7 @@ use crate::sdf::{LayerOffset, Path};
 
 use super::layer_stack::LayerStackId;
 use super::mapping::MapFunction;
+use super::site_index::{SiteIndex, SITE_INDEX_MIN_NODES};
 use super::LayerId;
 
 /// Whether an arc introduces a class hierarchy node — an inherit or a
@@ -397,6 +398,10 @@ pub(crate) struct PrimIndexGraph {
     /// Like `muted_external_targets`, the skipped arc is separately surfaced as an
     /// [`Error::MutedAssetPath`](super::Error::MutedAssetPath).
     pub(crate) muted_unloaded_targets: Vec<String>,
+    /// The nodes by site path, once the graph is large enough to need it (see
+    /// [`SiteIndex`]); kept in step by the appends of the build and dropped when
+    /// the build finishes or the sites move.
+    pub(crate) sites: Option<Box<SiteIndex>>,
 }
 
 impl PrimIndexGraph {
@@ -444,6 +449,7 @@ impl PrimIndexGraph {
         node.namespace_depth = depth;
         node.flags |= NodeFlags::INERT;
         self.nodes.push(node);
+        self.index_last_site();
         self.root = id;
         id
     }
@@ -510,7 +516,25 @@ impl PrimIndexGraph {
             self.nodes[struct_parent.idx()].children.push(idx);
         }
         self.nodes.push(node);
+        self.index_last_site();
         idx
+    }
+
+    /// Adds the node just appended to the site index, building the index once
+    /// the graph reaches [`SITE_INDEX_MIN_NODES`] (or again if a node was
+    /// appended past it).
+    fn index_last_site(&mut self) {
+        let len = self.nodes.len();
+        match &mut self.sites {
+            Some(sites) if sites.covers(len - 1) => sites.push(NodeId(len as u32 - 1), &self.nodes[len - 1].path),
+            _ if len >= SITE_INDEX_MIN_NODES => self.sites = Some(Box::new(SiteIndex::build(&self.nodes))),
+            _ => {}
+        }
+    }
+
+    /// The site index when it covers every node of the arena.
+    pub(crate) fn site_index(&self) -> Option<&SiteIndex> {
+        self.sites.as_deref().filter(|sites| sites.covers(self.nodes.len()))
     }
 
     /// Finds a non-inert, non-culled node already on this graph whose site
@@ -520,15 +544,23 @@ impl PrimIndexGraph {
     /// site.layerStack` test). The task-queue indexer uses this for opt-in
     /// duplicate-node skipping by the class-based arcs (inherits/specializes);
     /// reference/payload arcs keep diamonds.
+    ///
+    /// A large graph answers from its [`SiteIndex`]: the first candidate at
+    /// `path` in arena order that still matches is the node the scan finds.
     pub(crate) fn node_using_site(&self, layer_stack: LayerStackId, path: &Path) -> Option<NodeId> {
-        self.nodes
-            .iter()
-            .position(|node| {
-                !node.flags.intersects(NodeFlags::INERT | NodeFlags::CULLED)
-                    && node.layer_stack == layer_stack
-                    && &node.path == path
-            })
-            .map(|i| NodeId(i as u32))
+        let uses_site = |node: &Node| {
+            !node.flags.intersects(NodeFlags::INERT | NodeFlags::CULLED)
+                && node.layer_stack == layer_stack
+                && &node.path == path
+        };
+        if let Some(sites) = self.site_index() {
+            return sites
+                .nodes_at(path)
+                .iter()
+                .copied()
+                .find(|&id| uses_site(&self.nodes[id.idx()]));
+        }
+        self.nodes.iter().position(uses_site).map(|i| NodeId(i as u32))
     }
 
     /// Deepens every node's site path by one namespace element, from the parent
@@ -547,6 +579,8 @@ impl PrimIndexGraph {
         let Some(child_name) = child_path.name() else {
             return;
         };
+        // Every site moves: the index is rebuilt by the next append that needs it.
+        self.sites = None;
         for node in &mut self.nodes {
             if node.path == parent_path {
                 node.path = child_path.clone();
@@ -987,6 +1021,8 @@ impl PrimIndexGraph {
     /// arena order — never the projection being computed — so it is well-defined
     /// here.
     pub(crate) fn finalize_strength_order(&mut self) {
+        // The build is over: a stored index carries no site map.
+        self.sites = None;
         if !self.root.is_valid() {
             return;
         }

@@ -2485,6 +2485,22 @@ impl<'a, 'f> Indexer<'a, 'f> {
     ) -> Option<NodeId> {
         let parent_is_relocate = self.node(parent).arc == ArcType::Relocate
             || (!self.root_contributes && parent == self.output.local_root());
+        // A node is among `parent`'s children exactly when its parent is `parent`,
+        // so a large graph finds the children at the site among the nodes there;
+        // only two or more need the scan to tell which comes first.
+        if !parent_is_relocate {
+            if let Some(sites) = self.output.site_index() {
+                let mut at_site = sites.nodes_at(path).iter().copied().filter(|&c| {
+                    let cn = self.node(c);
+                    cn.parent() == Some(parent) && cn.layer_id() == rep_layer
+                });
+                match (at_site.next(), at_site.next()) {
+                    (None, _) => return None,
+                    (Some(only), None) => return Some(only),
+                    _ => {}
+                }
+            }
+        }
         let origin_depth = self.output.depth_below_introduction(origin);
         self.node(parent).children().iter().copied().find(|&c| {
             let cn = self.node(c);
