@@ -105,6 +105,9 @@ impl DirectionSampler for TwoLevelSampler<'_, '_> {
     fn pdf(&self, dir: Vec3) -> f32 {
         TwoLevelSampler::pdf(self, dir)
     }
+    fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
+        TwoLevelSampler::sample_many(self, u, out)
+    }
 }
 
 impl<const R: usize> DirectionSampler for TwoStageSampler<'_, '_, R> {

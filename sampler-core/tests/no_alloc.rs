@@ -109,6 +109,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
             sink += estimator::sampled(&two, &sp, u, &mut vis).value.x;
             let [a, b] = estimator::sampled_mis(&two, &sp, u, u.as_vec2(), &mut vis);
             sink += a.value.x + b.value.x;
+            let mut many = [None; 4];
+            two.sample_many(&points, &mut many);
+            sink += many.iter().flatten().map(|d| f64::from(d.pdf)).sum::<f64>();
         }
         sink += batched(&sampler, &env, &sp, &points, &mut vis);
         sink += wavefront(&sampler, &sp, &points);

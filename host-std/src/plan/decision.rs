@@ -3,7 +3,7 @@
 //! the scores' own standard error (`plan::pilot`'s note says why each margin is what it is).
 
 use crate::plan::candidates::{PLANS, candidate_of};
-use crate::plan::pilot::{COSTLIER_OVERRIDE_MARGIN, OVERRIDE_MARGIN, SEPARATION};
+use crate::plan::pilot::{COSTLIER_FROM, COSTLIER_OVERRIDE_MARGIN, OVERRIDE_MARGIN, SEPARATION};
 use crate::render::strategy::Strategy;
 
 /// A candidate's pilot score: relative variance × cost per shading point, the mean of its
@@ -45,7 +45,7 @@ impl Score {
 /// with BRDF samples (see the module's note). Where the rule's plan was not measured or not
 /// trusted, the best, unless it does not separate from plain MIS: then MIS. `None` when
 /// nothing was scored.
-pub(crate) fn decide(scores: &[Option<Score>], rule: Option<usize>, samples_per_point: usize) -> Option<usize> {
+pub(crate) fn decide(scores: &[Option<Score>], rule: Option<usize>) -> Option<usize> {
     let values = without_unproven_env(&scores.iter().map(|s| s.as_ref().map(|s| s.value)).collect::<Vec<_>>());
     let (best, best_value) =
         values.iter().enumerate().filter_map(|(c, s)| s.map(|s| (c, s))).min_by(|a, b| a.1.total_cmp(&b.1))?;
@@ -57,7 +57,7 @@ pub(crate) fn decide(scores: &[Option<Score>], rule: Option<usize>, samples_per_
     match rule.and_then(|r| values[r].map(|s| (r, s))) {
         Some((r, rule_value)) => {
             let margin = |c: usize| {
-                let costlier = PLANS[c].cost_at(samples_per_point) > PLANS[r].cost_at(samples_per_point);
+                let costlier = PLANS[c].cost > COSTLIER_FROM * PLANS[r].cost;
                 if costlier { COSTLIER_OVERRIDE_MARGIN } else { OVERRIDE_MARGIN }
             };
             let beats_rule = |c: usize, value: f64| value * margin(c) < rule_value;
@@ -204,53 +204,53 @@ mod tests {
         };
         // The rule's MIS scores 2.5 on every pixel; product-MIS 1.0 on average, from one pixel.
         let scores = [None, None, steady(2.5), None, lucky(1.0), None, None];
-        assert_eq!(decide(&scores, Some(2), 4), Some(2), "2.5× as good, but not separated");
+        assert_eq!(decide(&scores, Some(2)), Some(2), "2.5× as good, but not separated");
         let scores = [None, None, steady(2.5), None, steady(1.0), None, None];
-        assert_eq!(decide(&scores, Some(2), 4), Some(4), "2.5× as good on every pixel");
+        assert_eq!(decide(&scores, Some(2)), Some(4), "2.5× as good on every pixel");
         // Towards plain MIS, the baseline, the margin alone decides.
         let scores = [None, None, lucky(1.0), steady(2.0), None, None, None];
-        assert_eq!(decide(&scores, Some(3), 4), Some(2), "MIS 1:1 against the rule's MIS 3:1");
+        assert_eq!(decide(&scores, Some(3)), Some(2), "MIS 1:1 against the rule's MIS 3:1");
         let scores = [None, None, lucky(1.7), steady(2.0), None, None, None];
-        assert_eq!(decide(&scores, Some(3), 4), Some(3), "within the margin: the rule's");
+        assert_eq!(decide(&scores, Some(3)), Some(3), "within the margin: the rule's");
         // A plan the rule's beats by far, and MIS past the margin: MIS.
         let scores = [None, None, steady(1.5), steady(2.0), lucky(0.8), None, None];
-        assert_eq!(decide(&scores, Some(3), 4), Some(2), "product-MIS not separated; MIS by the margin");
+        assert_eq!(decide(&scores, Some(3)), Some(2), "product-MIS not separated; MIS by the margin");
         // The rule's plan not trusted: plain MIS unless the best separates from it.
         let mut lucky = vec![0.5; 32];
         lucky[3] = 10.0;
         let scores = [Some(Score::new(lucky)), None, steady(1.2), None, None, None, None];
-        assert_eq!(decide(&scores, Some(1), 4), Some(2), "env not separated from MIS: MIS");
+        assert_eq!(decide(&scores, Some(1)), Some(2), "env not separated from MIS: MIS");
         let scores = [steady(0.5), None, steady(1.2), None, None, None, None];
-        assert_eq!(decide(&scores, Some(1), 4), Some(0), "env separated: env");
+        assert_eq!(decide(&scores, Some(1)), Some(0), "env separated: env");
     }
 
     #[test]
     fn the_rules_plan_stands_unless_another_is_measured_better_by_the_margin() {
         // In PLANS' order: env, brdf, mis, mis 3:1, product-mis, product-mis 3:1, two-level-mis.
         let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(5.2)];
-        assert_eq!(decide(&scored(&scores), Some(3), 4), Some(0), "5.1 against 4.0: overridden");
+        assert_eq!(decide(&scored(&scores), Some(3)), Some(0), "5.1 against 4.0: overridden");
         let scores = [Some(4.0), None, Some(9.0), Some(5.1), None, Some(4.9)];
-        assert_eq!(decide(&scored(&scores), Some(5), 4), Some(5), "4.9 against 4.0: kept");
+        assert_eq!(decide(&scored(&scores), Some(5)), Some(5), "4.9 against 4.0: kept");
         let close = [Some(4.5), None, Some(9.0), Some(5.6), None, None];
-        assert_eq!(decide(&scored(&close), Some(3), 4), Some(3), "5.6 against 4.5: kept");
+        assert_eq!(decide(&scored(&close), Some(3)), Some(3), "5.6 against 4.5: kept");
         let clear = [Some(4.0), None, Some(9.0), Some(5.6), None, None];
         // Product-MIS costs more than MIS: it replaces the rule's MIS only when twice as good.
         let product = [None, None, Some(9.0), None, Some(5.0), None];
-        assert_eq!(decide(&scored(&product), Some(2), 4), Some(2), "5.0 against 9.0, costlier: kept");
+        assert_eq!(decide(&scored(&product), Some(2)), Some(2), "5.0 against 9.0, costlier: kept");
         let product = [None, None, Some(9.0), None, Some(4.4), None];
-        assert_eq!(decide(&scored(&product), Some(2), 4), Some(4), "4.4 against 9.0, costlier: overridden");
+        assert_eq!(decide(&scored(&product), Some(2)), Some(4), "4.4 against 9.0, costlier: overridden");
         // MIS costs less than product-MIS: it replaces the rule's product-MIS at the lower margin.
         let cheaper = [None, None, Some(5.0), None, Some(6.5), None];
-        assert_eq!(decide(&scored(&cheaper), Some(4), 4), Some(2), "5.0 against 6.5, cheaper: overridden");
-        assert_eq!(decide(&scored(&clear), Some(1), 4), Some(0), "the rule's plan not trusted: the best");
-        assert_eq!(decide(&scored(&clear), None, 4), Some(0), "no rule: the best");
-        assert_eq!(decide(&scored(&[None; 7]), Some(2), 4), None);
-        // Two-level-MIS, built per shading point, costs more than MIS at any split: it
-        // replaces the rule's MIS only when twice as good.
-        let two_level = [None, None, Some(9.0), None, None, None, Some(5.0)];
-        assert_eq!(decide(&scored(&two_level), Some(2), 16), Some(2), "5.0 against 9.0, costlier: kept");
-        let two_level = [None, None, Some(9.0), None, None, None, Some(4.4)];
-        assert_eq!(decide(&scored(&two_level), Some(2), 16), Some(6), "4.4 against 9.0, costlier: overridden");
+        assert_eq!(decide(&scored(&cheaper), Some(4)), Some(2), "5.0 against 6.5, cheaper: overridden");
+        assert_eq!(decide(&scored(&clear), Some(1)), Some(0), "the rule's plan not trusted: the best");
+        assert_eq!(decide(&scored(&clear), None), Some(0), "no rule: the best");
+        assert_eq!(decide(&scored(&[None; 7]), Some(2)), None);
+        // Two-level-MIS costs little more per sample than MIS: it replaces the rule's MIS at the
+        // lower margin, as its score carries its cost.
+        let two_level = [None, None, Some(9.0), None, None, None, Some(7.5)];
+        assert_eq!(decide(&scored(&two_level), Some(2)), Some(2), "7.5 against 9.0: kept");
+        let two_level = [None, None, Some(9.0), None, None, None, Some(7.0)];
+        assert_eq!(decide(&scored(&two_level), Some(2)), Some(6), "7.0 against 9.0: overridden");
     }
 
     #[test]
@@ -259,16 +259,16 @@ mod tests {
         // A diffuse ground under a low sun: env looks 1.2× better than MIS in the pilot, and
         // MIS 1:1 1.4× better than the rule's MIS 3:1.
         let ground = [Some(2.1), None, Some(2.5), Some(3.5), Some(5.5), None, None];
-        assert_eq!(decide(&scored(&ground), Some(3), 4), Some(2), "MIS 1:1, not env");
+        assert_eq!(decide(&scored(&ground), Some(3)), Some(2), "MIS 1:1, not env");
         assert_eq!(without_unproven_env(&ground)[0], None);
         // Clearly ahead of every plan with BRDF samples, env sampling replaces the rule's plan.
         let open_sky = [Some(2.1), None, Some(5.0), Some(3.5), Some(5.5), None, None];
-        assert_eq!(decide(&scored(&open_sky), Some(3), 4), Some(0));
+        assert_eq!(decide(&scored(&open_sky), Some(3)), Some(0));
         // A product-MIS plan within the margin also holds env sampling back.
         let glossy = [Some(2.1), None, Some(5.0), Some(3.5), Some(2.4), None, None];
-        assert_eq!(decide(&scored(&glossy), Some(3), 4), Some(3), "env held back; product-MIS costlier, not 2× better");
+        assert_eq!(decide(&scored(&glossy), Some(3)), Some(3), "env held back; product-MIS costlier, not 2× better");
         // Without any plan with BRDF samples scored, env sampling stands on its own score.
         let alone = [Some(2.1), Some(9.0), None, None, None, None, None];
-        assert_eq!(decide(&scored(&alone), Some(1), 4), Some(0));
+        assert_eq!(decide(&scored(&alone), Some(1)), Some(0));
     }
 }

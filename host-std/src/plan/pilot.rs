@@ -6,8 +6,7 @@
 //! shading point (`plan::candidates`: a plan that costs more per sample takes fewer, so that
 //! no material's choice takes time from the others'), scored by variance × cost per shading
 //! point — the variance from the pixel pairs' squared differences (relMSE's normalisation),
-//! the cost a fixed per-sample weight per plan and a sampler's build per shading point
-//! ([`PLANS`]), not the pilot's clock, so that the choice, and the image, depend only on the
+//! the cost a fixed per-sample weight per plan ([`PLANS`]), not the pilot's clock, so that the choice, and the image, depend only on the
 //! scene, the settings and the seed. The pilot's samples are independent of the render's
 //! (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
 //!
@@ -28,23 +27,20 @@
 //! where the lighting is (its weight is L × B·cos/p). Each MIS strategy competes with the
 //! rules' split and plain MIS (1:1) only: the splits between differ by less than the pilot
 //! can tell apart ([`OVERRIDE_MARGIN`]), and every candidate fewer leaves more pixels for the
-//! others. Product-MIS competes on glossy lobes only: on a diffuse one env sampling draws
-//! nearly the product, cheaper, and product-MIS has lost on every diffuse region measured
-//! (docs/perf.md, "The products against MIS at equal time"), so measuring it there only adds
-//! to the pilot's cost.
+//! others. Product-MIS and two-level-MIS compete on glossy lobes only: on a diffuse one env
+//! sampling draws nearly the product, cheaper, and both products have lost on every diffuse
+//! region measured under a sun (docs/perf.md, "The products against MIS at equal time"), so
+//! measuring them there only adds to the pilot's cost.
 //!
 //! Nor can a pilot see the rare pixels where a plan fails. Env-only sampling fails where the
 //! bright part of the map is hidden (in a shadow, the sky is lit only by the few samples that
 //! miss the sun), and those few pixels carry most of the image's error: a pilot of a few dozen
 //! pixels rarely holds one, so it finds env sampling better than it is. Env-only sampling
 //! therefore replaces the rules' plan only where it scores [`OVERRIDE_MARGIN`]× better than
-//! every plan with BRDF samples too (`plan::decision`; docs/perf.md, "`auto` and its pilot"). A plan
-//! that builds a sampler per shading point (two-level-MIS) competes only where the render's
-//! samples per shading point let it repay its build ([`affordable`]): elsewhere the pilot
-//! is the pilot without it, at no cost.
+//! every plan with BRDF samples too (`plan::decision`; docs/perf.md, "`auto` and its pilot").
 
 use crate::plan::candidates::at_equal_cost;
-pub use crate::plan::candidates::{Candidate, PLANS, affordable};
+pub use crate::plan::candidates::{Candidate, PLANS};
 use crate::plan::decision::{decide, score};
 use crate::plan::method::strategy_name;
 use crate::plan::rules::{SMOOTH_LIGHTING_PEAK, auto_env_share, product_share};
@@ -67,6 +63,12 @@ pub const OVERRIDE_MARGIN: f64 = 1.25;
 /// it loses on every scene measured (docs/perf.md, "`auto` and its pilot"), and a pilot whose
 /// few brightest pixels happened to favour it would spend the render's time where it does not pay.
 pub const COSTLIER_OVERRIDE_MARGIN: f64 = 2.0;
+
+/// Ratio of costs per sample from which a plan counts as costlier than the rule's for
+/// [`COSTLIER_OVERRIDE_MARGIN`]: product-MIS (1.45× MIS and above) is, two-level-MIS (1.12×)
+/// is not — its samples come from a sampler shared as product-MIS's is, and its score already
+/// carries its cost.
+pub const COSTLIER_FROM: f64 = 1.2;
 
 /// Standard errors by which the rule's plan must score above another's for the other to replace
 /// it (`plan::decision`): a one-sided test at about 2% per comparison, on the mean of the pilot
@@ -141,7 +143,7 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         Strategy::ProductMis { product_share: share } => {
             !bsdf.as_brdf().is_diffuse() && share == product_share(bsdf, env_peak)
         }
-        Strategy::TwoLevelMis { .. } => true,
+        Strategy::TwoLevelMis { .. } => !bsdf.as_brdf().is_diffuse(),
         Strategy::Product
         | Strategy::Wavelet
         | Strategy::Ris
@@ -172,7 +174,6 @@ pub(crate) fn choose(
     let candidates: Vec<MaterialPlan> = tasks.iter().map(|&(m, c)| plan(m, c)).collect();
     let cones = if ctx.cones.is_none() { two_level_cones(env, &candidates) } else { None };
     let ctx = &Context { cones: ctx.cones.or(cones.as_deref()), ..*ctx };
-    let v = samples_per_point(ctx.options);
     let mut measured: Vec<Measured> = vec![Vec::new(); found.len()];
     for ((m, c), v) in tasks.iter().zip(measure(ctx, env, &found, &tasks)) {
         measured[*m].push((*c, v));
@@ -186,7 +187,7 @@ pub(crate) fn choose(
         let pairs: Vec<(usize, &[[[f64; 3]; 2]])> = measured[m].iter().map(|(c, v)| (*c, v.as_slice())).collect();
         let scores = score(&pairs, pixels.len(), env_budget);
         let rule = PLANS.iter().position(|p| p.strategy == defaults[m].strategy);
-        let Some(chosen) = decide(&scores, rule, v) else { continue };
+        let Some(chosen) = decide(&scores, rule) else { continue };
         plans[m] = plan(m, chosen);
         let scores = scores.iter().map(|s| s.as_ref().map(|s| s.value)).collect();
         results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
@@ -221,7 +222,7 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
         .filter(|&m| found[m].len() >= MIN_PIXELS)
         .flat_map(|m| {
             let bsdf = &ctx.scene.materials[m].bsdf;
-            (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak) && affordable(c, v)).map(move |c| (m, c))
+            (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))
         })
         .collect();
     let pilot = pilot_options(ctx.options, &tasks);

@@ -242,8 +242,10 @@ fn sample_light(
             }
             m
         } else {
-            // One point, or a product-MIS material's points through their shared sampler.
-            let shaded = if matches!(sampling, Sampling::ProductMis { .. }) { m } else { 1 };
+            // One point, or a product-MIS or two-level-MIS material's points through their
+            // shared sampler.
+            let shared = matches!(sampling, Sampling::ProductMis { .. } | Sampling::TwoLevelMis { .. });
+            let shaded = if shared { m } else { 1 };
             for &k in &members[..shaded] {
                 let mut vis = CountingVisibility { test: |d: Vec3| visible(k, d), rays: 0 };
                 values[k] = shade::shade(

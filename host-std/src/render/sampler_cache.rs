@@ -47,13 +47,24 @@ pub fn reuse_cosine(brdf: &dyn Brdf) -> f32 {
 /// (`product_arena::check_brdf_samples`) before it renders.
 const BRDF_SAMPLES_FIT: &str = "--brdf-samples within the product arenas' capacity";
 
-/// A product-MIS sampler kept for the next pixels of the tile, with the normal and mirror
+/// A sampler's arena kept for the next pixels of the tile, with the normal and mirror
 /// direction of the shading point it was built at.
-struct SharedSampler {
-    arena: SizedArena,
+struct Shared<A> {
+    arena: A,
     normal: Vec3,
     mirror: Vec3,
 }
+
+impl<A> Shared<A> {
+    /// Whether a sampler built here serves a shading point of `normal` and `mirror` within the
+    /// reuse angle whose cosine is `cos`.
+    fn near(&self, normal: Vec3, mirror: Vec3, cos: f32) -> bool {
+        self.normal.dot(normal) >= cos && self.mirror.dot(mirror) >= cos
+    }
+}
+
+/// A product-MIS sampler kept for the next pixels of the tile.
+type SharedSampler = Shared<SizedArena>;
 
 /// The shading point a sampler is built at: its hit, its shading point and the seed of the
 /// build's BRDF samples.
@@ -74,12 +85,19 @@ pub(crate) struct SamplerCache {
     two_level: Option<Box<TwoLevelArena>>,
     /// Per material, the product-MIS sampler built last and where.
     shared: Vec<Option<SharedSampler>>,
+    /// Per material, the two-level-MIS sampler built last and where.
+    shared_two_level: Vec<Option<Shared<Box<TwoLevelArena>>>>,
 }
 
 impl SamplerCache {
     /// An empty cache for a scene of `materials` materials.
     pub fn new(materials: usize) -> Self {
-        Self { arena: None, two_level: None, shared: (0..materials).map(|_| None).collect() }
+        Self {
+            arena: None,
+            two_level: None,
+            shared: (0..materials).map(|_| None).collect(),
+            shared_two_level: (0..materials).map(|_| None).collect(),
+        }
     }
 
     /// The sampling of `lead`'s material at its shading point, with the sampler it needs built
@@ -108,7 +126,7 @@ impl SamplerCache {
             }
             Strategy::TwoLevel => Sampling::TwoLevel(self.two_level(ctx, env, lead)),
             Strategy::TwoLevelMis { two_level_share } => {
-                Sampling::TwoLevelMis { sampler: self.two_level(ctx, env, lead), two_level_share }
+                Sampling::TwoLevelMis { sampler: self.shared_two_level(ctx, env, plan, lead), two_level_share }
             }
             Strategy::Sis => {
                 Sampling::Sis(ctx.strata.expect("the strata are built when a material is shaded with SIS"))
@@ -129,7 +147,7 @@ impl SamplerCache {
         let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
         let arena = self.two_level.get_or_insert_with(Box::default);
         let sp = lead.sp;
-        arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect("the cones are of a level the map and the arena hold")
+        arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT)
     }
 
     /// A product sampler of the paper's estimator, built for `lead` alone from its material's K.
@@ -160,8 +178,7 @@ impl SamplerCache {
     ) -> ProductSampler<'s, 'e> {
         let (hit, sp) = (lead.hit, lead.sp);
         let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
-        let cos = plan.reuse_cosine;
-        let near = |c: &SharedSampler| c.normal.dot(normal) >= cos && c.mirror.dot(mirror) >= cos;
+        let near = |c: &SharedSampler| c.near(normal, mirror, plan.reuse_cosine);
         let slot = &mut self.shared[hit.material];
         if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
             let params = ProductParams::for_mis(plan.brdf_samples);
@@ -179,6 +196,35 @@ impl SamplerCache {
         slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above")
     }
 }
+
+impl SamplerCache {
+    /// The two-level-MIS sampler of `lead`'s material: the kept one if it was built within the
+    /// material's reuse angle (and the material is not textured), otherwise built anew and kept.
+    /// As for product-MIS, MIS with BRDF sampling covers where another point's lobe leaves the
+    /// shared cells' bounds.
+    fn shared_two_level<'s, 'e>(
+        &'s mut self,
+        ctx: &Context<'s, 'e>,
+        env: &'s EnvHierarchy<'e>,
+        plan: &MaterialPlan,
+        lead: &Lead<'_>,
+    ) -> TwoLevelSampler<'s, 'e> {
+        let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
+        let (hit, sp) = (lead.hit, lead.sp);
+        let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
+        let slot = &mut self.shared_two_level[hit.material];
+        if hit.bsdf.is_some() || !slot.as_ref().is_some_and(|c| c.near(normal, mirror, plan.reuse_cosine)) {
+            let c = slot.get_or_insert_with(|| Shared { arena: Box::default(), normal, mirror });
+            c.arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT);
+            (c.normal, c.mirror) = (normal, mirror);
+        }
+        let slot: &'s Option<Shared<Box<TwoLevelArena>>> = slot;
+        slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above")
+    }
+}
+
+/// The cell cones are of a level the map and the two-level arena hold.
+const CONES_FIT: &str = "the cones are of a level the map and the arena hold";
 
 /// The mirror direction of `wo` about `n`.
 fn reflect(wo: Vec3, n: Vec3) -> Vec3 {

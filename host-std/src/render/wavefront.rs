@@ -57,6 +57,11 @@ fn layout(sampling: &Sampling<'_, '_>, budget: usize) -> Option<Layout> {
         }
         Sampling::Mis { env_share, .. } => split(env_share),
         Sampling::ProductMis { product_share, .. } => split(product_share),
+        Sampling::TwoLevelMis { two_level_share: 0.5, .. } => {
+            let n = (budget / 2).max(1);
+            fits(n).then_some(Layout::Pairs { n })
+        }
+        Sampling::TwoLevelMis { two_level_share, .. } => split(two_level_share),
         _ => None,
     }
 }
@@ -135,6 +140,9 @@ pub(crate) fn shade_wavefront(
             wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
         }
         Sampling::Mis { sampler, .. } => {
+            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
+        }
+        Sampling::TwoLevelMis { sampler, .. } => {
             wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
         }
         _ => wavefront(env, points, &buffers.samples, weighting, &mut buffers.candidates),

@@ -21,7 +21,7 @@
 use crate::brdf::Brdf;
 use crate::cell::Cell;
 use crate::cone::{Cone, cell_count, level_of, morton_cell};
-use crate::env::{EnvHierarchy, level_offset, luminance};
+use crate::env::{EnvHierarchy, IN_FLIGHT, WarpLane, level_offset, luminance};
 use crate::frame::Frame;
 use crate::mapping::SPHERE_AREA;
 use crate::sampler::DirectionSample;
@@ -208,6 +208,49 @@ impl<'e> TwoLevelSampler<'_, 'e> {
 
     /// Draws a direction; `None` when no cell has weight.
     pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
+        let (c, mut xi) = self.draw_cell(u)?;
+        let (cx, cy) = morton_cell(c);
+        let texel = self.env.warp_down(Cell::new(self.level, cx, cy), &mut xi)?;
+        let uv = texel.point(xi);
+        let pdf = self.pdf_texel(c, texel) / SPHERE_AREA;
+        (pdf > 0.0).then(|| DirectionSample { dir: self.env.dir_of(uv), uv, pdf })
+    }
+
+    /// [`sample`](Self::sample) for every point of `u` (as many as both hold): the cells
+    /// drawn first, then the descents below them side by side, as the environment's own
+    /// [`EnvHierarchy::sample_many`] advances them. The same distribution and pdf; the point
+    /// within a texel can differ from [`sample`](Self::sample)'s in the last bits.
+    pub fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
+        for (us, os) in u.chunks(IN_FLIGHT).zip(out.chunks_mut(IN_FLIGHT)) {
+            let n = us.len().min(os.len());
+            let mut lanes = [WarpLane::default(); IN_FLIGHT];
+            let mut cells = [0usize; IN_FLIGHT];
+            for ((lane, cell), &u) in lanes.iter_mut().zip(&mut cells).zip(&us[..n]) {
+                if let Some((c, xi)) = self.draw_cell(u) {
+                    let (cx, cy) = morton_cell(c);
+                    (*lane, *cell) = (WarpLane::new(Cell::new(self.level, cx, cy), xi), c);
+                }
+            }
+            self.env.warp_down_lanes(&mut lanes[..n]);
+            let finest = self.env.finest_level();
+            let mut points = [(Vec2::ZERO, 0.0f32); IN_FLIGHT];
+            for ((p, lane), &c) in points.iter_mut().zip(&lanes[..n]).zip(&cells) {
+                let texel = self.env.node_relative_at(finest, lane.morton);
+                *p = (lane.cell.point(lane.xi), self.pdf_of(c, texel) / SPHERE_AREA);
+            }
+            let mut dirs = [Vec3::ZERO; IN_FLIGHT];
+            self.env.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
+            for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
+                let (uv, pdf) = points[k];
+                *o = (lane.alive && pdf > 0.0).then_some(DirectionSample { dir: dirs[k], uv, pdf });
+            }
+        }
+    }
+
+    /// The coarse cell `u` draws ∝ B̃ × mass, and the point rescaled within it; `None` when no
+    /// cell has weight.
+    #[inline]
+    fn draw_cell(&self, u: DVec2) -> Option<(usize, DVec2)> {
         let total = self.total();
         if !(total > 0.0 && total.is_finite()) {
             return None;
@@ -220,11 +263,7 @@ impl<'e> TwoLevelSampler<'_, 'e> {
             return None;
         }
         xi.x = ((t - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
-        let (cx, cy) = morton_cell(c);
-        let texel = self.env.warp_down(Cell::new(self.level, cx, cy), &mut xi)?;
-        let uv = texel.point(xi);
-        let pdf = self.pdf_texel(c, texel) / SPHERE_AREA;
-        (pdf > 0.0).then(|| DirectionSample { dir: self.env.dir_of(uv), uv, pdf })
+        Some((c, xi))
     }
 
     /// The running sums before and after cell `c`.
@@ -235,15 +274,20 @@ impl<'e> TwoLevelSampler<'_, 'e> {
 
     /// Density per unit area of the square in a finest-level texel of cell `c`.
     fn pdf_texel(&self, c: usize, texel: Cell) -> f32 {
+        self.pdf_of(c, self.env.node_relative(texel))
+    }
+
+    /// Density per unit area of the square in a finest-level texel of cell `c` whose relative
+    /// importance is `texel`.
+    #[inline]
+    fn pdf_of(&self, c: usize, texel: f32) -> f32 {
         let total = self.total();
         let (lo, hi) = self.bounds(c);
-        let (cx, cy) = morton_cell(c);
-        let cell = f64::from(self.env.node_relative(Cell::new(self.level, cx, cy)));
+        let cell = f64::from(self.env.node_relative_at(self.level, c));
         if !(total > 0.0 && cell > 0.0) {
             return 0.0;
         }
-        let texel = f64::from(self.env.node_relative(texel));
-        ((hi - lo) / total * cell_count(self.level) as f64 * texel / cell) as f32
+        ((hi - lo) / total * cell_count(self.level) as f64 * f64::from(texel) / cell) as f32
     }
 
     /// Density per unit area of the square at `uv`.

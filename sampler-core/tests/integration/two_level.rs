@@ -1,7 +1,7 @@
 //! The two-level product: every built-in BRDF's cone bound holds over its cells, the sampler
-//! matches its own pdf (χ²) which integrates to 1, the estimators match quadrature under a sun
-//! 1e7 times the sky, a BRDF without a bound is still sampled without bias, and a build that
-//! cannot be made says why. (The shared estimator harness in `estimators.rs` covers occluders
+//! matches its own pdf (χ²) which integrates to 1, its batched draws are its single ones, the
+//! estimators match quadrature under a sun 1e7 times the sky, a BRDF without a bound is still
+//! sampled without bias, and a build that cannot be made says why. (The shared estimator harness in `estimators.rs` covers occluders
 //! and the other lobes.)
 
 use crate::common::*;
@@ -335,4 +335,40 @@ fn a_build_that_cannot_be_made_says_why() {
     // Nothing to draw from below the surface.
     let s = arena.build(&e, &cones(3), &brdf, &frame, Vec3::new(0.0, 0.6, -0.8)).unwrap();
     assert!(s.sample(DVec2::new(0.3, 0.3)).is_none() && s.total() == 0.0);
+}
+
+#[test]
+fn sample_many_draws_what_sample_draws() {
+    let envs = [TestEnv::random_smooth(6, 12), TestEnv::sun(7, (70, 20), 1e6)];
+    let mut arena: Box<TwoLevelArena> = Box::default();
+    let mut rng = Pcg32::new(9, 4);
+    for env in &envs {
+        let e = env.view();
+        for level in [3u32, 4, 5] {
+            let cones = cones(level);
+            for (name, brdf) in brdfs() {
+                let frame = Frame::from_normal(Vec3::new(-0.6, 0.2, 0.3).normalize());
+                let wo = frame.to_world(Vec3::new(0.5, 0.1, 0.8).normalize());
+                let s = arena.build(&e, &cones, brdf.as_ref(), &frame, wo).unwrap();
+                // More points than one call's lanes, and the unit square's edges.
+                let mut u: Vec<DVec2> = (0..300).map(|_| DVec2::new(rng.next_f64(), rng.next_f64())).collect();
+                u.extend([DVec2::ZERO, DVec2::ONE, DVec2::new(1.0, 0.0), DVec2::new(0.0, 1.0)]);
+                let mut many = vec![None; u.len()];
+                s.sample_many(&u, &mut many);
+                for (k, (&p, m)) in u.iter().zip(&many).enumerate() {
+                    let label = format!("level {level} {name} point {k}");
+                    match (s.sample(p), m) {
+                        (Some(a), Some(b)) => {
+                            assert_eq!(e.texel_at(a.uv), e.texel_at(b.uv), "{label}: another texel");
+                            assert!((a.pdf - b.pdf).abs() <= 1e-6 * a.pdf, "{label}: pdf {} vs {}", a.pdf, b.pdf);
+                            assert!((a.uv - b.uv).abs().max_element() < 1e-6, "{label}: {} vs {}", a.uv, b.uv);
+                            assert!((a.dir - b.dir).length() < 1e-5, "{label}: direction");
+                        }
+                        (None, None) => {}
+                        (a, b) => panic!("{label}: {a:?} against {b:?}"),
+                    }
+                }
+            }
+        }
+    }
 }

@@ -144,16 +144,9 @@ fn sampling_summary() -> String {
         }
     }
     let last = candidates.pop().unwrap_or_default();
-    // The fewest light samples per shading point that let a sampler built per point compete.
-    let per_point = (0..PLANS.len()).filter(|&c| PLANS[c].build > 0.0).map(|c| {
-        let v = (1..=1 << 16).find(|&v| pilot::affordable(c, v)).map_or("never".to_string(), |v| format!("from {v}"));
-        format!("{} {v} samples per shading point", pilot::plan_name(c))
-    });
-    let per_point: Vec<String> = per_point.collect();
     format!(
-        "product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {WIDE_LOBE_PRODUCT_SHARE} of its samples from the product on GGX conductors with α ≥ {WIDE_LOBE} when the map's peak is under {SUN_PEAK}, half elsewhere); auto = product-mis on GGX conductors with α in {PRODUCT_ALPHA:?} ({PRODUCT_ALPHA_EXTENDED:?} when the map's peak is under {SUN_PEAK}: no sun), mis on the other materials ({AUTO_DIFFUSE_ENV_SHARE} of it env samples on diffuse surfaces when the peak is under {SUN_PEAK}), or BRDF sampling when the lighting is smooth (peak < {SMOOTH_LIGHTING_PEAK}) — then checked per material by a pilot render of {MIN_PIXELS}–{MAX_PIXELS} of its pixels with the candidate plans {} and {last} (those whose sample weights are bounded there, the two MIS methods at the rules' splits, {}; of {} plans in all: {}), each at about MIS's cost per shading point (fewer samples for a costlier plan), which replaces the rule's plan where another measures {OVERRIDE_MARGIN}× better ({COSTLIER_OVERRIDE_MARGIN}× where it costs more per sample) and by {SEPARATION} standard errors (about {}% of the render, at most {}%: with fewer than {MIN_PIXELS} pixels per material within that, the rules decide alone)",
+        "product samplers for methods product and wavelet (per shading point), product-mis and two-level-mis (per pixel and material, reused by nearby pixels; {WIDE_LOBE_PRODUCT_SHARE} of its samples from the product on GGX conductors with α ≥ {WIDE_LOBE} when the map's peak is under {SUN_PEAK}, half elsewhere); auto = product-mis on GGX conductors with α in {PRODUCT_ALPHA:?} ({PRODUCT_ALPHA_EXTENDED:?} when the map's peak is under {SUN_PEAK}: no sun), mis on the other materials ({AUTO_DIFFUSE_ENV_SHARE} of it env samples on diffuse surfaces when the peak is under {SUN_PEAK}), or BRDF sampling when the lighting is smooth (peak < {SMOOTH_LIGHTING_PEAK}) — then checked per material by a pilot render of {MIN_PIXELS}–{MAX_PIXELS} of its pixels with the candidate plans {} and {last} (those whose sample weights are bounded there, the two MIS methods at the rules' splits; of {} plans in all: {}), each at about MIS's cost per shading point (fewer samples for a costlier plan), which replaces the rule's plan where another measures {OVERRIDE_MARGIN}× better ({COSTLIER_OVERRIDE_MARGIN}× where it costs more per sample) and by {SEPARATION} standard errors (about {}% of the render, at most {}%: with fewer than {MIN_PIXELS} pixels per material within that, the rules decide alone)",
         candidates.join(", "),
-        per_point.join(", "),
         PLANS.len(),
         (0..PLANS.len()).map(pilot::plan_name).collect::<Vec<_>>().join(", "),
         PILOT_SHARE * 100.0,
