@@ -20,6 +20,9 @@
   knot.json        — a 100 000-triangle torus knot (GGX α = 0.1, face normals) on a grey floor
                      under the courtyard map: a scene whose cost is in its geometry
                      (knot.ply, binary PLY).
+  alphas_{default,s3,sharp}.json — default_twin.json's view with GGX conductor spheres of
+                     α = 0.1, 0.2, 0.3 and 0.5 under three suns: the default sky's, s3's sunset
+                     and sharp_sun's map (committed; the maps as above).
 
   pip install numpy; python3 docs/scenes/make_scenes.py
 The maps and the knot are generated (not committed). The maps are float32 RGB OpenEXR, written
