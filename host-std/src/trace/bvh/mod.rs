@@ -194,7 +194,7 @@ impl Bvh {
         traverse::any(&self.nodes, o, d, t_max, |first, count| {
             self.blocks[first as usize..(first + count) as usize]
                 .iter()
-                .any(|b| b.triangles(o, d, t_min, t_max).0 != 0 || b.spheres(o, d, t_min, t_max).0 != 0)
+                .any(|b| b.occludes(o, d, t_min, t_max))
         })
     }
 
