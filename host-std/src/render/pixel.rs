@@ -287,8 +287,7 @@ fn shade_members(
     }
     let mut out = [DVec3::ZERO; GROUP];
     let shadows = ctx.options.shadows;
-    let occluded =
-        |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(hits[members[i]].origin, dir, 0.0, f32::INFINITY);
+    let occluded = |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(hits[members[i]].origin, dir, 0.0, f32::INFINITY);
     let runs = &runs[..members.len()];
     let traced = wavefront::shade_wavefront(sampling, env, &points, runs, budget, waves, occluded, &mut out)
         .map_or(0, |r| r as u64);
