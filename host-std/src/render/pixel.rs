@@ -12,7 +12,7 @@ use crate::render::strategy::Strategy;
 use crate::render::wavefront::{self, WaveBuffers};
 use crate::render::{Context, Counters};
 use crate::scene::{Bsdf, Scene};
-use crate::trace::bvh::{self, ShadowRay, Surface};
+use crate::trace::bvh::{self, Surface};
 use crate::trace::camera::Camera;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
@@ -280,21 +280,19 @@ fn shade_members(
     budget: usize,
     waves: &mut WaveBuffers,
 ) -> ([DVec3; GROUP], u64) {
-    // Sized to the members: a group's full arrays would cost more to fill than its few points.
+    // Sized to the members: a group's full array would cost more to fill than its few points.
     let points: Vec<ShadingPoint<'_, dyn Brdf + '_>> =
         members.iter().map(|&k| shading_point(ctx.scene, &hits[k])).collect();
-    let runs: Vec<Run> = members.iter().map(|&k| run_of(&hits[k])).collect();
-    let origins: Vec<Vec3> = members.iter().map(|&k| hits[k].origin).collect();
+    let mut runs = [Run { seed: 0, block: 0 }; GROUP];
+    for (r, &k) in runs.iter_mut().zip(members) {
+        *r = run_of(&hits[k]);
+    }
     let mut out = [DVec3::ZERO; GROUP];
     let shadows = ctx.options.shadows;
-    let occluded_many = |rays: &[ShadowRay], blocked: &mut [bool]| {
-        if shadows {
-            ctx.bvh.occluded_many(rays, blocked);
-        }
-    };
-    let traced =
-        wavefront::shade_wavefront(sampling, env, &points, &runs, &origins, budget, waves, occluded_many, &mut out)
-            .map_or(0, |r| r as u64);
+    let occluded = |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(hits[members[i]].origin, dir, 0.0, f32::INFINITY);
+    let runs = &runs[..members.len()];
+    let traced = wavefront::shade_wavefront(sampling, env, &points, runs, budget, waves, occluded, &mut out)
+        .map_or(0, |r| r as u64);
     (out, traced)
 }
 

@@ -3,10 +3,9 @@
 //! point — the environment (env, BRDF and MIS sampling) or the pixel's shared product-MIS
 //! sampler — and each point takes few samples: then each point's estimate is the per-point
 //! estimator's ([`shade::shade`]) bit for bit, but the samples of all points are drawn
-//! together and their shadow rays traced together.
+//! together, and each shadow ray is traced as its point's estimate sums its sample.
 
 use crate::render::shade::{Run, Sampling};
-use crate::trace::bvh::ShadowRay;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
@@ -95,25 +94,23 @@ pub(crate) fn split_shares(first: usize, brdf: usize) -> (f32, f32) {
 pub(crate) struct WaveBuffers {
     samples: Vec<WaveSample>,
     candidates: Vec<Candidate>,
-    rays: Vec<ShadowRay>,
-    blocked: Vec<bool>,
 }
 
 /// Each shading point's estimate of its direct light into `out`, from `budget` samples drawn
 /// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
-/// through one sampler for all of them and the budget is small ([`fits`]). The shadow rays of
-/// all samples that need one (from `origins[k]`, point k's) are traced together by
-/// `occluded_many`; returns how many. `None` (nothing done) where the wavefront does not fit.
+/// through one sampler for all of them and the budget is small ([`fits`]). Each sample that
+/// needs a shadow ray asks `occluded(k, dir)` whether direction `dir` is blocked at point k,
+/// in the order the estimates sum them; returns how many rays it asked for. `None` (nothing
+/// done) where the wavefront does not fit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_wavefront(
     sampling: &Sampling<'_, '_>,
     env: &EnvHierarchy<'_>,
     points: &[ShadingPoint<'_, dyn Brdf + '_>],
     runs: &[Run],
-    origins: &[Vec3],
     budget: usize,
     buffers: &mut WaveBuffers,
-    mut occluded_many: impl FnMut(&[ShadowRay], &mut [bool]),
+    mut occluded: impl FnMut(usize, Vec3) -> bool,
     out: &mut [DVec3],
 ) -> Option<usize> {
     let layout = layout(sampling, budget)?;
@@ -147,26 +144,21 @@ pub(crate) fn shade_wavefront(
         }
         _ => wavefront(env, points, &buffers.samples, weighting, &mut buffers.candidates),
     }
-    // The shadow rays, all at once.
-    buffers.rays.clear();
+    // Each shadow ray as its sample is summed: a ray's answer is used where it is found, and
+    // no list of rays and answers is written and read back.
+    let mut rays = 0;
     let per_point = layout.len();
-    for (candidates, &origin) in buffers.candidates.chunks(per_point).zip(origins) {
-        for c in candidates.iter().filter(|c| c.needs_ray) {
-            buffers.rays.push(ShadowRay { origin, dir: c.dir, t_min: 0.0, t_max: f32::INFINITY });
-        }
-    }
-    buffers.blocked.clear();
-    buffers.blocked.resize(buffers.rays.len(), false);
-    occluded_many(&buffers.rays, &mut buffers.blocked);
-    let mut blocked = buffers.blocked.iter();
-    for (candidates, o) in buffers.candidates.chunks(per_point).zip(out.iter_mut()) {
+    for (k, (candidates, o)) in buffers.candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
         let mut value = |c: &Candidate| {
-            let visible = c.needs_ray && !blocked.next().copied().unwrap_or(true);
-            if visible { c.value } else { DVec3::ZERO }
+            if !c.needs_ray {
+                return DVec3::ZERO;
+            }
+            rays += 1;
+            if occluded(k, c.dir) { DVec3::ZERO } else { c.value }
         };
         *o = reduce(layout, candidates, &mut value);
     }
-    Some(buffers.rays.len())
+    Some(rays)
 }
 
 /// A shading point's samples in the order its estimate sums them, from its `block` of the

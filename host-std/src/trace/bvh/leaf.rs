@@ -95,17 +95,8 @@ impl Block {
         if self.spheres == 0 {
             return (0, [0.0; 4]);
         }
-        let center = self.v0.each_ref().map(F4::load);
-        let r2 = F4::load(&self.e1[0]);
-        let d = [d.x, d.y, d.z].map(F4::splat);
-        let f = [o.x, o.y, o.z].map(F4::splat);
-        let f = [f[0].sub(center[0]), f[1].sub(center[1]), f[2].sub(center[2])];
-        let b = dot(f, d).neg();
-        let perp = [f[0].add(b.mul(d[0])), f[1].add(b.mul(d[1])), f[2].add(b.mul(d[2]))];
-        let disc = r2.sub(dot(perp, perp));
-        let c = dot(f, f).sub(r2);
-        let q = b.add(disc.sqrt().copysign(b));
-        let (q, cq, disc) = (q.to_array(), c.div(q).to_array(), disc.to_array());
+        let (disc, q, cq) = self.sphere_roots(o, d);
+        let (q, cq, disc) = (q.to_array(), cq.to_array(), disc.to_array());
         let (mut hits, mut t) = (0, [0.0; 4]);
         let mut lanes = self.spheres;
         while lanes != 0 {
@@ -123,6 +114,43 @@ impl Block {
             }
         }
         (hits, t)
+    }
+
+    /// Whether the ray hits any primitive of the block in (t_min, t_max): the lanes
+    /// [`Block::triangles`] and [`Block::spheres`] find, decided in the lanes. A sphere lane
+    /// hits where either root is in the interval: its nearer root in it, or else its farther,
+    /// is the same test. Where q = 0 the scalar test takes 0 for both roots; then q's own lane
+    /// tests 0 and c/q (infinite or NaN) is in no interval, so the answer is the same.
+    #[inline(always)]
+    pub(super) fn occludes(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        if self.triangles(o, d, t_min, t_max).0 != 0 {
+            return true;
+        }
+        if self.spheres == 0 {
+            return false;
+        }
+        let (disc, q, cq) = self.sphere_roots(o, d);
+        let (lo, hi) = (F4::splat(t_min), F4::splat(t_max));
+        let inside = |t: F4| lo.lt_mask(t) & t.lt_mask(hi);
+        let real = !disc.lt_mask(F4::splat(0.0));
+        real & (inside(q) | inside(cq)) & self.spheres != 0
+    }
+
+    /// Per sphere lane: the discriminant (its root's radicand), q and c/q, the roots of
+    /// [`Primitive::intersect`]'s quadratic where q ≠ 0.
+    #[inline(always)]
+    fn sphere_roots(&self, o: Vec3, d: Vec3) -> (F4, F4, F4) {
+        let center = self.v0.each_ref().map(F4::load);
+        let r2 = F4::load(&self.e1[0]);
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let f = [o.x, o.y, o.z].map(F4::splat);
+        let f = [f[0].sub(center[0]), f[1].sub(center[1]), f[2].sub(center[2])];
+        let b = dot(f, d).neg();
+        let perp = [f[0].add(b.mul(d[0])), f[1].add(b.mul(d[1])), f[2].add(b.mul(d[2]))];
+        let disc = r2.sub(dot(perp, perp));
+        let c = dot(f, f).sub(r2);
+        let q = b.add(disc.sqrt().copysign(b));
+        (disc, q, c.div(q))
     }
 }
 
@@ -167,6 +195,9 @@ mod tests {
             let (tris, t_tri) = b.triangles(o, d, 1e-3, 4.5);
             let (spheres, t_sphere) = b.spheres(o, d, 1e-3, 4.5);
             assert_eq!(tris & spheres, 0, "block {i}: a lane is one primitive");
+            assert_eq!(b.occludes(o, d, 1e-3, 4.5), tris | spheres != 0, "block {i}: occlusion");
+            let unbounded = b.triangles(o, d, 0.0, f32::INFINITY).0 | b.spheres(o, d, 0.0, f32::INFINITY).0;
+            assert_eq!(b.occludes(o, d, 0.0, f32::INFINITY), unbounded != 0, "block {i}: occlusion to ∞");
             for k in 0..4 {
                 let scalar = prims[4 * i + k].intersect(o, d, 1e-3, 4.5);
                 let lane = match (tris & (1 << k) != 0, spheres & (1 << k) != 0) {
@@ -188,6 +219,8 @@ mod tests {
             let scalar = inside.intersect(o, d, 1e-3, 4.5);
             assert!(scalar.is_some());
             assert_eq!(one[0].spheres(o, d, 1e-3, 4.5), (1, [scalar.unwrap(), 0.0, 0.0, 0.0]));
+            assert!(one[0].occludes(o, d, 1e-3, 4.5));
+            assert!(!one[0].occludes(o, d, 1e-3, 0.5), "both roots beyond the interval");
         }
         assert!(hits > 150 && sphere_hits > 30, "{hits} hits, {sphere_hits} on spheres: too few to test the lanes");
     }

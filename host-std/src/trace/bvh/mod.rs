@@ -192,9 +192,7 @@ impl Bvh {
             return true;
         }
         traverse::any(&self.nodes, o, d, t_max, |first, count| {
-            self.blocks[first as usize..(first + count) as usize]
-                .iter()
-                .any(|b| b.triangles(o, d, t_min, t_max).0 != 0 || b.spheres(o, d, t_min, t_max).0 != 0)
+            self.blocks[first as usize..(first + count) as usize].iter().any(|b| b.occludes(o, d, t_min, t_max))
         })
     }
 
