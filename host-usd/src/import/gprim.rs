@@ -10,18 +10,53 @@ use crate::xform::uniform_scale;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::collections::HashMap;
 
+/// What a gprim authors, read from the stage once and placed under any number of transforms
+/// (a PointInstancer's prototype part under each of its instances). The sphere's radius and
+/// the tessellation are read on first use: a sphere under uniform scales never needs its
+/// triangles.
+pub(super) struct GprimSource {
+    prim: PrimPath,
+    type_name: String,
+    double_sided: bool,
+    material: usize,
+    radius: Option<f64>,
+    shape: Option<LocalShape>,
+}
+
+/// A gprim's triangles in its local space, grouped by material (in material order).
+struct LocalShape {
+    local: LocalMesh,
+    groups: Vec<(usize, Vec<usize>)>,
+}
+
 impl Importer<'_> {
     /// One gprim with its local-to-renderer transform `m`.
     pub(super) fn gprim(&mut self, prim: &PrimPath, type_name: &str, label: &str, m: &DMat4) -> Result<(), String> {
-        let stage = self.stage;
-        let double_sided = stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
+        let mut source = self.gprim_source(prim, type_name)?;
+        self.place_gprim(&mut source, label, m)
+    }
+
+    /// What `prim` (a gprim of `type_name`) authors that does not depend on where it is placed.
+    pub(super) fn gprim_source(&mut self, prim: &PrimPath, type_name: &str) -> Result<GprimSource, String> {
+        let double_sided = self.stage.value(prim, "doubleSided")?.and_then(|v| v.scalar()).is_some_and(|v| v != 0.0);
         let material = self.material_for(prim)?;
+        let (prim, type_name) = (prim.clone(), type_name.to_string());
+        Ok(GprimSource { prim, type_name, double_sided, material, radius: None, shape: None })
+    }
+
+    /// The gprim of `source` placed by the local-to-renderer transform `m`.
+    pub(super) fn place_gprim(&mut self, source: &mut GprimSource, label: &str, m: &DMat4) -> Result<(), String> {
+        let stage = self.stage;
+        let (material, double_sided) = (source.material, source.double_sided);
         self.scene.counts.gprims += 1;
-        if type_name == "Sphere"
+        if source.type_name == "Sphere"
             && let Some(s) = uniform_scale(m)
         {
-            let r = shapes::number(stage, prim, "radius", 1.0)? * s;
-            let center = m.transform_point3(DVec3::ZERO);
+            let radius = match source.radius {
+                Some(r) => r,
+                None => *source.radius.insert(shapes::number(stage, &source.prim, "radius", 1.0)?),
+            };
+            let (r, center) = (radius * s, m.transform_point3(DVec3::ZERO));
             if !(r.is_finite() && center.is_finite()) {
                 return Err("the sphere's transform or radius is not finite".into());
             }
@@ -32,10 +67,24 @@ impl Importer<'_> {
             self.scene.spheres.push(Sphere { path, center: c, radius: r, material, double_sided });
             return Ok(());
         }
+        if source.type_name == "Mesh" {
+            self.scene.counts.meshes += 1;
+        }
+        let shape = match source.shape.take() {
+            Some(shape) => shape,
+            None => self.local_shape(&source.prim, &source.type_name, material)?,
+        };
+        let placed = self.place_shape(&shape, label, m, double_sided);
+        source.shape = Some(shape);
+        placed
+    }
+
+    /// A gprim's triangles in its local space, grouped by the materials of its faces.
+    fn local_shape(&mut self, prim: &PrimPath, type_name: &str, material: usize) -> Result<LocalShape, String> {
+        let stage = self.stage;
         // Per-face materials from GeomSubsets of the materialBind family.
         let face_materials = if type_name == "Mesh" { self.subset_materials(prim)? } else { Default::default() };
         let local = if type_name == "Mesh" {
-            self.scene.counts.meshes += 1;
             // Texture coordinates only for a mesh whose materials read textures.
             let uv = std::iter::once(material)
                 .chain(face_materials.materials().iter().copied())
@@ -49,8 +98,13 @@ impl Importer<'_> {
             let mat = face_materials.get(face).unwrap_or(material);
             groups.entry(mat).or_default().push(i);
         }
-        let mut keys: Vec<usize> = groups.keys().copied().collect();
-        keys.sort_unstable();
+        let mut groups: Vec<(usize, Vec<usize>)> = groups.into_iter().collect();
+        groups.sort_unstable_by_key(|(mat, _)| *mat);
+        Ok(LocalShape { local, groups })
+    }
+
+    /// The triangles of `shape` placed by `m`, one mesh per material.
+    fn place_shape(&mut self, shape: &LocalShape, label: &str, m: &DMat4, double_sided: bool) -> Result<(), String> {
         let m3 = DMat3::from_mat4(*m);
         let det = m3.determinant();
         if !(det.is_finite() && det != 0.0) {
@@ -58,8 +112,10 @@ impl Importer<'_> {
             return Ok(());
         }
         let normal_matrix = m3.inverse().transpose();
-        for mat in keys {
-            let mesh = transform(&local, &groups[&mat], m, &normal_matrix, det < 0.0, label, mat, double_sided)?;
+        let mut remap = vec![UNMAPPED; shape.local.positions.len()];
+        for (mat, which) in &shape.groups {
+            let placed = Placement { m, normal_matrix: &normal_matrix, mirror: det < 0.0 };
+            let mesh = transform(&shape.local, which, &placed, &mut remap, label, *mat, double_sided)?;
             self.scene.counts.triangles += mesh.triangles.len();
             for &p in &mesh.positions {
                 self.grow(p);
@@ -76,20 +132,30 @@ impl Importer<'_> {
     }
 }
 
-/// The triangles `which` of a local mesh, transformed by `m` (non-singular; normals by
-/// `normal_matrix`, its inverse transpose; winding reversed when it `mirror`s).
-#[allow(clippy::too_many_arguments)]
+/// A local point not yet placed in the mesh being built.
+const UNMAPPED: u32 = u32::MAX;
+
+/// Where a local mesh goes: `m` (non-singular), normals by `normal_matrix`, its inverse
+/// transpose, winding reversed when it `mirror`s.
+struct Placement<'a> {
+    m: &'a DMat4,
+    normal_matrix: &'a DMat3,
+    mirror: bool,
+}
+
+/// The triangles `which` of a local mesh, placed. `remap` (one entry per local point, all
+/// [`UNMAPPED`]) numbers the points the triangles use in the order they first use them, and
+/// is left all [`UNMAPPED`] again.
 fn transform(
     local: &LocalMesh,
     which: &[usize],
-    m: &DMat4,
-    normal_matrix: &DMat3,
-    mirror: bool,
+    placed: &Placement<'_>,
+    remap: &mut [u32],
     label: &str,
     material: usize,
     double_sided: bool,
 ) -> Result<Mesh, String> {
-    let mut remap: HashMap<u32, u32> = HashMap::new();
+    let Placement { m, normal_matrix, mirror } = *placed;
     // The lists are sized once: the scene holds every gprim's lists at once, and a list
     // grown by pushing keeps up to half of it spare.
     let mut positions = Vec::new();
@@ -111,15 +177,20 @@ fn transform(
         }
         uvs.extend(uv);
         let t = t.map(|v| {
-            *remap.entry(v).or_insert_with(|| {
+            let slot = &mut remap[v as usize];
+            if *slot == UNMAPPED {
                 positions.push(m.transform_point3(local.positions[v as usize]).as_vec3());
-                (positions.len() - 1) as u32
-            })
+                *slot = (positions.len() - 1) as u32;
+            }
+            *slot
         });
         triangles.push(t);
         if let Some(n) = n {
             normals.push(n.map(|n| (*normal_matrix * n).normalize_or_zero().as_vec3()));
         }
+    }
+    for &i in which {
+        local.triangles[i].iter().for_each(|&v| remap[v as usize] = UNMAPPED);
     }
     if normals.len() != triangles.len() {
         normals.clear();

@@ -8,6 +8,7 @@
 
 #![allow(clippy::mutable_key_type, reason = "a path's interior mutability is its text cache, outside Eq and Hash")]
 
+use super::gprim::GprimSource;
 use super::{Failure, Importer, Stop, fail};
 use crate::instancer;
 use crate::stage::{PrimMap, PrimPath, Stage, Step};
@@ -196,12 +197,19 @@ impl Importer<'_> {
         let index: Vec<Option<usize>> = protos.iter().map(|p| known.get(p).copied()).collect();
         // Out of `self` while `gprim` adds to the scene.
         let parts = std::mem::take(&mut self.prototypes.parts);
+        // Each prototype gprim read from the stage once, on its first instance, and placed
+        // at every instance.
+        let mut sources: Vec<Vec<Option<GprimSource>>> = Vec::new();
+        sources.resize_with(parts.len(), Vec::new);
         let expanded = instances.iter().try_for_each(|inst| {
-            let Some(list) = index.get(inst.prototype).copied().flatten().map(|i| &parts[i]) else { return Ok(()) };
-            list.iter().try_for_each(|(p, t, rel, mesh_light)| {
+            let Some(i) = index.get(inst.prototype).copied().flatten() else { return Ok(()) };
+            if sources[i].is_empty() {
+                sources[i].resize_with(parts[i].len(), || None);
+            }
+            parts[i].iter().zip(&mut sources[i]).try_for_each(|((p, t, rel, mesh_light), source)| {
                 let m = self.conversion * *world * inst.transform * *rel;
                 let label = format!("{p}[{prim}:{}]", inst.index);
-                self.prototype_part(p, t, *mesh_light, &label, &m).map_err(fail(p))
+                self.prototype_part(p, t, *mesh_light, &label, &m, source).map_err(fail(p))
             })
         });
         self.prototypes.parts = parts;
@@ -211,7 +219,7 @@ impl Importer<'_> {
     }
 
     /// One prim kept under a prototype root, for one instance at `m`: a light, a mesh light
-    /// (MeshLightAPI) or a gprim.
+    /// (MeshLightAPI) or a gprim (read into `source` on its first instance).
     fn prototype_part(
         &mut self,
         prim: &PrimPath,
@@ -219,6 +227,7 @@ impl Importer<'_> {
         mesh_light: bool,
         label: &str,
         m: &DMat4,
+        source: &mut Option<GprimSource>,
     ) -> Result<(), String> {
         if crate::lights::KINDS.contains(&type_name) {
             return self.light_at(prim, type_name, m, label);
@@ -226,6 +235,10 @@ impl Importer<'_> {
         if mesh_light {
             return self.mesh_light_at(prim, type_name, m, label);
         }
-        self.gprim(prim, type_name, label, m)
+        let source = match source {
+            Some(s) => s,
+            empty => empty.insert(self.gprim_source(prim, type_name)?),
+        };
+        self.place_gprim(source, label, m)
     }
 }
