@@ -176,28 +176,16 @@ impl SamplerCache {
         plan: &MaterialPlan,
         lead: &Lead<'_>,
     ) -> ProductSampler<'s, 'e> {
-        let (hit, sp) = (lead.hit, lead.sp);
-        let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
-        let near = |c: &SharedSampler| c.near(normal, mirror, plan.reuse_cosine);
-        let slot = &mut self.shared[hit.material];
-        if hit.bsdf.is_some() || !slot.as_ref().is_some_and(near) {
-            let params = ProductParams::for_mis(plan.brdf_samples);
-            let c = match &mut *slot {
-                Some(c) => c,
-                empty => {
-                    let arena = SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT);
-                    empty.insert(SharedSampler { arena, normal, mirror })
-                }
-            };
-            c.arena.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT);
-            (c.normal, c.mirror) = (normal, mirror);
-        }
-        let slot: &'s Option<SharedSampler> = slot;
-        slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above")
+        let sp = lead.sp;
+        let params = ProductParams::for_mis(plan.brdf_samples);
+        let new = || SizedArena::for_samples(params.brdf_samples).expect(BRDF_SAMPLES_FIT);
+        let build = |a: &mut SizedArena| {
+            a.build(env, sp.brdf, &sp.frame, sp.wo, &params, lead.seed).expect(BRDF_SAMPLES_FIT);
+        };
+        let kept = kept_or_built(&mut self.shared[lead.hit.material], lead.hit, plan.reuse_cosine, new, build);
+        kept.arena.last_built(env).expect("built")
     }
-}
 
-impl SamplerCache {
     /// The two-level-MIS sampler of `lead`'s material: the kept one if it was built within the
     /// material's reuse angle (and the material is not textured), otherwise built anew and kept.
     /// As for product-MIS, MIS with BRDF sampling covers where another point's lobe leaves the
@@ -210,17 +198,34 @@ impl SamplerCache {
         lead: &Lead<'_>,
     ) -> TwoLevelSampler<'s, 'e> {
         let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
-        let (hit, sp) = (lead.hit, lead.sp);
-        let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
-        let slot = &mut self.shared_two_level[hit.material];
-        if hit.bsdf.is_some() || !slot.as_ref().is_some_and(|c| c.near(normal, mirror, plan.reuse_cosine)) {
-            let c = slot.get_or_insert_with(|| Shared { arena: Box::default(), normal, mirror });
-            c.arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT);
-            (c.normal, c.mirror) = (normal, mirror);
-        }
-        let slot: &'s Option<Shared<Box<TwoLevelArena>>> = slot;
-        slot.as_ref().and_then(|c| c.arena.last_built(env)).expect("built above")
+        let sp = lead.sp;
+        let build = |a: &mut Box<TwoLevelArena>| {
+            a.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT);
+        };
+        let slot = &mut self.shared_two_level[lead.hit.material];
+        let kept = kept_or_built(slot, lead.hit, plan.reuse_cosine, Box::default, build);
+        kept.arena.last_built(env).expect("built")
     }
+}
+
+/// The sampler kept in `slot` if it was built within the reuse angle of cosine `cos` of `hit`
+/// (and `hit`'s material is not textured), otherwise `build` into its arena (a `new` one for an
+/// empty slot), kept with `hit`'s normal and mirror direction.
+fn kept_or_built<'s, A>(
+    slot: &'s mut Option<Shared<A>>,
+    hit: &Hit,
+    cos: f32,
+    new: impl FnOnce() -> A,
+    build: impl FnOnce(&mut A),
+) -> &'s Shared<A> {
+    let (normal, mirror) = (hit.frame.n, reflect(hit.wo, hit.frame.n));
+    if hit.bsdf.is_some() || !slot.as_ref().is_some_and(|c| c.near(normal, mirror, cos)) {
+        let c = slot.get_or_insert_with(|| Shared { arena: new(), normal, mirror });
+        build(&mut c.arena);
+        (c.normal, c.mirror) = (normal, mirror);
+    }
+    let slot: &'s Option<Shared<A>> = slot;
+    slot.as_ref().expect("kept or built above")
 }
 
 /// The cell cones are of a level the map and the two-level arena hold.

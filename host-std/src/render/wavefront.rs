@@ -50,17 +50,13 @@ fn layout(sampling: &Sampling<'_, '_>, budget: usize) -> Option<Layout> {
     match *sampling {
         Sampling::Env => fits(budget).then_some(Layout::Single { technique: Technique::Sampler, n: budget }),
         Sampling::Brdf => fits(budget).then_some(Layout::Single { technique: Technique::Brdf, n: budget }),
-        Sampling::Mis { env_share: 0.5, .. } => {
+        Sampling::Mis { env_share: 0.5, .. } | Sampling::TwoLevelMis { two_level_share: 0.5, .. } => {
             let n = (budget / 2).max(1);
             fits(n).then_some(Layout::Pairs { n })
         }
-        Sampling::Mis { env_share, .. } => split(env_share),
-        Sampling::ProductMis { product_share, .. } => split(product_share),
-        Sampling::TwoLevelMis { two_level_share: 0.5, .. } => {
-            let n = (budget / 2).max(1);
-            fits(n).then_some(Layout::Pairs { n })
-        }
-        Sampling::TwoLevelMis { two_level_share, .. } => split(two_level_share),
+        Sampling::Mis { env_share: share, .. }
+        | Sampling::ProductMis { product_share: share, .. }
+        | Sampling::TwoLevelMis { two_level_share: share, .. } => split(share),
         _ => None,
     }
 }
