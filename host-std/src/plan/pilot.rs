@@ -6,8 +6,8 @@
 //! shading point (`plan::candidates`: a plan that costs more per sample takes fewer, so that
 //! no material's choice takes time from the others'), scored by variance × cost per shading
 //! point — the variance from the pixel pairs' squared differences (relMSE's normalisation),
-//! the cost a fixed per-sample weight per plan ([`PLANS`]), not the pilot's clock, so that the choice, and the image, depend only on the
-//! scene, the settings and the seed. The pilot's samples are independent of the render's
+//! the cost a fixed per-sample weight per plan ([`PLANS`]), not the pilot's clock, so that the
+//! choice, and the image, depend only on the scene, the settings and the seed. The pilot's samples are independent of the render's
 //! (their own seeds), so choosing from them keeps every pixel's estimate unbiased.
 //!
 //! The pilot overrides the rules' plan ([`auto_strategy`](crate::plan::rules::auto_strategy))

@@ -1,9 +1,9 @@
 //! The light samples of all shading points of one material in a group, drawn as one wavefront
 //! (`sampler_core::estimator::wavefront`) where the material's sampler is the same at every
-//! point — the environment (env, BRDF and MIS sampling) or the pixel's shared product-MIS
-//! sampler — and each point takes few samples: then each point's estimate is the per-point
-//! estimator's ([`shade::shade`]) bit for bit, but the samples of all points are drawn
-//! together, and each shadow ray is traced as its point's estimate sums its sample.
+//! point — the environment (env, BRDF and MIS sampling) or the pixel's shared product-MIS or
+//! two-level-MIS sampler — and each point takes few samples: then each point's estimate is the
+//! per-point estimator's ([`shade::shade`]) bit for bit, but the samples of all points are
+//! drawn together, and each shadow ray is traced as its point's estimate sums its sample.
 
 use crate::render::shade::{Run, Sampling};
 use sampler_core::brdf::Brdf;
