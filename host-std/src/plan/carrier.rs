@@ -22,15 +22,12 @@ use crate::cpu_time::process_cpu_time;
 use crate::light::environment::Environment;
 use crate::light::move_distant_lights;
 use crate::plan::method::Lighting;
-use crate::plan::{Method, Settings, ShadingPoints, render_crop};
+use crate::plan::paired::{PilotCandidate, paired_scores, pilot_tiles};
+use crate::plan::{Method, Settings, ShadingPoints};
 use crate::render::crop::Crop;
-use crate::render::tiles::TILE;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
-use sampler_core::estimator::luminance64;
-use sampler_core::glam::Vec3;
 use sampler_core::light::{Light, SceneLight};
-use sampler_core::rng::hash_combine;
 use std::time::Instant;
 
 /// Share of the render's pixels each of the pilot's four renders covers (at least a tile).
@@ -104,7 +101,7 @@ pub fn choose(
     }
     let (start, cpu_start) = (Instant::now(), process_cpu_time());
     let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
-    let tiles = pilot_tiles(width, height);
+    let tiles = pilot_tiles(width, height, PILOT_SHARE);
     let mut in_map = Environment {
         level: env.level,
         rgb: env.rgb.clone(),
@@ -116,33 +113,18 @@ pub fn choose(
     move_distant_lights(&mut map_scene.lights, &mut in_map);
     // `auto`'s own pilot would run again in every tile's render: its MIS plans stand in for it.
     let method = if settings.method == Method::Auto { Method::Mis } else { settings.method };
-    let renders = |scene: &Scene, env: &Environment, carrier: u64| -> [(Vec<[f32; 3]>, f64); 2] {
-        let lighting = Lighting::of(true, scene.lights.len());
-        let hierarchy = env.hierarchy();
-        std::array::from_fn(|rep| {
-            let s = Settings {
-                method,
-                shading_points: points.resolve(method, settings.spp, lighting),
-                seed: hash_combine(hash_combine(settings.seed, 0xca55_1e55), 2 * carrier + rep as u64),
-                progress: false,
-                ..*settings
-            };
-            let mut cost = 0.0;
-            let pixels = tiles
-                .iter()
-                .flat_map(|&t| {
-                    let image = render_crop(scene, bvh, Some(&hierarchy), &s, t);
-                    cost += image.shadow_rays as f64 + point_cost(settings.method) * image.shading_points as f64;
-                    image.pixels
-                })
-                .collect();
-            (pixels, cost)
-        })
+    let (cone_env, map_env) = (env.hierarchy(), in_map.hierarchy());
+    let pilot_settings = |scene: &Scene| Settings {
+        method,
+        shading_points: points.resolve(method, settings.spp, Lighting::of(true, scene.lights.len())),
+        ..*settings
     };
-    let (cone, map) = (renders(scene, env, 0), renders(&map_scene, &in_map, 1));
-    let variance = pair_scores([[&cone[0].0, &cone[1].0], [&map[0].0, &map[1].0]]);
-    // Variance × cost: the carriers' images at equal time.
-    let scores = [variance[0] * (cone[0].1 + cone[1].1), variance[1] * (map[0].1 + map[1].1)];
+    let point_cost = point_cost(settings.method);
+    let candidates = [
+        PilotCandidate { scene, env: Some(&cone_env), settings: pilot_settings(scene), point_cost },
+        PilotCandidate { scene: &map_scene, env: Some(&map_env), settings: pilot_settings(&map_scene), point_cost },
+    ];
+    let scores: [f64; 2] = paired_scores(bvh, &candidates, &tiles, 0xca55_1e55).try_into().expect("two carriers");
     let carrier = if scores[1] * MAP_MARGIN < scores[0] { Carrier::Map } else { Carrier::Cone };
     let cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
     let pixels = tiles.iter().map(Crop::area).sum();
@@ -153,49 +135,12 @@ pub fn choose(
 /// shadow rays, per method: where the sun moves into the map and the scene has no other light,
 /// the shading-point rule gives each point fewer samples and so the image more points
 /// (docs/tuning.md, "A sun in the map or by its cone").
-fn point_cost(method: Method) -> f64 {
+pub(crate) fn point_cost(method: Method) -> f64 {
     match method {
         Method::ProductMis => PRODUCT_POINT_COST,
         Method::Auto => AUTO_POINT_COST,
         _ => POINT_COST,
     }
-}
-
-/// The render tiles the pilot renders: about [`PILOT_SHARE`] of the frame's pixels, at least
-/// one tile, spread over the frame on a grid of their own (the centre tile for one).
-fn pilot_tiles(width: usize, height: usize) -> Vec<Crop> {
-    let frame = Crop::full(width, height);
-    let count = ((PILOT_SHARE * (width * height) as f64 / (TILE * TILE) as f64).round() as usize).max(1);
-    let columns = (count as f64).sqrt().ceil() as usize;
-    let rows = count.div_ceil(columns);
-    let mut tiles: Vec<Crop> = (0..count)
-        .filter_map(|k| {
-            let x = ((k % columns) * 2 + 1) * width / (2 * columns);
-            let y = ((k / columns) * 2 + 1) * height / (2 * rows);
-            let (x0, y0) = (x / TILE * TILE, y / TILE * TILE);
-            Crop { x0, y0, x1: x0 + TILE, y1: y0 + TILE }.intersection(&frame)
-        })
-        .collect();
-    tiles.dedup();
-    tiles
-}
-
-/// Each carrier's variance from its two renders: the mean over pixels of the pairs'
-/// halved squared luminance difference over the squared mean luminance of all four renders
-/// (plus 0.01, relMSE's guard against dark pixels).
-fn pair_scores(renders: [[&[[f32; 3]]; 2]; 2]) -> [f64; 2] {
-    let lum = |c: [f32; 3]| luminance64(Vec3::from(c).as_dvec3());
-    let n = renders[0][0].len();
-    let mut scores = [0.0; 2];
-    for p in 0..n {
-        let values = renders.map(|r| [lum(r[0][p]), lum(r[1][p])]);
-        let mean = values.iter().flatten().sum::<f64>() / 4.0;
-        let norm = mean * mean + 0.01;
-        for (score, v) in scores.iter_mut().zip(values) {
-            *score += 0.5 * (v[0] - v[1]).powi(2) / norm;
-        }
-    }
-    scores.map(|s| s / n.max(1) as f64)
 }
 
 #[cfg(test)]
@@ -234,27 +179,5 @@ mod tests {
         assert_eq!((a.carrier, a.scores, a.pixels), (b.carrier, b.scores, b.pixels));
         assert!(a.carrier != Carrier::Auto && a.pixels == 16 * 16, "the one tile the pilot renders");
         assert!(a.scores.iter().all(|s| s.is_finite() && *s > 0.0), "{:?}", a.scores);
-    }
-
-    #[test]
-    fn pilot_tiles_are_whole_tiles_spread_over_the_frame() {
-        assert_eq!(pilot_tiles(128, 128), vec![Crop { x0: 64, y0: 64, x1: 80, y1: 80 }]);
-        let tiles = pilot_tiles(1024, 512);
-        assert_eq!(tiles.len(), 20);
-        assert!(tiles.iter().all(|t| t.area() == TILE * TILE && t.x0 % TILE == 0 && t.y0 % TILE == 0));
-        assert!(tiles.iter().any(|t| t.x0 < 256) && tiles.iter().any(|t| t.x0 >= 768));
-        assert!(tiles.iter().any(|t| t.y0 < 128) && tiles.iter().any(|t| t.y0 >= 384));
-        assert_eq!(pilot_tiles(10, 6), vec![Crop::full(10, 6)]);
-    }
-
-    #[test]
-    fn scores_are_the_pairs_variance_over_the_common_mean() {
-        let flat = |v: f32| vec![[v; 3]; 4];
-        // Cone: pairs 1 and 3 (variance 2 per pixel); map: pairs 2 and 2 (none).
-        let cone = [flat(1.0), flat(3.0)];
-        let map = [flat(2.0), flat(2.0)];
-        let s = pair_scores([[&cone[0], &cone[1]], [&map[0], &map[1]]]);
-        let norm = 4.0 + 0.01;
-        assert!((s[0] - 2.0 / norm).abs() < 1e-6 && s[1] == 0.0, "{s:?}");
     }
 }

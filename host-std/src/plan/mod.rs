@@ -8,8 +8,11 @@ pub mod candidates;
 pub mod carrier;
 mod decision;
 pub mod method;
+pub mod paired;
 pub mod pilot;
+pub mod prepass;
 pub mod rules;
+pub mod split;
 
 pub use budget::ShadingPoints;
 pub use method::Method;
@@ -17,6 +20,7 @@ pub use method::Method;
 use crate::cpu_time::process_cpu_time;
 use crate::light::baselines::{LightcutTable, sis_strata};
 use crate::light::lights::{LightOptions, LightTable};
+use crate::light::map_buffer::MapBuffer;
 use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::render::strategy::MaterialPlan;
@@ -122,6 +126,31 @@ pub fn render(scene: &Scene, bvh: &Bvh, env: Option<&EnvHierarchy<'_>>, settings
     render_crop(scene, bvh, env, settings, frame)
 }
 
+/// `auto` and product-MIS resolve their plan per material once, knowing how peaked the
+/// lighting is: the peak (`f32::MAX` where the method does not read it) and every material's plan.
+fn material_plans(scene: &Scene, env: Option<&EnvHierarchy<'_>>, settings: &Settings) -> (f32, Vec<MaterialPlan>) {
+    let env_peak = match env {
+        Some(e) if settings.method.reads_env_peak() => e.peak(5),
+        _ => f32::MAX,
+    };
+    let plans = scene
+        .materials
+        .iter()
+        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf, settings.brdf_samples))
+        .collect();
+    (env_peak, plans)
+}
+
+/// The MIS-compensated pyramid a render of `settings` samples (`None` where it samples none),
+/// built once so that a pilot's renders and the render share it through
+/// [`EnvHierarchy::with_compensated`] instead of each building its own. Like the map's own
+/// pyramid it is the map's preprocessing, outside the render's time.
+#[must_use]
+pub fn compensation(scene: &Scene, env: &EnvHierarchy<'_>, settings: &Settings) -> Option<MapBuffer<f32>> {
+    let (_, plans) = material_plans(scene, Some(env), settings);
+    compensated_pyramid(env, &plans, settings.method == Method::Auto)
+}
+
 /// Renders the pixels of `crop` (inside the frame), bit for bit the same pixels of the whole
 /// frame's render: everything is planned from the whole frame (`auto`'s pilot too).
 pub fn render_crop(
@@ -131,16 +160,7 @@ pub fn render_crop(
     settings: &Settings,
     crop: Crop,
 ) -> Rendered {
-    // `auto` and product-MIS resolve per material once, knowing how peaked the lighting is.
-    let env_peak = match env {
-        Some(e) if settings.method.reads_env_peak() => e.peak(5),
-        _ => f32::MAX,
-    };
-    let plans: Vec<MaterialPlan> = scene
-        .materials
-        .iter()
-        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf, settings.brdf_samples))
-        .collect();
+    let (env_peak, plans) = material_plans(scene, env, settings);
     // MIS's env samples draw from the compensated pyramid, built only where MIS may sample.
     let compensated = env.and_then(|e| compensated_pyramid(e, &plans, settings.method == Method::Auto));
     let env_view = env.map(|e| match &compensated {

@@ -20,8 +20,10 @@ pub use series::Series;
 pub use tables::{csv, markdown, relmse_at};
 
 use crate::plan::method::Lighting;
+use crate::plan::prepass::render_planned;
 use crate::plan::{self, Method, Settings, ShadingPoints};
 use crate::render::brdf_samples::BrdfSamples;
+use crate::render::crop::Crop;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
@@ -126,6 +128,7 @@ pub fn sweep(
     mut progress: impl FnMut(&Measurement),
 ) -> Vec<Measurement> {
     let regions = Regions::of(scene, bvh);
+    let frame = Crop::full(scene.camera.width as usize, scene.camera.height as usize);
     let lighting = Lighting::of(env.is_some(), scene.lights.len());
     let settings = |series: Series, spp: usize| Settings {
         method: series.method,
@@ -135,7 +138,7 @@ pub fn sweep(
         ..*base
     };
     let mut measure = |series: Series, spp: usize| {
-        let image = plan::render(scene, bvh, env, &settings(series, spp));
+        let (image, _) = render_planned(scene, bvh, env, &settings(series, spp), points, frame);
         let (rmse, relmse) = errors(&image.pixels, reference);
         let bias = errors::relative_bias(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
@@ -182,7 +185,8 @@ pub fn sweep(
         }
     }
     keep_fastest(&mut out, timing.repeat, |series, spp| {
-        timing.clock.seconds(&plan::render(scene, bvh, env, &Settings { progress: false, ..settings(series, spp) }))
+        let settings = Settings { progress: false, ..settings(series, spp) };
+        timing.clock.seconds(&render_planned(scene, bvh, env, &settings, points, frame).0)
     });
     out
 }

@@ -10,7 +10,7 @@ use clap::Args;
 use host_std::light::environment::Environment;
 use host_std::output;
 use host_std::plan::carrier::{self, Carrier, CarrierChoice};
-use host_std::plan::method::Lighting;
+use host_std::plan::prepass::Prepass;
 use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
 use host_std::render::crop::Crop;
 use host_std::scene::Scene;
@@ -98,19 +98,20 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let points = args.sampling.shading_points.map_or(ShadingPoints::Rule, |p| ShadingPoints::Given(p as usize));
     let carries = prepared.environment.is_some() && carrier::has_wide_distant_light(&prepared.scene);
     let carrier = pool.install(|| carry_distant_lights(args.sampling.carrier(), &mut prepared, &settings, points));
-    let lighting = Lighting::of(prepared.environment.is_some(), prepared.scene.lights.len());
-    let shading_points = points.resolve(args.method, args.spp as usize, lighting) as u32;
-    settings.shading_points = shading_points as usize;
+    let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
+    let prepass = pool.install(|| Prepass::run(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, points));
+    let shading_points = prepass.shading_points as u32;
+    settings.shading_points = prepass.shading_points;
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
     let used = carries.then(|| carrier.as_ref().map_or(args.sampling.carrier(), |c| c.carrier));
     let record = provenance::settings_text(&args, &settings, frame, &prepared.files, used)?;
-    let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
-    let mut image =
-        pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, crop));
+    let view = hierarchy.as_ref().map(|h| prepass.view(h));
+    let mut image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, view.as_ref(), &settings, crop));
+    // The pilots and the prepass are part of the render's cost.
+    prepass.charge(&mut image);
     if let Some(c) = &carrier {
-        // The pilot is part of the render's cost.
         image.render_seconds += c.seconds;
         image.render_cpu_seconds = image.render_cpu_seconds.zip(c.cpu_seconds).map(|(r, p)| r + p);
     }
@@ -118,7 +119,8 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     output::write_exr_part(&exr_path, frame, crop, &image.pixels, Some(&record))?;
     output::write_png(&png_path, image.width, image.height, &image.pixels)?;
     if let Some(path) = &args.stats_json {
-        let stats = Stats::new(&args, &prepared, hierarchy.as_ref(), &image, shading_points, threads);
+        let stats =
+            Stats::new(&args, &prepared, hierarchy.as_ref(), &image, shading_points, prepass.split.as_ref(), threads);
         output::write_text(path, &serde_json::to_string_pretty(&stats)?)?;
     }
     let t = image.render_seconds.max(1e-9);
@@ -143,6 +145,19 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
             c.pixels,
             c.scores[0],
             c.scores[1],
+            c.seconds
+        );
+    }
+    if let Some(c) = &prepass.split {
+        eprintln!(
+            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}; {:.2} s)",
+            c.samples_per_point,
+            c.pixels,
+            c.pilot_spp,
+            c.scores[0],
+            c.candidates[0],
+            c.scores[1],
+            c.candidates[1],
             c.seconds
         );
     }

@@ -3,6 +3,7 @@
 //! host-usd/bench/) read them by name.
 
 use crate::render_cmd::{Prepared, RenderArgs};
+use host_std::plan::split::SplitChoice;
 use host_std::plan::{Rendered, pilot};
 use sampler_core::env::EnvHierarchy;
 use serde::Serialize;
@@ -59,6 +60,8 @@ pub(crate) struct Stats {
     shading_points: u64,
     shading_points_per_pixel: u32,
     shadow_rays: u64,
+    /// The light samples per shading point the split pilot measured (`null` where it did not run).
+    split_pilot: Option<SplitPilot>,
     spp: u32,
     threads: usize,
     /// `--frame` as given (a USD time code), `null` without it.
@@ -66,6 +69,17 @@ pub(crate) struct Stats {
     unshadowed: bool,
     /// The image's width (the crop's).
     width: usize,
+}
+
+/// What the split pilot measured (`plan::split`).
+#[derive(Serialize)]
+struct SplitPilot {
+    /// Light samples per shading point the render took.
+    chosen: usize,
+    pilot_pixels: usize,
+    pilot_spp: usize,
+    /// Per candidate samples per shading point, its variance × cost.
+    scores: BTreeMap<usize, f64>,
 }
 
 /// What `auto`'s pilot measured for one material.
@@ -87,6 +101,7 @@ impl Stats {
         hierarchy: Option<&EnvHierarchy<'_>>,
         image: &Rendered,
         shading_points: u32,
+        split: Option<&SplitChoice>,
         threads: usize,
     ) -> Self {
         let env = prepared.environment.as_ref();
@@ -140,6 +155,12 @@ impl Stats {
             shading_points: image.shading_points,
             shading_points_per_pixel: shading_points,
             shadow_rays: image.shadow_rays,
+            split_pilot: split.map(|c| SplitPilot {
+                chosen: c.samples_per_point,
+                pilot_pixels: c.pixels,
+                pilot_spp: c.pilot_spp,
+                scores: c.candidates.into_iter().zip(c.scores).collect(),
+            }),
             spp: args.spp,
             threads,
             time_code: args.scene.frame.clone(),
