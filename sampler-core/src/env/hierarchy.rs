@@ -240,8 +240,7 @@ impl<'a> EnvHierarchy<'a> {
     #[inline]
     pub fn prefetch_texel(&self, uv: Vec2) {
         let (x, y) = self.texel_at(uv);
-        let i = y as usize * self.resolution() as usize + x as usize;
-        prefetch(&self.radiance[i..=i]);
+        self.prefetch_radiance_texel(x, y);
         match &self.cdf {
             Some(cdf) => cdf.prefetch(morton2(x, y)),
             None => {
@@ -249,6 +248,20 @@ impl<'a> EnvHierarchy<'a> {
                 prefetch(&self.pyramid[node..=node]);
             }
         }
+    }
+
+    /// Asks the memory system for what [`radiance_at`](Self::radiance_at) reads at `uv`
+    /// alone: for a sampler's own draws, whose density comes with the draw.
+    #[inline]
+    pub fn prefetch_radiance(&self, uv: Vec2) {
+        let (x, y) = self.texel_at(uv);
+        self.prefetch_radiance_texel(x, y);
+    }
+
+    #[inline(always)]
+    fn prefetch_radiance_texel(&self, x: u32, y: u32) {
+        let i = y as usize * self.resolution() as usize + x as usize;
+        prefetch(&self.radiance[i..=i]);
     }
 
     /// Env-only density per unit area of the square at `uv` (mean 1 over the square): the

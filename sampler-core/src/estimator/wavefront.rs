@@ -149,9 +149,9 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
     // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
-    // for now, it arrives meanwhile.
+    // for now, it arrives meanwhile (their density came with the draw).
     for d in drawn[..n_sampler].iter().flatten() {
-        env.prefetch_texel(d.uv);
+        env.prefetch_radiance(d.uv);
     }
     let mut p_square = [0.0f32; WAVE];
     if weighting != Weighting::Single {
