@@ -134,7 +134,9 @@ mod tests {
 
     #[test]
     fn morton2_interleaves_the_bits() {
-        let interleaved = |x: u32, y: u32| (0..16).fold(0usize, |m, b| m | ((x >> b & 1) as usize) << (2 * b) | ((y >> b & 1) as usize) << (2 * b + 1));
+        let interleaved = |x: u32, y: u32| {
+            (0..16).fold(0usize, |m, b| m | ((x >> b & 1) as usize) << (2 * b) | ((y >> b & 1) as usize) << (2 * b + 1))
+        };
         for (x, y) in [(0, 0), (1, 0), (0, 1), (255, 256), (1023, 77), (0xFFFF, 0xFFFF), (0x1_2345, 0xABCD)] {
             assert_eq!(morton2(x, y), interleaved(x & 0xFFFF, y & 0xFFFF), "({x}, {y})");
         }
