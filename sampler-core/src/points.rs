@@ -107,6 +107,19 @@ static SOBOL_DIM1_REVERSED: [[u32; 256]; 4] = reversed(byte_tables(1));
 /// linearity x(i + 1) = x(i) ⊕ `SOBOL_STEPS[dim][trailing_ones(i)]`.
 static SOBOL_STEPS: [[u32; 33]; 2] = [steps(0), steps(1)];
 
+/// [`SOBOL_STEPS`] of the second dimension with every entry's bits reversed, the steps of
+/// [`SOBOL_DIM1_REVERSED`]'s points.
+static SOBOL_DIM1_STEPS_REVERSED: [u32; 33] = reversed_steps(steps(1));
+
+const fn reversed_steps(mut t: [u32; 33]) -> [u32; 33] {
+    let mut m = 0;
+    while m < 33 {
+        t[m] = t[m].reverse_bits();
+        m += 1;
+    }
+    t
+}
+
 const fn steps(dim: usize) -> [u32; 33] {
     let v = generator(dim);
     let mut t = [0u32; 33];
@@ -196,19 +209,32 @@ impl Sobol02 {
     }
 
     /// Points `first .. first + out.len()`.
+    #[inline]
     pub fn fill(&self, first: u32, out: &mut [DVec2]) {
-        for (k, p) in out.iter_mut().enumerate() {
-            let i = first.wrapping_add(k as u32);
-            // The first dimension is the index with its bits reversed, so reversed it is the index.
-            let x = scramble_reversed(i, self.s0);
-            let b = i.to_le_bytes();
-            let t = &SOBOL_DIM1_REVERSED;
-            let y = scramble_reversed(
-                t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize],
-                self.s1,
-            );
-            *p = DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32);
+        for (p, q) in out.iter_mut().zip(self.points(first)) {
+            *p = q;
         }
+    }
+
+    /// Points `first, first + 1, …` (wrapping after index 2³² − 1), for callers that take them
+    /// one at a time without a buffer.
+    #[inline]
+    pub fn points(&self, first: u32) -> impl Iterator<Item = DVec2> + use<> {
+        let Self { s0, s1 } = *self;
+        // The second dimension's reversed point from the byte tables once, then from each
+        // point to the next by one step (`SOBOL_STEPS`, reversed): the same points.
+        let b = first.to_le_bytes();
+        let t = &SOBOL_DIM1_REVERSED;
+        let mut y_reversed = t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize];
+        let mut i = first;
+        core::iter::from_fn(move || {
+            // The first dimension is the index with its bits reversed, so reversed it is the index.
+            let x = scramble_reversed(i, s0);
+            let y = scramble_reversed(y_reversed, s1);
+            y_reversed ^= SOBOL_DIM1_STEPS_REVERSED[i.trailing_ones() as usize];
+            i = i.wrapping_add(1);
+            Some(DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32))
+        })
     }
 }
 

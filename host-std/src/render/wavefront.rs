@@ -10,7 +10,7 @@ use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
 use sampler_core::estimator::{BATCH, ShadingPoint};
-use sampler_core::glam::{DVec2, DVec3, Vec3};
+use sampler_core::glam::{DVec3, Vec3};
 use sampler_core::points::Sobol02;
 use sampler_core::rng::hash_combine;
 
@@ -167,26 +167,19 @@ fn push_samples(
     samples: &mut Vec<WaveSample>,
 ) {
     let mut push = |technique, u| samples.push(WaveSample { point, technique, u });
-    let mut points = [DVec2::ZERO; BATCH];
     match layout {
         Layout::Single { technique, n } => {
-            first_seq.fill((block * n) as u32, &mut points[..n]);
-            points[..n].iter().for_each(|&u| push(technique, u));
+            first_seq.points((block * n) as u32).take(n).for_each(|u| push(technique, u));
         }
         Layout::Pairs { n } => {
-            let mut others = [DVec2::ZERO; BATCH];
-            first_seq.fill((block * n) as u32, &mut points[..n]);
-            brdf_seq.fill((block * n) as u32, &mut others[..n]);
-            for (&u, &v) in points[..n].iter().zip(&others[..n]) {
+            for (u, v) in first_seq.points((block * n) as u32).zip(brdf_seq.points((block * n) as u32)).take(n) {
                 push(Technique::Sampler, u);
                 push(Technique::Brdf, v);
             }
         }
         Layout::Split { first, brdf } => {
-            first_seq.fill((block * first) as u32, &mut points[..first]);
-            points[..first].iter().for_each(|&u| push(Technique::Sampler, u));
-            brdf_seq.fill((block * brdf) as u32, &mut points[..brdf]);
-            points[..brdf].iter().for_each(|&u| push(Technique::Brdf, u));
+            first_seq.points((block * first) as u32).take(first).for_each(|u| push(Technique::Sampler, u));
+            brdf_seq.points((block * brdf) as u32).take(brdf).for_each(|u| push(Technique::Brdf, u));
         }
     }
 }

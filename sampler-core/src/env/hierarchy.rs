@@ -234,14 +234,12 @@ impl<'a> EnvHierarchy<'a> {
         self.radiance_texel(x, y)
     }
 
-    /// Asks the memory system for what [`radiance_at`](Self::radiance_at) and
-    /// [`pdf_square`](Self::pdf_square) read at `uv`, ahead of reading it: a hint that changes
-    /// no result.
-    #[inline]
-    pub fn prefetch_texel(&self, uv: Vec2) {
-        let (x, y) = self.texel_at(uv);
-        let i = y as usize * self.resolution() as usize + x as usize;
-        prefetch(&self.radiance[i..=i]);
+    /// Asks the memory system for what [`radiance_texel`](Self::radiance_texel) and
+    /// [`pdf_square`](Self::pdf_square) read at texel (x, y) ([`texel_at`](Self::texel_at)),
+    /// ahead of reading it: a hint that changes no result.
+    #[inline(always)]
+    pub fn prefetch_texel(&self, x: u32, y: u32) {
+        self.prefetch_radiance(x, y);
         match &self.cdf {
             Some(cdf) => cdf.prefetch(morton2(x, y)),
             None => {
@@ -249,6 +247,14 @@ impl<'a> EnvHierarchy<'a> {
                 prefetch(&self.pyramid[node..=node]);
             }
         }
+    }
+
+    /// Asks the memory system for what [`radiance_texel`](Self::radiance_texel) reads at
+    /// texel (x, y) alone: for a sampler's own draws, whose density comes with the draw.
+    #[inline(always)]
+    pub fn prefetch_radiance(&self, x: u32, y: u32) {
+        let i = y as usize * self.resolution() as usize + x as usize;
+        prefetch(&self.radiance[i..=i]);
     }
 
     /// Env-only density per unit area of the square at `uv` (mean 1 over the square): the

@@ -135,8 +135,11 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
     let mut uvs = [Vec2::ZERO; WAVE];
     env.squares_of(&dirs[..n_brdf], &mut uvs[..n_brdf]);
-    for uv in &uvs[..n_brdf] {
-        env.prefetch_texel(*uv);
+    // Each sample's texel found once: asked for now, read in the last loops.
+    let mut texels_brdf = [(0u32, 0u32); WAVE];
+    for (t, uv) in texels_brdf.iter_mut().zip(&uvs[..n_brdf]) {
+        *t = env.texel_at(*uv);
+        env.prefetch_texel(t.0, t.1);
     }
     // The sampler's draws, all in one batch (its descents side by side).
     let mut u_sampler = [DVec2::ZERO; WAVE];
@@ -149,9 +152,13 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
     // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
-    // for now, it arrives meanwhile.
-    for d in drawn[..n_sampler].iter().flatten() {
-        env.prefetch_texel(d.uv);
+    // for now, it arrives meanwhile (their density came with the draw).
+    let mut texels_drawn = [(0u32, 0u32); WAVE];
+    for (t, d) in texels_drawn.iter_mut().zip(&drawn[..n_sampler]) {
+        if let Some(d) = d {
+            *t = env.texel_at(d.uv);
+            env.prefetch_radiance(t.0, t.1);
+        }
     }
     let mut p_square = [0.0f32; WAVE];
     if weighting != Weighting::Single {
@@ -170,8 +177,8 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
         }
     }
     let mut radiance_brdf = [Vec3::ZERO; WAVE];
-    for (r, uv) in radiance_brdf.iter_mut().zip(&uvs[..n_brdf]) {
-        *r = env.radiance_at(*uv);
+    for (r, &(x, y)) in radiance_brdf.iter_mut().zip(&texels_brdf[..n_brdf]) {
+        *r = env.radiance_texel(x, y);
     }
     // Every sample's value, in order.
     let (mut i_sampler, mut i_brdf) = (0, 0);
@@ -182,7 +189,8 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
                 let k = i_sampler;
                 i_sampler += 1;
                 drawn[k].map_or(Candidate::default(), |d| {
-                    sampler_candidate(sp, d, env.radiance_at(d.uv), evaluated[k], weighting)
+                    let (x, y) = texels_drawn[k];
+                    sampler_candidate(sp, d, env.radiance_texel(x, y), evaluated[k], weighting)
                 })
             }
             Technique::Brdf => {

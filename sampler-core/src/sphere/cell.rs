@@ -96,14 +96,30 @@ impl Cell {
 #[inline]
 #[must_use]
 pub fn morton2(x: u32, y: u32) -> usize {
+    // A byte's bits spread by table: two lookups per coordinate where the shifts and masks
+    // take four steps.
+    #[inline(always)]
     fn spread(v: u32) -> u32 {
-        let mut v = v & 0xFFFF;
-        v = (v | (v << 8)) & 0x00FF_00FF;
-        v = (v | (v << 4)) & 0x0F0F_0F0F;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
+        SPREAD_BYTE[(v & 0xFF) as usize] as u32 | (SPREAD_BYTE[((v >> 8) & 0xFF) as usize] as u32) << 16
     }
     (spread(x) | (spread(y) << 1)) as usize
+}
+
+/// Each byte's bits moved to the even bits of 16.
+static SPREAD_BYTE: [u16; 256] = spread_bytes();
+
+const fn spread_bytes() -> [u16; 256] {
+    let mut t = [0u16; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut v = b as u32;
+        v = (v | (v << 4)) & 0x0F0F;
+        v = (v | (v << 2)) & 0x3333;
+        v = (v | (v << 1)) & 0x5555;
+        t[b] = v as u16;
+        b += 1;
+    }
+    t
 }
 
 /// The largest f32 below a positive finite `x`.
@@ -115,6 +131,19 @@ fn next_down(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn morton2_interleaves_the_bits() {
+        let interleaved = |x: u32, y: u32| {
+            (0..16).fold(0usize, |m, b| m | ((x >> b & 1) as usize) << (2 * b) | ((y >> b & 1) as usize) << (2 * b + 1))
+        };
+        for (x, y) in [(0, 0), (1, 0), (0, 1), (255, 256), (1023, 77), (0xFFFF, 0xFFFF), (0x1_2345, 0xABCD)] {
+            assert_eq!(morton2(x, y), interleaved(x & 0xFFFF, y & 0xFFFF), "({x}, {y})");
+        }
+        for x in (0..0x1_0000).step_by(97) {
+            assert_eq!(morton2(x, x ^ 0x5A5A), interleaved(x, x ^ 0x5A5A));
+        }
+    }
 
     #[test]
     fn side_is_the_division() {
