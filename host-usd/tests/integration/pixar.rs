@@ -67,12 +67,13 @@ fn instancer_renders_instances_not_prototypes() {
     let scene = host_usd::load(&fixtures().join("instancing.usda")).unwrap();
     // 4 visible instances (tree, rock, tree, rock) of one gprim each, plus 3 chairs as
     // instance proxies; the prototypes themselves are not rendered in place.
-    assert!(scene.meshes.iter().all(|m| !m.path.starts_with("/World/Forest/Prototypes") || m.path.contains('[')));
-    let instanced = scene.meshes.iter().filter(|m| m.path.contains("[/World/Forest:")).count()
+    let meshes = scene.all_meshes();
+    assert!(meshes.iter().all(|m| !m.path.starts_with("/World/Forest/Prototypes") || m.path.contains('[')));
+    let instanced = meshes.iter().filter(|m| m.path.contains("[/World/Forest:")).count()
         + scene.spheres.iter().filter(|s| s.path.contains("[/World/Forest:")).count();
     assert_eq!(instanced, 4);
     assert_eq!(scene.counts.instances, 4 + 3);
-    let chairs = scene.meshes.iter().filter(|m| m.path.starts_with("/World/Chair")).count();
+    let chairs = meshes.iter().filter(|m| m.path.starts_with("/World/Chair")).count();
     assert_eq!(chairs, 3);
     // Z-up stage: converted to Y up.
     assert_eq!(scene.up_axis, host_usd::UpAxis::Z);
