@@ -16,5 +16,6 @@ mod scene_lights;
 mod usd;
 mod usd_ies;
 mod usd_lights;
+mod usd_instances;
 mod usd_time;
 mod usd_twins;
