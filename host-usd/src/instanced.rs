@@ -67,12 +67,13 @@ impl Instanced {
     }
 
     /// The corners of each triangle of instance `i`'s `group`th material, placed in the
-    /// world as [`Instanced::mesh`] places them (in either winding), without making the mesh.
-    pub fn for_each_triangle(&self, i: usize, group: usize, mut f: impl FnMut([Vec3; 3])) {
+    /// world as [`Instanced::mesh`] places them (in either winding), without making the mesh;
+    /// `points` is scratch space.
+    pub fn for_each_triangle(&self, i: usize, group: usize, points: &mut Vec<Vec3>, mut f: impl FnMut([Vec3; 3])) {
         let inst = &self.instances[i];
         let proto = &self.prototypes[inst.prototype as usize];
-        let points: Vec<Vec3> =
-            proto.local.positions.iter().map(|&p| inst.transform.transform_point3(p).as_vec3()).collect();
+        points.clear();
+        points.extend(proto.local.positions.iter().map(|&p| inst.transform.transform_point3(p).as_vec3()));
         for &t in &proto.groups[group].1 {
             f(proto.local.triangles[t].map(|v| points[v as usize]));
         }
@@ -80,14 +81,17 @@ impl Instanced {
 
     /// The triangles of instance `i`'s `group`th material, placed in the world.
     pub fn mesh(&self, i: usize, group: usize) -> Mesh {
+        Mesh { path: self.path(i), ..self.placed(i, group) }
+    }
+
+    /// [`Instanced::mesh`] without its name (an empty path): what a renderer needs.
+    pub fn placed(&self, i: usize, group: usize) -> Mesh {
         let inst = &self.instances[i];
         let proto = &self.prototypes[inst.prototype as usize];
         let (material, which) = &proto.groups[group];
         let mut remap = vec![UNMAPPED; proto.local.positions.len()];
         let placed = Placement::new(&inst.transform);
-        let mut mesh = place(&proto.local, which, &placed, &mut remap, *material, proto.double_sided);
-        mesh.path = self.path(i);
-        mesh
+        place(&proto.local, which, &placed, &mut remap, *material, proto.double_sided)
     }
 }
 

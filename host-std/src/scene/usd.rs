@@ -212,7 +212,7 @@ struct UsdInstances(host_usd::Instanced);
 
 impl Instances for UsdInstances {
     fn mesh(&self, instance: u32, group: u32) -> Shape {
-        let m = self.0.mesh(instance as usize, group as usize);
+        let m = self.0.placed(instance as usize, group as usize);
         Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs }
     }
 
@@ -222,8 +222,13 @@ impl Instances for UsdInstances {
     }
 
     fn count_triangles(&self, instance: u32, group: u32, counted: &dyn Fn([Vec3; 3]) -> bool) -> usize {
+        thread_local! {
+            static POINTS: std::cell::RefCell<Vec<Vec3>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
         let mut n = 0;
-        self.0.for_each_triangle(instance as usize, group as usize, |t| n += usize::from(counted(t)));
+        POINTS.with_borrow_mut(|points| {
+            self.0.for_each_triangle(instance as usize, group as usize, points, |t| n += usize::from(counted(t)))
+        });
         n
     }
 }
@@ -299,14 +304,21 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> anyhow::R
         let mut taken = 0;
         let set = Arc::new(UsdInstances(instanced));
         let handle = InstancesHandle(set.clone());
+        // Each prototype's groups' materials, found on its first instance (materials are
+        // numbered in the order objects first use them).
+        let mut group_materials: Vec<Vec<usize>> = vec![Vec::new(); set.0.prototypes.len()];
         for (i, inst) in set.0.instances.iter().enumerate() {
             let upto = inst.after_meshes as usize;
             all.extend(meshes.by_ref().take(upto - taken).map(|m| mesh_object(m, &mut material)));
             taken = upto;
             let proto = &set.0.prototypes[inst.prototype as usize];
-            for (g, (m, _)) in proto.groups.iter().enumerate() {
+            let found = &mut group_materials[inst.prototype as usize];
+            if found.is_empty() {
+                found.extend(proto.groups.iter().map(|(m, _)| material(*m, proto.double_sided)));
+            }
+            for (g, &m) in found.iter().enumerate() {
                 let shape = Shape::Instance { set: handle.clone(), instance: i as u32, group: g as u32 };
-                all.push(Object { shape, material: material(*m, proto.double_sided) });
+                all.push(Object { shape, material: m });
             }
         }
         all.extend(meshes.map(|m| mesh_object(m, &mut material)));

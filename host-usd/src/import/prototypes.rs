@@ -202,6 +202,7 @@ impl Importer<'_> {
         let mut sources: Vec<Vec<Option<GprimSource>>> = Vec::new();
         sources.resize_with(parts.len(), Vec::new);
         let instancer = self.scene.instanced.instancers.len() as u32;
+        let to_world = self.conversion * *world;
         self.scene.instanced.instancers.push(prim.to_string());
         let expanded = instances.iter().try_for_each(|inst| {
             let Some(i) = index.get(inst.prototype).copied().flatten() else { return Ok(()) };
@@ -210,7 +211,7 @@ impl Importer<'_> {
             }
             let of = InstanceOf { instancer, index: inst.index as u32 };
             parts[i].iter().zip(&mut sources[i]).try_for_each(|((p, t, rel, mesh_light), source)| {
-                let m = self.conversion * *world * inst.transform * *rel;
+                let m = to_world * inst.transform * *rel;
                 self.prototype_part(p, t, *mesh_light, of, &m, source).map_err(fail(p))
             })
         });
