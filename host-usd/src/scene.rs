@@ -1,8 +1,8 @@
 //! What an import yields: plain data in the renderer's frame (Y up, scene units), with no
 //! openusd types, so host-std converts it without knowing USD.
 
-pub use crate::material::{Lobes, Material, Texture, TextureInput};
 pub use crate::instanced::{Instance, Instanced, Prototype};
+pub use crate::material::{Lobes, Material, Texture, TextureInput};
 use crate::render_settings::Conform;
 use glam::{DMat3, Vec2, Vec3};
 use std::path::PathBuf;

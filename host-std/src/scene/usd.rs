@@ -6,7 +6,9 @@
 use crate::light::environment::{EnvSource, Placement};
 use crate::light::image_file;
 use crate::scene::texture::{ImageTexture, Wrap};
-use crate::scene::{Bsdf, CameraSpec, Instances, InstancesHandle, Material, Object, Scene, Shape, TextureHandle, Textured};
+use crate::scene::{
+    Bsdf, CameraSpec, Instances, InstancesHandle, Material, Object, Scene, Shape, TextureHandle, Textured,
+};
 pub use host_usd::TimeCode;
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};

@@ -95,7 +95,8 @@ fn instances_keep_each_prototype_once_and_pixars_transforms() {
         assert!(err <= 1e-9, "instance {}: {err:e}", inst.index);
     }
     // Placed, each instance is its prototype's triangles under its transform, named by it.
-    let placed: Vec<String> = scene.all_meshes().iter().filter(|m| m.path.contains('[')).map(|m| m.path.clone()).collect();
+    let placed: Vec<String> =
+        scene.all_meshes().iter().filter(|m| m.path.contains('[')).map(|m| m.path.clone()).collect();
     let names = ["Crown[/World/Forest:0]", "Rock[/World/Forest:1]", "Crown[/World/Forest:3]", "Rock[/World/Forest:4]"];
     assert_eq!(placed.len(), names.len());
     placed.iter().zip(names).for_each(|(p, n)| assert!(p.ends_with(n), "{p}"));
