@@ -1,9 +1,9 @@
 //! A PointInstancer's instances kept as instances: each prototype gprim's triangles read once
 //! in its own space, and per instance only which prototype and where. The renderer places
-//! them when it needs their triangles ([`Instanced::mesh`]), as the import placed gprims
-//! before (the same arithmetic, so the same points to the bit); a stage of many instances
-//! holds one small record per instance, not a mesh per instance. See docs/usd.md,
-//! "PointInstancer".
+//! them when it needs their triangles ([`Instanced::mesh`]) by [`place`], the arithmetic that
+//! places a gprim's own mesh, so an instance's points are those of its twin mesh to the bit; a
+//! stage of many instances holds one small record per instance, not a mesh per instance. See
+//! docs/usd.md, "Import speed" (the PointInstancer's table).
 
 use crate::mesh::LocalMesh;
 use crate::scene::Mesh;
@@ -41,6 +41,9 @@ pub struct Instance {
     /// Prototype space to the renderer's world (non-singular).
     pub transform: DAffine3,
 }
+
+// A stage of many instances holds one record per instance and nothing on the heap for it.
+const _: () = assert!(std::mem::size_of::<Instance>() == 112);
 
 /// Every PointInstancer instance of a scene.
 #[derive(Clone, Debug, Default, PartialEq)]

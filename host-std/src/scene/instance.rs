@@ -1,6 +1,7 @@
 //! Instanced geometry: a loader's prototype placed by many transforms (USD's PointInstancer),
 //! held as one small record per instance and made triangles only when a render gathers its
-//! primitives. See docs/usd.md, "PointInstancer".
+//! primitives. See docs/usd.md, "Import speed", and docs/bvh.md, "Instances: what a two-level
+//! BVH needs".
 
 use super::Shape;
 use sampler_core::glam::Vec3;

@@ -26,7 +26,8 @@ pub struct Converted {
     pub scene: Scene,
     /// What the import left out or reduced, one line each.
     pub notes: Vec<String>,
-    /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
+    /// The import, without its meshes and instances (their geometry is in `scene`; `usd.counts`
+    /// counts them).
     pub usd: UsdScene,
     /// Every file the import read: its layers, the textures and the dome's map (a package
     /// once for everything inside it), sorted.
