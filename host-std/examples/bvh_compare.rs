@@ -25,6 +25,11 @@ fn triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
                 out.push([*p0, *p0 + *e1 + *e2, *p0 + *e2]);
             }
             Shape::Sphere { .. } => {}
+            Shape::Instance { set, instance, group } => {
+                if let Shape::Mesh { positions, triangles, .. } = set.0.mesh(*instance, *group) {
+                    out.extend(triangles.iter().map(|t| t.map(|i| positions[i as usize])));
+                }
+            }
         }
     }
     out.retain(|[a, b, c]| (*b - *a).cross(*c - *a).length_squared() > 0.0);

@@ -136,6 +136,7 @@ fn load_unguarded(file: &Path, options: &Options) -> Result<UsdScene, UsdError> 
         time_code_range: stage.time_code_range(),
         layers: Vec::new(),
         meshes: Vec::new(),
+        instanced: Default::default(),
         spheres: Vec::new(),
         materials: Vec::new(),
         dome: None,

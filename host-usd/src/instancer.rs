@@ -34,8 +34,9 @@ pub fn read(stage: &Stage, prim: &PrimPath) -> Result<(Vec<PrimPath>, Vec<Instan
     }
     let scales = numbers(stage.value(prim, "scales")?);
     let ids = numbers(stage.value(prim, "ids")?);
-    let invisible: std::collections::HashSet<i64> =
-        numbers(stage.value(prim, "invisibleIds")?).iter().map(|&x| x as i64).collect();
+    // Sorted and searched: a hash of every instance's id costs more than the search.
+    let mut invisible: Vec<i64> = numbers(stage.value(prim, "invisibleIds")?).iter().map(|&x| x as i64).collect();
+    invisible.sort_unstable();
     let n = proto_indices.len();
     if positions.len() < 3 * n {
         return Err(format!("{n} protoIndices but {} positions", positions.len() / 3));
@@ -43,7 +44,7 @@ pub fn read(stage: &Stage, prim: &PrimPath) -> Result<(Vec<PrimPath>, Vec<Instan
     let mut out = Vec::with_capacity(n);
     for (i, &p) in proto_indices.iter().enumerate() {
         let id = ids.get(i).map_or(i as i64, |&x| x as i64);
-        if invisible.contains(&id) {
+        if invisible.binary_search(&id).is_ok() {
             continue;
         }
         let proto = p as i64;

@@ -12,6 +12,7 @@ pub mod error;
 mod guard;
 pub mod import;
 pub mod inherit;
+pub mod instanced;
 pub mod instancer;
 pub mod lights;
 pub mod material;

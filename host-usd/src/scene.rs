@@ -1,6 +1,7 @@
 //! What an import yields: plain data in the renderer's frame (Y up, scene units), with no
 //! openusd types, so host-std converts it without knowing USD.
 
+pub use crate::instanced::{Instance, Instanced, Prototype};
 pub use crate::material::{Lobes, Material, Texture, TextureInput};
 use crate::render_settings::Conform;
 use glam::{DMat3, Vec2, Vec3};
@@ -158,6 +159,9 @@ pub struct UsdScene {
     pub layers: Vec<String>,
     /// Triangle meshes in world space.
     pub meshes: Vec<Mesh>,
+    /// PointInstancer instances not made meshes: their prototypes' triangles, read once, and
+    /// where each instance places them ([`UsdScene::all_meshes`] places them).
+    pub instanced: Instanced,
     /// Exact spheres.
     pub spheres: Vec<Sphere>,
     /// Every material a mesh or sphere refers to.
@@ -178,4 +182,21 @@ pub struct UsdScene {
     pub counts: Counts,
     /// Wall time of the import.
     pub import_seconds: f64,
+}
+
+impl UsdScene {
+    /// Every mesh, the instances' placed, in the order the import met them.
+    pub fn all_meshes(&self) -> Vec<Mesh> {
+        let instanced = &self.instanced;
+        let mut all = Vec::with_capacity(self.meshes.len() + instanced.instances.len());
+        let mut taken = 0;
+        for (i, inst) in instanced.instances.iter().enumerate() {
+            let upto = inst.after_meshes as usize;
+            all.extend_from_slice(&self.meshes[taken..upto]);
+            taken = upto;
+            all.extend((0..instanced.groups(i)).map(|g| instanced.mesh(i, g)));
+        }
+        all.extend_from_slice(&self.meshes[taken..]);
+        all
+    }
 }

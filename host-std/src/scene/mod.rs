@@ -4,6 +4,7 @@
 
 pub mod builtin;
 pub mod ies;
+mod instance;
 pub mod json;
 mod json_lights;
 mod json_shaping;
@@ -21,4 +22,5 @@ pub mod usd_info;
 #[cfg(feature = "usd")]
 pub mod usd_lights;
 
+pub use instance::{Instances, InstancesHandle};
 pub use model::*;

@@ -2,6 +2,7 @@
 //! number of other lights, as every loader fills it (the built-in scene, the JSON reader, the
 //! USD importer).
 
+use super::InstancesHandle;
 use crate::light::environment::{EnvSource, Placement};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::glam::{Vec2, Vec3};
@@ -58,6 +59,16 @@ pub enum Shape {
         normals: Box<[[Vec3; 3]]>,
         /// Per triangle, its corners' texture coordinates (empty: none).
         uvs: Box<[[Vec2; 3]]>,
+    },
+    /// One material's triangles of one instance of a shared prototype, placed when a render
+    /// gathers them ([`super::Instances::mesh`]).
+    Instance {
+        /// The set it belongs to.
+        set: InstancesHandle,
+        /// Which instance of the set.
+        instance: u32,
+        /// Which of its prototype's material groups.
+        group: u32,
     },
 }
 
@@ -189,6 +200,7 @@ impl Scene {
             .iter()
             .map(|o| match &o.shape {
                 Shape::Mesh { triangles, .. } => triangles.len(),
+                Shape::Instance { set, instance, group } => set.0.triangle_count(*instance, *group),
                 Shape::Rectangle { .. } => 2,
                 Shape::Sphere { .. } => 0,
             })

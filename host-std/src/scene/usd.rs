@@ -6,7 +6,9 @@
 use crate::light::environment::{EnvSource, Placement};
 use crate::light::image_file;
 use crate::scene::texture::{ImageTexture, Wrap};
-use crate::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape, TextureHandle, Textured};
+use crate::scene::{
+    Bsdf, CameraSpec, Instances, InstancesHandle, Material, Object, Scene, Shape, TextureHandle, Textured,
+};
 pub use host_usd::TimeCode;
 use host_usd::{Lobes, TextureInput, UsdScene};
 use sampler_core::brdf::{CarPaint, Lambert, RoughConductor};
@@ -24,7 +26,8 @@ pub struct Converted {
     pub scene: Scene,
     /// What the import left out or reduced, one line each.
     pub notes: Vec<String>,
-    /// The import, without its meshes (their geometry is in `scene`; `usd.counts` counts them).
+    /// The import, without its meshes and instances (their geometry is in `scene`; `usd.counts`
+    /// counts them).
     pub usd: UsdScene,
     /// Every file the import read: its layers, the textures and the dome's map (a package
     /// once for everything inside it), sorted.
@@ -206,6 +209,33 @@ fn bsdf(l: &Lobes) -> Bsdf {
     }
 }
 
+/// A USD scene's PointInstancer instances, placed as the import placed meshes.
+#[derive(Debug)]
+struct UsdInstances(host_usd::Instanced);
+
+impl Instances for UsdInstances {
+    fn mesh(&self, instance: u32, group: u32) -> Shape {
+        let m = self.0.placed(instance as usize, group as usize);
+        Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs }
+    }
+
+    fn triangle_count(&self, instance: u32, group: u32) -> usize {
+        let inst = &self.0.instances[instance as usize];
+        self.0.prototypes[inst.prototype as usize].groups[group as usize].1.len()
+    }
+
+    fn count_triangles(&self, instance: u32, group: u32, counted: &dyn Fn([Vec3; 3]) -> bool) -> usize {
+        thread_local! {
+            static POINTS: std::cell::RefCell<Vec<Vec3>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut n = 0;
+        POINTS.with_borrow_mut(|points| {
+            self.0.for_each_triangle(instance as usize, group as usize, points, |t| n += usize::from(counted(t)))
+        });
+        n
+    }
+}
+
 /// Converts an imported USD scene, rendered at `size` (width, height) where given; an error
 /// when a light's IES file cannot be parsed.
 pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> anyhow::Result<Converted> {
@@ -254,19 +284,47 @@ pub fn convert(mut usd: UsdScene, size: (Option<u32>, Option<u32>)) -> anyhow::R
     // objects in their own list's memory (an object is no larger than a mesh record), so
     // the two lists of a stage of many small meshes are not held at once; the spheres
     // go first, as they always have.
-    let meshes: Vec<Object> = std::mem::take(&mut usd.meshes)
-        .into_iter()
-        .map(|m| {
-            let shape = Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs };
-            Object { shape, material: material(m.material, m.double_sided) }
-        })
-        .collect();
-    let objects = if spheres.is_empty() {
-        meshes
+    let meshes = std::mem::take(&mut usd.meshes);
+    let instanced = std::mem::take(&mut usd.instanced);
+    let mesh_object = |m: host_usd::Mesh, material: &mut dyn FnMut(usize, bool) -> usize| {
+        let shape = Shape::Mesh { positions: m.positions, triangles: m.triangles, normals: m.normals, uvs: m.uvs };
+        Object { shape, material: material(m.material, m.double_sided) }
+    };
+    let objects = if instanced.instances.is_empty() {
+        let meshes: Vec<Object> = meshes.into_iter().map(|m| mesh_object(m, &mut material)).collect();
+        if spheres.is_empty() {
+            meshes
+        } else {
+            let mut all = spheres;
+            all.reserve_exact(meshes.len());
+            all.extend(meshes);
+            all
+        }
     } else {
+        // Each instance's objects among the meshes, where the import met it.
         let mut all = spheres;
-        all.reserve_exact(meshes.len());
-        all.extend(meshes);
+        let mut meshes = meshes.into_iter();
+        let mut taken = 0;
+        let set = Arc::new(UsdInstances(instanced));
+        let handle = InstancesHandle(set.clone());
+        // Each prototype's groups' materials, found on its first instance (materials are
+        // numbered in the order objects first use them).
+        let mut group_materials: Vec<Vec<usize>> = vec![Vec::new(); set.0.prototypes.len()];
+        for (i, inst) in set.0.instances.iter().enumerate() {
+            let upto = inst.after_meshes as usize;
+            all.extend(meshes.by_ref().take(upto - taken).map(|m| mesh_object(m, &mut material)));
+            taken = upto;
+            let proto = &set.0.prototypes[inst.prototype as usize];
+            let found = &mut group_materials[inst.prototype as usize];
+            if found.is_empty() {
+                found.extend(proto.groups.iter().map(|(m, _)| material(*m, proto.double_sided)));
+            }
+            for (g, &m) in found.iter().enumerate() {
+                let shape = Shape::Instance { set: handle.clone(), instance: i as u32, group: g as u32 };
+                all.push(Object { shape, material: m });
+            }
+        }
+        all.extend(meshes.map(|m| mesh_object(m, &mut material)));
         all
     };
     let cam = usd.camera.clone().unwrap_or_else(|| host_usd::camera::framing((Vec3::splat(-1.0), Vec3::ONE)));

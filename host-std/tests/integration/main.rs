@@ -15,6 +15,7 @@ mod render;
 mod scene_lights;
 mod usd;
 mod usd_ies;
+mod usd_instances;
 mod usd_lights;
 mod usd_time;
 mod usd_twins;

@@ -59,13 +59,23 @@ impl Importer<'_> {
         let targets = &self.light_geometry;
         // Triangles taken back per target path.
         let mut dropped: HashMap<&str, usize> = HashMap::new();
-        self.scene.meshes.retain(|m| match targets.get_key_value(m.path.as_str()) {
-            Some((path, _)) => {
-                *dropped.entry(path).or_default() += m.triangles.len();
-                false
-            }
-            None => true,
+        // Meshes kept before each place, for the instances' places among them.
+        let mut kept_before = Vec::with_capacity(self.scene.meshes.len() + 1);
+        kept_before.push(0u32);
+        self.scene.meshes.retain(|m| {
+            let kept = match targets.get_key_value(m.path.as_str()) {
+                Some((path, _)) => {
+                    *dropped.entry(path).or_default() += m.triangles.len();
+                    false
+                }
+                None => true,
+            };
+            kept_before.push(kept_before[kept_before.len() - 1] + u32::from(kept));
+            kept
         });
+        for inst in &mut self.scene.instanced.instances {
+            inst.after_meshes = kept_before[inst.after_meshes as usize];
+        }
         self.scene.spheres.retain(|s| match targets.get_key_value(s.path.as_str()) {
             Some((path, _)) => {
                 dropped.entry(path).or_default();

@@ -8,7 +8,7 @@
 
 #![allow(clippy::mutable_key_type, reason = "a path's interior mutability is its text cache, outside Eq and Hash")]
 
-use super::gprim::GprimSource;
+use super::gprim::{GprimSource, InstanceOf};
 use super::{Failure, Importer, Stop, fail};
 use crate::instancer;
 use crate::stage::{PrimMap, PrimPath, Stage, Step};
@@ -201,15 +201,18 @@ impl Importer<'_> {
         // at every instance.
         let mut sources: Vec<Vec<Option<GprimSource>>> = Vec::new();
         sources.resize_with(parts.len(), Vec::new);
+        let instancer = self.scene.instanced.instancers.len() as u32;
+        let to_world = self.conversion * *world;
+        self.scene.instanced.instancers.push(prim.to_string());
         let expanded = instances.iter().try_for_each(|inst| {
             let Some(i) = index.get(inst.prototype).copied().flatten() else { return Ok(()) };
             if sources[i].is_empty() {
                 sources[i].resize_with(parts[i].len(), || None);
             }
+            let of = InstanceOf { instancer, index: inst.index as u32 };
             parts[i].iter().zip(&mut sources[i]).try_for_each(|((p, t, rel, mesh_light), source)| {
-                let m = self.conversion * *world * inst.transform * *rel;
-                let label = format!("{p}[{prim}:{}]", inst.index);
-                self.prototype_part(p, t, *mesh_light, &label, &m, source).map_err(fail(p))
+                let m = to_world * inst.transform * *rel;
+                self.prototype_part(p, t, *mesh_light, of, &m, source).map_err(fail(p))
             })
         });
         self.prototypes.parts = parts;
@@ -225,20 +228,20 @@ impl Importer<'_> {
         prim: &PrimPath,
         type_name: &str,
         mesh_light: bool,
-        label: &str,
+        of: InstanceOf,
         m: &DMat4,
         source: &mut Option<GprimSource>,
     ) -> Result<(), String> {
         if crate::lights::KINDS.contains(&type_name) {
-            return self.light_at(prim, type_name, m, label);
+            return self.light_at(prim, type_name, m, &self.instance_label(prim, of));
         }
         if mesh_light {
-            return self.mesh_light_at(prim, type_name, m, label);
+            return self.mesh_light_at(prim, type_name, m, &self.instance_label(prim, of));
         }
         let source = match source {
             Some(s) => s,
             empty => empty.insert(self.gprim_source(prim, type_name)?),
         };
-        self.place_gprim(source, label, m)
+        self.place_instance(source, of, m)
     }
 }

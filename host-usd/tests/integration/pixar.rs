@@ -62,17 +62,62 @@ fn instancer_transforms_match_pixar() {
     }
 }
 
+/// A row-major 4×4 of Pixar's JSON (row vectors) as a column-vector matrix.
+fn pixar_matrix(rows: &serde_json::Value) -> DMat4 {
+    DMat4::from_cols_array(&std::array::from_fn(|k| rows[k / 4][k % 4].as_f64().unwrap()))
+}
+
+#[test]
+fn instances_keep_each_prototype_once_and_pixars_transforms() {
+    let scene = host_usd::load(&fixtures().join("instancing.usda")).unwrap();
+    let text = std::fs::read_to_string(fixtures().join("instancing.expected.json")).unwrap();
+    let want: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let set = &scene.instanced;
+    assert_eq!(set.instancers, ["/World/Forest"]);
+    // The cone (instances 0 and 3) and the rock (1 and 4: neither under a uniform scale, the
+    // authored half-precision quaternion of 1 not being unit) are instances; 2 is invisible.
+    let indices: Vec<u32> = set.instances.iter().map(|i| i.index).collect();
+    assert_eq!(indices, [0, 1, 3, 4]);
+    assert_eq!(set.prototypes.len(), 2, "each prototype gprim is read once");
+    assert!(scene.meshes.iter().all(|m| !m.path.contains('[')), "no instance is a mesh of its own");
+    // Pixar's instance transform includes the prototype root's own; the cone's scale lies
+    // below the root.
+    let pixar = &want["instancers"]["/World/Forest"]["transforms"];
+    let visible = [0, 1, 3, 4];
+    let forest = pixar_matrix(&want["prims"]["/World/Forest"]["world"]);
+    let conversion = host_usd::xform::up_axis_conversion(true);
+    for inst in &set.instances {
+        let k = visible.iter().position(|&v| v == inst.index).unwrap();
+        let path = &set.prototypes[inst.prototype as usize].path;
+        let part = if path.ends_with("Crown") { DMat4::from_scale((0.5, 0.5, 1.0).into()) } else { DMat4::IDENTITY };
+        let expected = conversion * forest * pixar_matrix(&pixar[k]) * part;
+        let err = (DMat4::from(inst.transform) - expected).to_cols_array().iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        assert!(err <= 1e-9, "instance {}: {err:e}", inst.index);
+    }
+    // Placed, each instance is its prototype's triangles under its transform, named by it.
+    let placed: Vec<String> =
+        scene.all_meshes().iter().filter(|m| m.path.contains('[')).map(|m| m.path.clone()).collect();
+    let names = ["Crown[/World/Forest:0]", "Rock[/World/Forest:1]", "Crown[/World/Forest:3]", "Rock[/World/Forest:4]"];
+    assert_eq!(placed.len(), names.len());
+    placed.iter().zip(names).for_each(|(p, n)| assert!(p.ends_with(n), "{p}"));
+    let (inst, mesh) = (&set.instances[0], set.mesh(0, 0));
+    let proto = &set.prototypes[inst.prototype as usize];
+    let corner = inst.transform.transform_point3(proto.local.positions[proto.local.triangles[0][0] as usize]);
+    assert_eq!(mesh.positions[mesh.triangles[0][0] as usize], corner.as_vec3());
+}
+
 #[test]
 fn instancer_renders_instances_not_prototypes() {
     let scene = host_usd::load(&fixtures().join("instancing.usda")).unwrap();
     // 4 visible instances (tree, rock, tree, rock) of one gprim each, plus 3 chairs as
     // instance proxies; the prototypes themselves are not rendered in place.
-    assert!(scene.meshes.iter().all(|m| !m.path.starts_with("/World/Forest/Prototypes") || m.path.contains('[')));
-    let instanced = scene.meshes.iter().filter(|m| m.path.contains("[/World/Forest:")).count()
+    let meshes = scene.all_meshes();
+    assert!(meshes.iter().all(|m| !m.path.starts_with("/World/Forest/Prototypes") || m.path.contains('[')));
+    let instanced = meshes.iter().filter(|m| m.path.contains("[/World/Forest:")).count()
         + scene.spheres.iter().filter(|s| s.path.contains("[/World/Forest:")).count();
     assert_eq!(instanced, 4);
     assert_eq!(scene.counts.instances, 4 + 3);
-    let chairs = scene.meshes.iter().filter(|m| m.path.starts_with("/World/Chair")).count();
+    let chairs = meshes.iter().filter(|m| m.path.starts_with("/World/Chair")).count();
     assert_eq!(chairs, 3);
     // Z-up stage: converted to Y up.
     assert_eq!(scene.up_axis, host_usd::UpAxis::Z);

@@ -5,7 +5,7 @@
 use super::disk::Disk;
 use super::{CornerAttrs, NO_ATTRS, Primitive, Surface};
 use crate::scene::{Scene, Shape};
-use sampler_core::glam::Vec3;
+use sampler_core::glam::{Vec2, Vec3};
 use sampler_core::light::LightSurface;
 
 /// What a scene's hierarchy is built over.
@@ -26,22 +26,11 @@ pub(super) fn gather(scene: &Scene) -> Gathered {
             }
             Shape::Rectangle { p0, e1, e2 } => rectangle(&mut g.prims, *p0, *e1, *e2, surface),
             Shape::Mesh { positions, triangles, normals, uvs } => {
-                for (k, t) in triangles.iter().enumerate() {
-                    let [a, b, c] = t.map(|i| positions[i as usize]);
-                    if has_area(a, b, c) {
-                        let n = normals
-                            .get(k)
-                            .filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0))
-                            .copied();
-                        let uv = uvs.get(k).filter(|uv| uv.iter().all(|t| t.is_finite())).copied();
-                        let attrs = if n.is_some() || uv.is_some() {
-                            g.corner_attrs.push(CornerAttrs { normals: n, uvs: uv });
-                            (g.corner_attrs.len() - 1) as u32
-                        } else {
-                            NO_ATTRS
-                        };
-                        g.prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, surface, attrs });
-                    }
+                mesh(&mut g, positions, triangles, normals, uvs, surface)
+            }
+            Shape::Instance { set, instance, group } => {
+                if let Shape::Mesh { positions, triangles, normals, uvs } = set.0.mesh(*instance, *group) {
+                    mesh(&mut g, &positions, &triangles, &normals, &uvs, surface)
                 }
             }
         }
@@ -65,9 +54,35 @@ pub(super) fn gather(scene: &Scene) -> Gathered {
     g
 }
 
-/// The number of primitives [`gather`] makes of `scene` (disks aside), without making them.
-pub(super) fn count(scene: &Scene) -> usize {
-    let shape = |shape: &Shape| match shape {
+/// A mesh's triangles that have an area, with their shading normals and texture
+/// coordinates where given and finite.
+fn mesh(
+    g: &mut Gathered,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    normals: &[[Vec3; 3]],
+    uvs: &[[Vec2; 3]],
+    surface: u32,
+) {
+    for (k, t) in triangles.iter().enumerate() {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        if has_area(a, b, c) {
+            let n = normals.get(k).filter(|n| n.iter().all(|n| n.is_finite() && n.length_squared() > 0.0)).copied();
+            let uv = uvs.get(k).filter(|uv| uv.iter().all(|t| t.is_finite())).copied();
+            let attrs = if n.is_some() || uv.is_some() {
+                g.corner_attrs.push(CornerAttrs { normals: n, uvs: uv });
+                (g.corner_attrs.len() - 1) as u32
+            } else {
+                NO_ATTRS
+            };
+            g.prims.push(Primitive::Triangle { v0: a, e1: b - a, e2: c - a, surface, attrs });
+        }
+    }
+}
+
+/// The number of primitives [`gather`] makes of `shape`.
+fn shape_count(shape: &Shape) -> usize {
+    match shape {
         Shape::Sphere { .. } => 1,
         Shape::Rectangle { .. } => 2,
         Shape::Mesh { positions, triangles, .. } => triangles
@@ -77,13 +92,21 @@ pub(super) fn count(scene: &Scene) -> usize {
                 has_area(a, b, c)
             })
             .count(),
-    };
+        // A triangle's area is the same in either winding.
+        Shape::Instance { set, instance, group } => {
+            set.0.count_triangles(*instance, *group, &|[a, b, c]| has_area(a, b, c))
+        }
+    }
+}
+
+/// The number of primitives [`gather`] makes of `scene` (disks aside), without making them.
+pub(super) fn count(scene: &Scene) -> usize {
     let light = |surface: Option<LightSurface>| match surface {
         Some(LightSurface::Sphere { .. } | LightSurface::Triangle(_)) => 1,
         Some(LightSurface::Rect { .. }) => 2,
         Some(LightSurface::Disk { .. }) | None => 0,
     };
-    scene.objects.iter().map(|o| shape(&o.shape)).sum::<usize>()
+    scene.objects.iter().map(|o| shape_count(&o.shape)).sum::<usize>()
         + scene.lights.iter().map(|l| light(l.surface())).sum::<usize>()
 }
 
