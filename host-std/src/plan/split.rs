@@ -7,9 +7,10 @@
 //! "Shading points per pixel"). Neither wins on every scene, so a pilot measures the scene:
 //! paired renders of a few tiles with each split (`plan::paired`), scored by variance × cost.
 //!
-//! The pilot renders at a quarter of the render's samples per pixel: the footprint's share of
-//! the error falls with spp faster than the light's (stratified shading points), so a split
-//! that wins there wins at the render's spp too, and the pilot costs a quarter as much.
+//! The pilot renders at an eighth of the render's samples per pixel (at least 32): the
+//! footprint's share of the error falls with spp faster than the light's (stratified shading
+//! points), so a split that wins there wins at the render's spp too, and the pilot's four
+//! renders of 5% of the pixels cost a few per cent of the render.
 
 use crate::cpu_time::process_cpu_time;
 use crate::plan::carrier::point_cost;
@@ -22,12 +23,13 @@ use crate::trace::bvh::Bvh;
 use sampler_core::env::EnvHierarchy;
 use std::time::Instant;
 
-/// Samples per pixel from which the pilot runs: below, its renders would cost more than a
-/// quarter of the render's samples, and the rule's split stands.
+/// Samples per pixel from which the pilot runs: below, its renders (at least
+/// [`MIN_PILOT_SPP`]) would cost more than a quarter of the render's samples per pixel, and the
+/// rule's split stands.
 pub const MIN_SPP: usize = 128;
 
 /// The pilot's samples per pixel are the render's over this (at least [`MIN_PILOT_SPP`]).
-pub const PILOT_SPP_DIVISOR: usize = 4;
+pub const PILOT_SPP_DIVISOR: usize = 8;
 
 /// Share of the frame's pixels each of the pilot's renders covers: a few tiles decide wrongly
 /// where a scene's error sits in its edges and glints (docs/tuning.md, "Shading points per pixel").
