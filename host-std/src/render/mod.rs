@@ -31,7 +31,7 @@ use crate::trace::camera::Camera;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::lights::LightSet;
 use std::ops::AddAssign;
-use strategy::MaterialPlan;
+use strategy::{MaterialPlan, Strategy};
 
 /// How pixels are sampled: the budget, the seed and what is traced.
 #[derive(Clone, Copy, Debug)]
@@ -117,11 +117,12 @@ pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option
 }
 
 /// The MIS-compensated pyramid of `env` ([`EnvHierarchy::compensated`]), built when a plan
-/// samples MIS or `auto`'s pilot may choose it, and `env` has none attached; `None` also where
+/// samples MIS or two-level-MIS (whose cells it compensates) or `auto`'s pilot may choose
+/// them, and `env` has none attached; `None` also where
 /// nothing of the map stands above its mean (the plain pyramid then serves MIS).
 #[must_use]
 pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<MapBuffer<f32>> {
-    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, strategy::Strategy::Mis { .. }));
+    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, Strategy::Mis { .. } | Strategy::TwoLevelMis { .. }));
     if !mis || env.has_compensated() {
         return None;
     }
@@ -132,7 +133,7 @@ pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot
 /// The summed-area table two-stage sampling reads, built when a plan needs it.
 #[must_use]
 pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<f64>> {
-    plans.iter().any(|p| p.strategy == strategy::Strategy::TwoStage).then(|| {
+    plans.iter().any(|p| p.strategy == Strategy::TwoStage).then(|| {
         let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(env.finest_level())];
         sampler_core::two_stage::build_sat(env, &mut sat);
         sat
@@ -143,7 +144,6 @@ pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Opti
 mod tests {
     use super::*;
     use crate::render::brdf_samples::BrdfSamples;
-    use crate::render::strategy::Strategy;
     use crate::scene::Bsdf;
     use sampler_core::brdf::Lambert;
     use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
@@ -158,6 +158,8 @@ mod tests {
         let plan = |strategy| MaterialPlan::new(strategy, &bsdf, BrdfSamples::default());
         let (env_only, mis) = ([plan(Strategy::Env)], [plan(Strategy::Env), plan(Strategy::Mis { env_share: 0.5 })]);
         assert!(compensated_pyramid(&env, &env_only, false).is_none());
+        let two_level_mis = [plan(Strategy::TwoLevelMis { two_level_share: 0.5 })];
+        assert!(compensated_pyramid(&env, &two_level_mis, false).is_some(), "two-level-MIS compensates its cells");
         let built = compensated_pyramid(&env, &mis, false).expect("a MIS plan");
         assert!(compensated_pyramid(&env, &env_only, true).is_some(), "auto's pilot may choose MIS");
         let attached = env.with_compensated(&built).unwrap();
