@@ -150,7 +150,7 @@ pub fn render_crop(
     let env = env_view.as_ref();
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));
-    let cones = env.and_then(|e| two_level_cones(e, &plans));
+    let cones = env.and_then(|e| two_level_cones(e, &plans, rules::two_level_level(env_peak)));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
     let baselines = Baselines::build(scene, env, settings);
@@ -194,7 +194,7 @@ pub fn render_crop(
     // A two-level plan the pilot chose reads the cell cones, which the rules' plans did not build.
     let plans = chosen.as_deref().unwrap_or(ctx.plans);
     let pilot_cones = match (env, ctx.cones) {
-        (Some(e), None) => two_level_cones(e, plans),
+        (Some(e), None) => two_level_cones(e, plans, rules::two_level_level(env_peak)),
         _ => None,
     };
     let pilot_seconds = start.elapsed().as_secs_f64();

@@ -104,12 +104,16 @@ impl AddAssign for Counters {
     }
 }
 
-/// The cell cones the two-level product reads, built when a plan needs it: of
-/// [`strategy::TWO_LEVEL_LEVEL`], or of the map's finest level if that is coarser.
+/// The cell cones the two-level product reads, built when a plan needs it: of `level`
+/// ([`strategy::two_level_level`]), or of the map's finest level if that is coarser.
 #[must_use]
-pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<sampler_core::cone::Cone>> {
+pub fn two_level_cones(
+    env: &EnvHierarchy<'_>,
+    plans: &[MaterialPlan],
+    level: u32,
+) -> Option<Vec<sampler_core::cone::Cone>> {
     plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
-        let level = strategy::TWO_LEVEL_LEVEL.min(env.finest_level());
+        let level = level.min(env.finest_level());
         let mut cones = vec![sampler_core::cone::Cone::default(); sampler_core::cone::cell_count(level)];
         sampler_core::cone::build_cell_cones(&mut cones);
         cones
