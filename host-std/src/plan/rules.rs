@@ -19,7 +19,7 @@
 //!   [`SMOOTH_LIGHTING_PEAK`]): BRDF sampling for every material — the product is the lobe
 //!   within that factor, so BRDF sampling draws nearly the product without building it.
 
-use crate::render::strategy::{self, Strategy};
+use crate::render::strategy::Strategy;
 use crate::scene::Bsdf;
 
 /// Lobe widths (GGX α; `Brdf::lobe_width`) where `auto` samples the product (with BRDF
@@ -31,13 +31,6 @@ pub const PRODUCT_ALPHA_EXTENDED: std::ops::RangeInclusive<f32> = 0.03..=0.3;
 
 /// Peak (max / mean of the map over 32×32 blocks) from which the light counts as a sun.
 pub const SUN_PEAK: f32 = 100.0;
-
-/// The two-level product's coarse level under a map of peak `env_peak`: finer under extended
-/// light than under a sun ([`strategy::two_level_level`]).
-#[must_use]
-pub fn two_level_level(env_peak: f32) -> u32 {
-    strategy::two_level_level(env_peak, SUN_PEAK)
-}
 
 /// Below this peak (max / mean of the map over 32×32 blocks) `auto` samples the BRDF only.
 pub const SMOOTH_LIGHTING_PEAK: f32 = 4.0;

@@ -28,6 +28,7 @@ use crate::light::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
+use sampler_core::cone::Cone;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::lights::LightSet;
 use std::ops::AddAssign;
@@ -67,7 +68,7 @@ pub struct Context<'a, 'e> {
     pub sat: Option<&'a [f64]>,
     /// The cell cones of the two-level product's coarse level, built when a material is
     /// sampled with it.
-    pub cones: Option<&'a [sampler_core::cone::Cone]>,
+    pub cones: Option<&'a CellCones>,
     /// Structured importance sampling's strata of `env`, built when a material is shaded
     /// with them.
     pub strata: Option<&'a [sampler_core::sis::Stratum]>,
@@ -104,19 +105,37 @@ impl AddAssign for Counters {
     }
 }
 
-/// The cell cones the two-level product reads, built when a plan needs it: of `level`
-/// ([`strategy::two_level_level`]), or of the map's finest level if that is coarser.
+/// The cell cones the two-level product reads: of its coarse level, and under extended light
+/// of its finer one for the lobes that draw from it ([`strategy::TWO_LEVEL_FINE_LEVEL`]).
+pub struct CellCones {
+    coarse: Vec<Cone>,
+    /// Empty under a sun, or where the map is no finer than the coarse level.
+    fine: Vec<Cone>,
+}
+
+impl CellCones {
+    /// The cones a lobe of width `lobe_width` (`Brdf::lobe_width`) draws from.
+    #[must_use]
+    pub fn for_lobe(&self, lobe_width: f32) -> &[Cone] {
+        let fine = !self.fine.is_empty() && strategy::FINE_CELL_LOBES.contains(&lobe_width);
+        if fine { &self.fine } else { &self.coarse }
+    }
+}
+
+/// The cell cones the two-level product reads, built when a plan needs it: of
+/// [`strategy::TWO_LEVEL_LEVEL`] and, where the light is `extended` rather than a sun, of
+/// [`strategy::TWO_LEVEL_FINE_LEVEL`] (each clamped to the map's finest level).
 #[must_use]
-pub fn two_level_cones(
-    env: &EnvHierarchy<'_>,
-    plans: &[MaterialPlan],
-    level: u32,
-) -> Option<Vec<sampler_core::cone::Cone>> {
-    plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
-        let level = level.min(env.finest_level());
-        let mut cones = vec![sampler_core::cone::Cone::default(); sampler_core::cone::cell_count(level)];
+pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], extended: bool) -> Option<CellCones> {
+    let of_level = |level: u32| {
+        let mut cones = vec![Cone::default(); sampler_core::cone::cell_count(level.min(env.finest_level()))];
         sampler_core::cone::build_cell_cones(&mut cones);
         cones
+    };
+    plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
+        let coarse = of_level(strategy::TWO_LEVEL_LEVEL);
+        let finer = extended && env.finest_level() > strategy::TWO_LEVEL_LEVEL;
+        CellCones { coarse, fine: if finer { of_level(strategy::TWO_LEVEL_FINE_LEVEL) } else { Vec::new() } }
     })
 }
 
