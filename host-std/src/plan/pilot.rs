@@ -65,10 +65,10 @@ pub const OVERRIDE_MARGIN: f64 = 1.25;
 pub const COSTLIER_OVERRIDE_MARGIN: f64 = 2.0;
 
 /// Ratio of costs per sample from which a plan counts as costlier than the rule's for
-/// [`COSTLIER_OVERRIDE_MARGIN`]: product-MIS (1.45× MIS and above) is, two-level-MIS (1.25×)
+/// [`COSTLIER_OVERRIDE_MARGIN`]: product-MIS (1.45× MIS and above) is, two-level-MIS (1.12×)
 /// is not — its samples come from a sampler shared as product-MIS's is, and its score already
 /// carries its cost.
-pub const COSTLIER_FROM: f64 = 1.3;
+pub const COSTLIER_FROM: f64 = 1.2;
 
 /// Standard errors by which the rule's plan must score above another's for the other to replace
 /// it (`plan::decision`): a one-sided test at about 2% per comparison, on the mean of the pilot
