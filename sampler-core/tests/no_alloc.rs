@@ -71,7 +71,8 @@ fn ten_thousand_shading_points_allocate_nothing() {
     assert!(sampler_core::cone::build_cell_cones(&mut cones));
     let mut two_level: Box<sampler_core::two_level::TwoLevelArena> = Box::default();
     let mut above = vec![0.0f32; sampler_core::env::pyramid_len(level)];
-    let compensated = if env.compensate_into(&mut above).unwrap() { env.with_compensated(&above).unwrap() } else { env };
+    let compensated =
+        if env.compensate_into(&mut above).unwrap() { env.with_compensated(&above).unwrap() } else { env };
     ARMED.with(|a| a.set(true));
     for i in 0..10_000u64 {
         let normal = square_to_sphere(glam::Vec2::new(rng.next_f32(), rng.next_f32()));
