@@ -66,7 +66,7 @@ pub struct Context<'a, 'e> {
     pub lights: Option<&'a LightSet<'a>>,
     /// The summed-area table of `env`, built when a material is sampled two-stage.
     pub sat: Option<&'a [f64]>,
-    /// The cell cones of the two-level product's coarse level, built when a material is
+    /// The cell cones of the two-level product's coarse levels, built when a material is
     /// sampled with it.
     pub cones: Option<&'a CellCones>,
     /// Structured importance sampling's strata of `env`, built when a material is shaded
@@ -141,8 +141,8 @@ pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], extended:
 
 /// The MIS-compensated pyramid of `env` ([`EnvHierarchy::compensated`]), built when a plan
 /// samples MIS or two-level-MIS (whose cells it compensates) or `auto`'s pilot may choose
-/// them, and `env` has none attached; `None` also where
-/// nothing of the map stands above its mean (the plain pyramid then serves MIS).
+/// them, and `env` has none attached; `None` also where nothing of the map stands above its
+/// mean (the plain pyramid then serves MIS).
 #[must_use]
 pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<MapBuffer<f32>> {
     let mis = pilot || plans.iter().any(|p| matches!(p.strategy, Strategy::Mis { .. } | Strategy::TwoLevelMis { .. }));
