@@ -70,6 +70,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
     let mut cones = vec![sampler_core::cone::Cone::default(); 256];
     assert!(sampler_core::cone::build_cell_cones(&mut cones));
     let mut two_level: Box<sampler_core::two_level::TwoLevelArena> = Box::default();
+    let mut above = vec![0.0f32; sampler_core::env::pyramid_len(level)];
+    let compensated =
+        if env.compensate_into(&mut above).unwrap() { env.with_compensated(&above).unwrap() } else { env };
     ARMED.with(|a| a.set(true));
     for i in 0..10_000u64 {
         let normal = square_to_sphere(glam::Vec2::new(rng.next_f32(), rng.next_f32()));
@@ -112,6 +115,9 @@ fn ten_thousand_shading_points_allocate_nothing() {
             let mut many = [None; 4];
             two.sample_many(&points, &mut many);
             sink += many.iter().flatten().map(|d| f64::from(d.pdf)).sum::<f64>();
+            let two = two_level.build_for_mis(&compensated, &cones, brdf, &frame, wo).unwrap();
+            let [a, b] = estimator::sampled_mis(&two, &sp, u, u.as_vec2(), &mut vis);
+            sink += a.value.x + b.value.x;
         }
         sink += batched(&sampler, &env, &sp, &points, &mut vis);
         sink += wavefront(&sampler, &sp, &points);

@@ -175,11 +175,11 @@ impl Method {
         matches!(self, Method::Product | Method::Wavelet | Method::ProductMis | Method::Auto)
     }
 
-    /// Whether a render with this method reads the map's peak (`auto`'s rules and
-    /// product-MIS's split do).
+    /// Whether a render with this method reads the map's peak (`auto`'s rules, product-MIS's
+    /// split and the two-level product's coarse level do).
     #[must_use]
     pub fn reads_env_peak(self) -> bool {
-        matches!(self, Method::Auto | Method::ProductMis)
+        matches!(self, Method::Auto | Method::ProductMis | Method::TwoLevel | Method::TwoLevelMis)
     }
 }
 

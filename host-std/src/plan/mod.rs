@@ -170,7 +170,7 @@ pub fn render_crop(
     let env = env_view.as_ref();
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));
-    let cones = env.and_then(|e| two_level_cones(e, &plans));
+    let cones = env.and_then(|e| two_level_cones(e, &plans, env_peak < rules::SUN_PEAK));
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
     let baselines = Baselines::build(scene, env, settings);
@@ -185,7 +185,7 @@ pub fn render_crop(
         env,
         lights: lights.as_ref(),
         sat: sat.as_deref(),
-        cones: cones.as_deref(),
+        cones: cones.as_ref(),
         strata: baselines.strata.as_deref(),
         lightcuts: cut_tree.as_ref(),
         camera: &camera,
@@ -214,11 +214,11 @@ pub fn render_crop(
     // A two-level plan the pilot chose reads the cell cones, which the rules' plans did not build.
     let plans = chosen.as_deref().unwrap_or(ctx.plans);
     let pilot_cones = match (env, ctx.cones) {
-        (Some(e), None) => two_level_cones(e, plans),
+        (Some(e), None) => two_level_cones(e, plans, env_peak < rules::SUN_PEAK),
         _ => None,
     };
     let pilot_seconds = start.elapsed().as_secs_f64();
-    let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_deref()), ..ctx }, crop, start);
+    let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_ref()), ..ctx }, crop, start);
     // The baselines' lights are built per render: their build is part of their cost.
     let render_seconds = start.elapsed().as_secs_f64() + baselines.seconds;
     let render_cpu_seconds = cpu_start

@@ -172,8 +172,9 @@ pub(crate) fn choose(
     let plan =
         |m: usize, c: usize| at_equal_cost(MaterialPlan { strategy: PLANS[c].strategy, ..defaults[m] }, env_budget);
     let candidates: Vec<MaterialPlan> = tasks.iter().map(|&(m, c)| plan(m, c)).collect();
-    let cones = if ctx.cones.is_none() { two_level_cones(env, &candidates) } else { None };
-    let ctx = &Context { cones: ctx.cones.or(cones.as_deref()), ..*ctx };
+    let extended = env_peak < super::rules::SUN_PEAK;
+    let cones = if ctx.cones.is_none() { two_level_cones(env, &candidates, extended) } else { None };
+    let ctx = &Context { cones: ctx.cones.or(cones.as_ref()), ..*ctx };
     let mut measured: Vec<Measured> = vec![Vec::new(); found.len()];
     for ((m, c), v) in tasks.iter().zip(measure(ctx, env, &found, &tasks)) {
         measured[*m].push((*c, v));

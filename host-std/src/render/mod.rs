@@ -28,10 +28,11 @@ use crate::light::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
 use crate::trace::camera::Camera;
+use sampler_core::cone::Cone;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::lights::LightSet;
 use std::ops::AddAssign;
-use strategy::MaterialPlan;
+use strategy::{MaterialPlan, Strategy};
 
 /// How pixels are sampled: the budget, the seed and what is traced.
 #[derive(Clone, Copy, Debug)]
@@ -65,9 +66,9 @@ pub struct Context<'a, 'e> {
     pub lights: Option<&'a LightSet<'a>>,
     /// The summed-area table of `env`, built when a material is sampled two-stage.
     pub sat: Option<&'a [f64]>,
-    /// The cell cones of the two-level product's coarse level, built when a material is
+    /// The cell cones of the two-level product's coarse levels, built when a material is
     /// sampled with it.
-    pub cones: Option<&'a [sampler_core::cone::Cone]>,
+    pub cones: Option<&'a CellCones>,
     /// Structured importance sampling's strata of `env`, built when a material is shaded
     /// with them.
     pub strata: Option<&'a [sampler_core::sis::Stratum]>,
@@ -104,24 +105,47 @@ impl AddAssign for Counters {
     }
 }
 
+/// The cell cones the two-level product reads: of its coarse level, and under extended light
+/// of its finer one for the lobes that draw from it ([`strategy::TWO_LEVEL_FINE_LEVEL`]).
+pub struct CellCones {
+    coarse: Vec<Cone>,
+    /// Empty under a sun, or where the map is no finer than the coarse level.
+    fine: Vec<Cone>,
+}
+
+impl CellCones {
+    /// The cones a lobe of width `lobe_width` (`Brdf::lobe_width`) draws from.
+    #[must_use]
+    pub fn for_lobe(&self, lobe_width: f32) -> &[Cone] {
+        let fine = !self.fine.is_empty() && strategy::FINE_CELL_LOBES.contains(&lobe_width);
+        if fine { &self.fine } else { &self.coarse }
+    }
+}
+
 /// The cell cones the two-level product reads, built when a plan needs it: of
-/// [`strategy::TWO_LEVEL_LEVEL`], or of the map's finest level if that is coarser.
+/// [`strategy::TWO_LEVEL_LEVEL`] and, where the light is `extended` rather than a sun, of
+/// [`strategy::TWO_LEVEL_FINE_LEVEL`] (each clamped to the map's finest level).
 #[must_use]
-pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<sampler_core::cone::Cone>> {
-    plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
-        let level = strategy::TWO_LEVEL_LEVEL.min(env.finest_level());
-        let mut cones = vec![sampler_core::cone::Cone::default(); sampler_core::cone::cell_count(level)];
+pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], extended: bool) -> Option<CellCones> {
+    let of_level = |level: u32| {
+        let mut cones = vec![Cone::default(); sampler_core::cone::cell_count(level.min(env.finest_level()))];
         sampler_core::cone::build_cell_cones(&mut cones);
         cones
+    };
+    plans.iter().any(|p| p.strategy.is_two_level()).then(|| {
+        let coarse = of_level(strategy::TWO_LEVEL_LEVEL);
+        let finer = extended && env.finest_level() > strategy::TWO_LEVEL_LEVEL;
+        CellCones { coarse, fine: if finer { of_level(strategy::TWO_LEVEL_FINE_LEVEL) } else { Vec::new() } }
     })
 }
 
 /// The MIS-compensated pyramid of `env` ([`EnvHierarchy::compensated`]), built when a plan
-/// samples MIS or `auto`'s pilot may choose it, and `env` has none attached; `None` also where
-/// nothing of the map stands above its mean (the plain pyramid then serves MIS).
+/// samples MIS or two-level-MIS (whose cells it compensates) or `auto`'s pilot may choose
+/// them, and `env` has none attached; `None` also where nothing of the map stands above its
+/// mean (the plain pyramid then serves MIS).
 #[must_use]
 pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<MapBuffer<f32>> {
-    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, strategy::Strategy::Mis { .. }));
+    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, Strategy::Mis { .. } | Strategy::TwoLevelMis { .. }));
     if !mis || env.has_compensated() {
         return None;
     }
@@ -132,7 +156,7 @@ pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot
 /// The summed-area table two-stage sampling reads, built when a plan needs it.
 #[must_use]
 pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Option<Vec<f64>> {
-    plans.iter().any(|p| p.strategy == strategy::Strategy::TwoStage).then(|| {
+    plans.iter().any(|p| p.strategy == Strategy::TwoStage).then(|| {
         let mut sat = vec![0.0f64; sampler_core::two_stage::sat_len(env.finest_level())];
         sampler_core::two_stage::build_sat(env, &mut sat);
         sat
@@ -143,7 +167,6 @@ pub fn summed_area_table(env: &EnvHierarchy<'_>, plans: &[MaterialPlan]) -> Opti
 mod tests {
     use super::*;
     use crate::render::brdf_samples::BrdfSamples;
-    use crate::render::strategy::Strategy;
     use crate::scene::Bsdf;
     use sampler_core::brdf::Lambert;
     use sampler_core::env::{EnvHierarchy, build_pyramid, pyramid_len};
@@ -158,6 +181,8 @@ mod tests {
         let plan = |strategy| MaterialPlan::new(strategy, &bsdf, BrdfSamples::default());
         let (env_only, mis) = ([plan(Strategy::Env)], [plan(Strategy::Env), plan(Strategy::Mis { env_share: 0.5 })]);
         assert!(compensated_pyramid(&env, &env_only, false).is_none());
+        let two_level_mis = [plan(Strategy::TwoLevelMis { two_level_share: 0.5 })];
+        assert!(compensated_pyramid(&env, &two_level_mis, false).is_some(), "two-level-MIS compensates its cells");
         let built = compensated_pyramid(&env, &mis, false).expect("a MIS plan");
         assert!(compensated_pyramid(&env, &env_only, true).is_some(), "auto's pilot may choose MIS");
         let attached = env.with_compensated(&built).unwrap();

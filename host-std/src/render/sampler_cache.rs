@@ -147,7 +147,7 @@ impl SamplerCache {
         let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
         let arena = self.two_level.get_or_insert_with(Box::default);
         let sp = lead.sp;
-        arena.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT)
+        arena.build(env, cones.for_lobe(sp.brdf.lobe_width()), sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT)
     }
 
     /// A product sampler of the paper's estimator, built for `lead` alone from its material's K.
@@ -189,7 +189,7 @@ impl SamplerCache {
     /// The two-level-MIS sampler of `lead`'s material: the kept one if it was built within the
     /// material's reuse angle (and the material is not textured), otherwise built anew and kept.
     /// As for product-MIS, MIS with BRDF sampling covers where another point's lobe leaves the
-    /// shared cells' bounds.
+    /// shared cells' bounds, and the cells the compensation leaves without weight.
     fn shared_two_level<'s, 'e>(
         &'s mut self,
         ctx: &Context<'s, 'e>,
@@ -200,7 +200,7 @@ impl SamplerCache {
         let cones = ctx.cones.expect("the cell cones are built when a material is sampled two-level");
         let sp = lead.sp;
         let build = |a: &mut Box<TwoLevelArena>| {
-            a.build(env, cones, sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT);
+            a.build_for_mis(env, cones.for_lobe(sp.brdf.lobe_width()), sp.brdf, &sp.frame, sp.wo).expect(CONES_FIT);
         };
         let slot = &mut self.shared_two_level[lead.hit.material];
         let kept = kept_or_built(slot, lead.hit, plan.reuse_cosine, Box::default, build);

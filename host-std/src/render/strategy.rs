@@ -38,7 +38,8 @@ pub enum Strategy {
     /// `two_stage.rs`): a BRDF-driven partition weighted through a summed-area table.
     TwoStage,
     /// The two-level product (`sampler_core::two_level`): cells of a coarse level of the map
-    /// ([`TWO_LEVEL_LEVEL`]) drawn ∝ the BRDF's bound × their light, then a texel ∝ light.
+    /// ([`TWO_LEVEL_LEVEL`], or [`TWO_LEVEL_FINE_LEVEL`]) drawn ∝ the BRDF's bound × their
+    /// light, then a texel ∝ light.
     TwoLevel,
     /// MIS of the two-level product and BRDF samples, built per shading point.
     TwoLevelMis {
@@ -57,6 +58,18 @@ pub enum Strategy {
 /// The coarse level of the two-level product: 16 × 16 cells of the equal-area square (clamped
 /// to the map's finest level).
 pub const TWO_LEVEL_LEVEL: u32 = 4;
+
+/// The two-level product's finer coarse level, 32 × 32 cells, for the lobes of
+/// [`FINE_CELL_LOBES`] under extended light: such a lobe is narrower than a 16 × 16 cell and
+/// follows the bright regions' detail within it. Under a sun the sun's cell carries the
+/// product and finer cells cost more builds than they recover; sharper lobes rebuild their
+/// shared sampler nearly every pixel, and wider ones and diffuse surfaces gain nothing
+/// (docs/perf.md, "The two products").
+pub const TWO_LEVEL_FINE_LEVEL: u32 = 5;
+
+/// Lobe widths (`Brdf::lobe_width`, GGX α) drawn from [`TWO_LEVEL_FINE_LEVEL`]'s cells under
+/// extended light.
+pub const FINE_CELL_LOBES: std::ops::RangeInclusive<f32> = 0.03..=0.2;
 
 impl Strategy {
     /// Whether its shading points draw from the two-level product.

@@ -34,7 +34,7 @@ const EXPECTED: &[(&str, u64)] = &[
     ("default/ris", 0x7bb56dc06b6a38f1),
     ("default/two-stage", 0x0de22621b956bfb7),
     ("default/two-level", 0x3ca8f671241ecd42),
-    ("default/two-level-mis", 0xa9dff66d62924870),
+    ("default/two-level-mis", 0xd08d72c696013662),
     ("default/sis", 0xd5fd282a7d493f4b),
     ("default/lightcuts", 0xee84e2a10fe97911),
     ("default/auto", 0xaa0dde5b101b9182),

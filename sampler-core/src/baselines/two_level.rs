@@ -13,6 +13,14 @@
 //! * The fine level is the rest of the pyramid below the drawn cell: a texel ∝ L inside it, and
 //!   a point uniformly in the texel.
 //!
+//! * In its MIS form ([`TwoLevelArena::build_for_mis`]) the cells are MIS-compensated, as the
+//!   map is for MIS's env samples ([`crate::env::compensate_pyramid`]): BRDF samples already
+//!   cover the light the lobe sees on average, so a cell is weighted by B̃ × the larger of its
+//!   mean less that average (the cells' means weighted by B̃) and its mean of what stands
+//!   above the map's mean (the compensated pyramid), which keeps a small bright source in a
+//!   dim cell. Where neither is above zero the cell is left to the BRDF samples. Measured in
+//!   docs/perf.md, "The two products".
+//!
 //! The density of a direction is P(cell) × 4^L × L_texel / L̄_cell per unit area of the square.
 //! A BRDF without a bound gets B̃ by evaluation at each cone's axis and four points of its rim,
 //! every cell floored at [`ESTIMATE_FLOOR`] of the largest, so that no cell where B > 0 is left
@@ -115,6 +123,34 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
         frame: &Frame,
         wo: Vec3,
     ) -> Result<TwoLevelSampler<'a, 'e>, TwoLevelError> {
+        self.build_with(env, cones, brdf, frame, wo, false)
+    }
+
+    /// [`build`](Self::build) with its cells MIS-compensated (the module's documentation), for
+    /// draws combined with BRDF samples only: a cell at or below the light its lobe sees on
+    /// average and with nothing above the map's mean has no weight. Without a compensated
+    /// pyramid attached to `env` ([`EnvHierarchy::with_compensated`]) no cell is.
+    pub fn build_for_mis<'a, 'e, B: Brdf + ?Sized>(
+        &'a mut self,
+        env: &'a EnvHierarchy<'e>,
+        cones: &[Cone],
+        brdf: &B,
+        frame: &Frame,
+        wo: Vec3,
+    ) -> Result<TwoLevelSampler<'a, 'e>, TwoLevelError> {
+        self.build_with(env, cones, brdf, frame, wo, env.has_compensated())
+    }
+
+    /// [`build`](Self::build), its cells compensated where `compensate` says.
+    fn build_with<'a, 'e, B: Brdf + ?Sized>(
+        &'a mut self,
+        env: &'a EnvHierarchy<'e>,
+        cones: &[Cone],
+        brdf: &B,
+        frame: &Frame,
+        wo: Vec3,
+        compensate: bool,
+    ) -> Result<TwoLevelSampler<'a, 'e>, TwoLevelError> {
         let cells = cones.len();
         let level = level_of(cells).ok_or(TwoLevelError::NotALevel { cones: cells })?;
         if level > env.finest_level() {
@@ -150,17 +186,38 @@ impl<const CELLS: usize> TwoLevelArena<CELLS> {
             }
         }
         let floor = if bounded { 0.0 } else { ESTIMATE_FLOOR * cumulative.iter().copied().fold(0.0, f64::max) };
-        let mass = &env.pyramid[level_offset(level)..level_offset(level) + cells];
+        let level_cells = level_offset(level)..level_offset(level) + cells;
+        let mass = &env.pyramid[level_cells.clone()];
+        let weight = |w: f64| if w.is_finite() { w.max(floor) } else { f64::from(f32::MAX) };
         let mut total = 0.0f64;
-        for (w, &m) in cumulative.iter_mut().zip(mass) {
-            let b = if w.is_finite() { w.max(floor) } else { f64::from(f32::MAX) };
-            total += b * f64::from(m);
-            *w = total;
+        if compensate {
+            let seen = lobe_mean(cumulative.iter().map(|&w| weight(w)), mass);
+            let above = &env.compensated().pyramid[level_cells];
+            for ((w, &m), &a) in cumulative.iter_mut().zip(mass).zip(above) {
+                total += weight(*w) * (f64::from(m) - seen).max(f64::from(a));
+                *w = total;
+            }
+        } else {
+            for (w, &m) in cumulative.iter_mut().zip(mass) {
+                total += weight(*w) * f64::from(m);
+                *w = total;
+            }
         }
         self.built = Some((level, bounded));
         let built: &'a Self = self;
         Ok(built.last_built(env).expect("just built"))
     }
+}
+
+/// The mean of the cells' `mass` weighted by their B̃ `weights`: the light the lobe sees on
+/// average (0 where no cell has weight).
+fn lobe_mean(weights: impl Iterator<Item = f64>, mass: &[f32]) -> f64 {
+    let (mut seen, mut sum) = (0.0f64, 0.0f64);
+    for (b, &m) in weights.zip(mass) {
+        seen += b * f64::from(m);
+        sum += b;
+    }
+    if sum > 0.0 && seen.is_finite() { seen / sum } else { 0.0 }
 }
 
 /// B̃ of a cone by evaluation: the largest luminance of B·cos at its axis and four rim points.

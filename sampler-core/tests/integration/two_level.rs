@@ -1,5 +1,5 @@
 //! The two-level product: every built-in BRDF's cone bound holds over its cells, the sampler
-//! matches its own pdf (χ²) which integrates to 1, its batched draws are its single ones, the
+//! matches its own pdf (χ²) which integrates to 1, so does its compensated MIS form, its batched draws are its single ones, the
 //! estimators match quadrature under a sun 1e7 times the sky, a BRDF without a bound is still
 //! sampled without bias, and a build that cannot be made says why. (The shared estimator harness in `estimators.rs` covers occluders
 //! and the other lobes.)
@@ -8,7 +8,7 @@ use crate::common::*;
 use glam::{DVec2, DVec3, Mat3, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, BrdfSample, CarPaint, Lambert, Phong, RoughConductor};
 use sampler_core::cone::{Cone, build_cell_cones, cell_count, morton_cell};
-use sampler_core::env::luminance;
+use sampler_core::env::{luminance, pyramid_len};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::mapping::{sphere_to_square, square_to_sphere};
@@ -165,6 +165,41 @@ fn two_level_matches_its_pdf_and_integrates_to_one() {
     }
 }
 
+#[test]
+fn the_compensated_form_matches_its_pdf_and_drops_only_cells_without_excess() {
+    let envs = [TestEnv::random_smooth(6, 12), TestEnv::sun(7, (70, 20), 1e6)];
+    let alpha = sidak(envs.len() * 2 * brdfs().len());
+    let (mut arena, mut plain): (Box<TwoLevelArena>, Box<TwoLevelArena>) = (Box::default(), Box::default());
+    let cones = cones(4);
+    for (k, env) in envs.iter().enumerate() {
+        let e = env.view();
+        let mut above = vec![0.0f32; pyramid_len(e.finest_level())];
+        assert!(e.compensate_into(&mut above).unwrap());
+        let ec = e.with_compensated(&above).unwrap();
+        for (name, brdf) in brdfs() {
+            for (j, normal) in [Vec3::Z, Vec3::new(-0.6, 0.2, 0.3).normalize()].into_iter().enumerate() {
+                let frame = Frame::from_normal(normal);
+                let wo = frame.to_world(Vec3::new(0.5, 0.1, 0.8).normalize());
+                let label = format!("env {k} {name} normal {j}");
+                // Without a compensated pyramid the MIS form is the plain product.
+                let p = plain.build(&e, &cones, brdf.as_ref(), &frame, wo).unwrap().total();
+                assert_eq!(arena.build_for_mis(&e, &cones, brdf.as_ref(), &frame, wo).unwrap().total(), p, "{label}");
+                let s = arena.build_for_mis(&ec, &cones, brdf.as_ref(), &frame, wo).unwrap();
+                assert!(s.total() > 0.0 && s.total() <= p, "{label}: {} of {p}", s.total());
+                let r = chi_square_dyadic(
+                    100_000,
+                    51 + j as u64,
+                    40.0,
+                    |u| s.sample(u).map(|d| d.uv),
+                    |_| ec.finest_level(),
+                    |uv| s.pdf_square(uv),
+                );
+                assert!(r.p_value >= alpha && r.impossible == 0, "{label}: {r:?}");
+            }
+        }
+    }
+}
+
 /// ∫ L·B dω in RGB for a sky of one colour with one texel `sun` of radiance `sun_rgb`: the sky
 /// over the whole sphere by quadrature over half vectors (accurate at grazing views; `width` the
 /// sharpest lobe's α), plus the sun's excess over its texel, finely subdivided.
@@ -200,6 +235,11 @@ fn two_level_is_unbiased_under_a_sun_ten_million_times_the_sky() {
     let e = env.view();
     let cones = cones(4);
     let mut arena: Box<TwoLevelArena> = Box::default();
+    // The MIS form, its cells compensated: the sky is left to the BRDF samples.
+    let mut above = vec![0.0f32; pyramid_len(level)];
+    assert!(e.compensate_into(&mut above).unwrap());
+    let ec = e.with_compensated(&above).unwrap();
+    let mut compensated_arena: Box<TwoLevelArena> = Box::default();
     // Views that see the sun in or near the mirror direction, and grazing ones.
     let sun_dir = e.dir_of(Vec2::new((texel.0 as f32 + 0.5) / 128.0, (texel.1 as f32 + 0.5) / 128.0));
     let cases: Vec<(&str, Box<dyn Brdf>, f64)> = vec![
@@ -223,11 +263,13 @@ fn two_level_is_unbiased_under_a_sun_ten_million_times_the_sky() {
             let sp: ShadingPoint<'_, dyn Brdf> = ShadingPoint { frame, wo, brdf: brdf.as_ref() };
             let reference = luminance64(sun_reference(&e, &sp, (sky, Vec3::splat(1e7)), texel, *width));
             let s = arena.build(&e, &cones, brdf.as_ref(), &frame, wo).unwrap();
+            let compensated = compensated_arena.build_for_mis(&ec, &cones, brdf.as_ref(), &frame, wo).unwrap();
             let mut rng = Pcg32::new(11, 13);
             // Alone, the product follows the light inside a cell: a lobe far narrower than a cell
             // is found as env sampling finds it (`estimators.rs` tests that case with nets).
             let alone = *width >= 0.05;
-            for mis in [false, true].into_iter().filter(|&m| m || alone) {
+            let forms = [(false, s), (true, s), (true, compensated)];
+            for (k, (mis, s)) in forms.into_iter().enumerate().filter(|&(_, (m, _))| m || alone) {
                 let n = 400_000;
                 let (mut mean, mut m2) = (0.0f64, 0.0f64);
                 for i in 0..n {
@@ -244,7 +286,7 @@ fn two_level_is_unbiased_under_a_sun_ten_million_times_the_sky() {
                 }
                 let se = (m2 / (n - 1) as f64 / n as f64).sqrt();
                 if (mean - reference).abs() > 3.0 * se + 2e-3 * reference {
-                    failures.push(format!("{name} {view} mis={mis}: {mean} ± {se} vs {reference}"));
+                    failures.push(format!("{name} {view} form {k}: {mean} ± {se} vs {reference}"));
                 }
             }
         }
