@@ -35,6 +35,11 @@ pub const PILOT_SPP_DIVISOR: usize = 8;
 /// where a scene's error sits in its edges and glints (docs/tuning.md, "Shading points per pixel").
 pub const PILOT_SHARE: f64 = 0.05;
 
+/// The fewest tiles a pilot decides from: on a smaller frame the rule's split stands, since a
+/// few tiles miss the glints and edges that decide it (three tiles chose wrongly on two of six
+/// scenes; docs/tuning.md, "Shading points per pixel").
+pub const MIN_PILOT_TILES: usize = 8;
+
 /// The fewest samples per pixel the pilot renders with: four shading points at four pairs.
 pub const MIN_PILOT_SPP: usize = 32;
 
@@ -79,12 +84,15 @@ pub fn choose(
     if !applies {
         return None;
     }
+    let tiles = pilot_tiles(scene.camera.width as usize, scene.camera.height as usize, PILOT_SHARE);
+    if tiles.len() < MIN_PILOT_TILES {
+        return None;
+    }
     let (start, cpu_start) = (Instant::now(), process_cpu_time());
     let candidates = [rule, 2 * rule];
     let pilot_spp = (settings.spp / PILOT_SPP_DIVISOR).max(MIN_PILOT_SPP);
     // `auto`'s own pilot would run again in every tile's render: its MIS plans stand in for it.
     let method = if settings.method == Method::Auto { Method::Mis } else { settings.method };
-    let tiles = pilot_tiles(scene.camera.width as usize, scene.camera.height as usize, PILOT_SHARE);
     let candidate = |v: usize| PilotCandidate {
         scene,
         env,
@@ -150,7 +158,7 @@ mod tests {
         let env = Environment::build(&source, Placement::default()).unwrap();
         let hierarchy = env.hierarchy();
         let mut scene = crate::scene::builtin::scene();
-        (scene.camera.width, scene.camera.height) = (24, 20);
+        (scene.camera.width, scene.camera.height) = (224, 192);
         let bvh = Bvh::build(&scene);
         let run = |method, spp, points, env| choose(&scene, &bvh, env, &settings(method, spp), points);
         let some = Some(&hierarchy);
@@ -158,12 +166,16 @@ mod tests {
         assert!(run(Method::Mis, 128, ShadingPoints::Given(16), some).is_none(), "--shading-points forces P");
         assert!(run(Method::Env, 128, ShadingPoints::Rule, some).is_none(), "one sample per point");
         assert!(run(Method::Mis, 128, ShadingPoints::Rule, None).is_none(), "no environment");
+        let mut small = scene.clone();
+        (small.camera.width, small.camera.height) = (160, 90);
+        let small_settings = settings(Method::Mis, 128);
+        assert!(choose(&small, &bvh, some, &small_settings, ShadingPoints::Rule).is_none(), "too few tiles");
         let (a, b) = (
             run(Method::Mis, 128, ShadingPoints::Rule, some).unwrap(),
             run(Method::Mis, 128, ShadingPoints::Rule, some).unwrap(),
         );
         assert_eq!((a.samples_per_point, a.scores, a.pixels), (b.samples_per_point, b.scores, b.pixels));
-        assert_eq!((a.candidates, a.pilot_spp, a.pixels), ([4, 8], 32, 16 * 16));
+        assert_eq!((a.candidates, a.pilot_spp, a.pixels), ([4, 8], 32, 8 * 16 * 16));
         assert!(a.scores.iter().all(|s| s.is_finite() && *s > 0.0), "{:?}", a.scores);
         let best = if a.scores[1] < a.scores[0] { 8 } else { 4 };
         assert_eq!(a.samples_per_point, best);
