@@ -1,6 +1,6 @@
 //! A PointInstancer's instances kept as instances: each prototype gprim's triangles read once
 //! in its own space, and per instance only which prototype and where. The renderer places
-//! them when it needs their triangles ([`Instanced::mesh`]) by [`place`], the arithmetic that
+//! them when it needs their triangles ([`Instanced::mesh`]) by `place`, the arithmetic that
 //! places a gprim's own mesh, so an instance's points are those of its twin mesh to the bit; a
 //! stage of many instances holds one small record per instance, not a mesh per instance. See
 //! docs/usd.md, "Import speed" (the PointInstancer's table).
