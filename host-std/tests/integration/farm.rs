@@ -72,6 +72,24 @@ fn four_tile_processes_merge_into_the_bytes_of_the_one_process_frame() {
     assert!(tile.settings.contains("\nmethod=product-mis\nspp=4\n"), "{}", tile.settings);
 }
 
+/// The split pilot (`plan/split.rs`) decides from the whole frame, so every crop takes the
+/// frame's split: two tile processes still merge into the one-process frame's bytes.
+#[test]
+fn tiles_take_the_frames_split_of_light_samples_per_shading_point() {
+    let tmp = tempfile::Builder::new().prefix("ppis-farm-split-").tempdir().unwrap();
+    let dir = tmp.path();
+    let frame = ["render", "--width", "224", "--height", "192", "--spp", "128", "--method", "mis"];
+    let out = ppis(dir, &with(&frame, &["-o", "whole.exr"]).iter().map(String::as_str).collect::<Vec<_>>());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stderr.contains("light samples per shading point:"), "{stderr}");
+    for (i, crop) in ["0,0,224,96", "0,96,224,192"].iter().enumerate() {
+        run(dir, &with(&frame, &["--crop", crop, "--threads", "1", "-o", &format!("tile{i}.exr")]));
+    }
+    ok(dir, &["merge", "tile1.exr", "tile0.exr", "-o", "frame.exr"]);
+    let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
+    assert!(read("frame.exr") == read("whole.exr"), "the merged EXR differs from the one-process frame");
+}
+
 #[test]
 fn a_merge_refuses_overlapping_missing_foreign_and_truncated_tiles() {
     let tmp = tempfile::Builder::new().prefix("ppis-merge-").tempdir().unwrap();
