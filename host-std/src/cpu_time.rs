@@ -24,6 +24,12 @@ pub fn process_cpu_time() -> Option<Duration> {
     }
 }
 
+/// CPU seconds of every thread since `start` (a [`process_cpu_time`]), where the platform says.
+#[must_use]
+pub fn cpu_seconds_since(start: Option<Duration>) -> Option<f64> {
+    start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,7 +18,7 @@
 //! to tens of per cent. The choice depends only on the scene, the settings and the seed, and
 //! the pilot's samples are not the render's, so the render stays unbiased.
 
-use crate::cpu_time::process_cpu_time;
+use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::light::environment::Environment;
 use crate::light::move_distant_lights;
 use crate::plan::method::Lighting;
@@ -111,12 +111,9 @@ pub fn choose(
     };
     let mut map_scene = scene.clone();
     move_distant_lights(&mut map_scene.lights, &mut in_map);
-    // `auto`'s own pilot would run again in every tile's render: its MIS plans stand in for it.
-    let method = if settings.method == Method::Auto { Method::Mis } else { settings.method };
     let (cone_env, map_env) = (env.hierarchy(), in_map.hierarchy());
     let pilot_settings = |scene: &Scene| Settings {
-        method,
-        shading_points: points.resolve(method, settings.spp, Lighting::of(true, scene.lights.len())),
+        shading_points: points.resolve(settings.method, settings.spp, Lighting::of(true, scene.lights.len())),
         ..*settings
     };
     let point_cost = point_cost(settings.method);
@@ -126,7 +123,7 @@ pub fn choose(
     ];
     let scores: [f64; 2] = paired_scores(bvh, &candidates, &tiles, 0xca55_1e55).try_into().expect("two carriers");
     let carrier = if scores[1] * MAP_MARGIN < scores[0] { Carrier::Map } else { Carrier::Cone };
-    let cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
+    let cpu_seconds = cpu_seconds_since(cpu_start);
     let pixels = tiles.iter().map(Crop::area).sum();
     Some(CarrierChoice { carrier, scores, pixels, seconds: start.elapsed().as_secs_f64(), cpu_seconds })
 }

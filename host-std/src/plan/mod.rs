@@ -17,7 +17,7 @@ pub mod split;
 pub use budget::ShadingPoints;
 pub use method::Method;
 
-use crate::cpu_time::process_cpu_time;
+use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::light::baselines::{LightcutTable, sis_strata};
 use crate::light::lights::{LightOptions, LightTable};
 use crate::light::map_buffer::MapBuffer;
@@ -98,6 +98,14 @@ pub struct Rendered {
     pub pilot_seconds: f64,
 }
 
+impl Rendered {
+    /// Adds a pilot's time, run before the render and part of its cost, to the render's.
+    pub fn add_pilot(&mut self, seconds: f64, cpu_seconds: Option<f64>) {
+        self.render_seconds += seconds;
+        self.render_cpu_seconds = self.render_cpu_seconds.zip(cpu_seconds).map(|(r, p)| r + p);
+    }
+}
+
 /// The lights of the seed's baselines, built for a render that uses them, and what building
 /// them took.
 struct Baselines {
@@ -115,7 +123,7 @@ impl Baselines {
             _ => None,
         };
         let cuts = (settings.method == Method::Lightcuts).then(|| LightcutTable::new(env, &scene.lights));
-        let cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
+        let cpu_seconds = cpu_seconds_since(cpu_start);
         Self { strata, cuts, seconds: start.elapsed().as_secs_f64(), cpu_seconds }
     }
 }
@@ -221,11 +229,7 @@ pub fn render_crop(
     let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_ref()), ..ctx }, crop, start);
     // The baselines' lights are built per render: their build is part of their cost.
     let render_seconds = start.elapsed().as_secs_f64() + baselines.seconds;
-    let render_cpu_seconds = cpu_start
-        .zip(process_cpu_time())
-        .map(|(a, b)| b.saturating_sub(a).as_secs_f64())
-        .zip(baselines.cpu_seconds)
-        .map(|(r, b)| r + b);
+    let render_cpu_seconds = cpu_seconds_since(cpu_start).zip(baselines.cpu_seconds).map(|(r, b)| r + b);
     let c = image.counters;
     Rendered {
         width: image.width,

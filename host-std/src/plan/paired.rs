@@ -6,7 +6,7 @@
 //! sun's carrier (`plan::carrier`) and the light samples per shading point (`plan::split`) are
 //! chosen by them.
 
-use crate::plan::{Settings, render_crop};
+use crate::plan::{Method, Settings, render_crop};
 use crate::render::crop::Crop;
 use crate::render::tiles::TILE;
 use crate::scene::Scene;
@@ -22,7 +22,7 @@ pub struct PilotCandidate<'a> {
     pub scene: &'a Scene,
     /// Its environment, if any.
     pub env: Option<&'a EnvHierarchy<'a>>,
-    /// Its settings (the seed is replaced per render).
+    /// Its settings (the seed is replaced per render, and `auto` renders as MIS).
     pub settings: Settings,
     /// A shading point's cost in shadow rays.
     pub point_cost: f64,
@@ -38,6 +38,9 @@ pub fn paired_scores(bvh: &Bvh, candidates: &[PilotCandidate<'_>], tiles: &[Crop
         .map(|(k, c)| {
             std::array::from_fn(|rep| {
                 let s = Settings {
+                    // `auto`'s own pilot would run again in every tile's render: its MIS plans
+                    // stand in for it.
+                    method: if c.settings.method == Method::Auto { Method::Mis } else { c.settings.method },
                     seed: hash_combine(hash_combine(c.settings.seed, salt), 2 * k as u64 + rep as u64),
                     progress: false,
                     ..c.settings

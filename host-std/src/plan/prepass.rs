@@ -55,8 +55,7 @@ impl Prepass {
     /// Adds the split pilot's time to `image`'s.
     pub fn charge(&self, image: &mut Rendered) {
         if let Some(c) = &self.split {
-            image.render_seconds += c.seconds;
-            image.render_cpu_seconds = image.render_cpu_seconds.zip(c.cpu_seconds).map(|(r, p)| r + p);
+            image.add_pilot(c.seconds, c.cpu_seconds);
         }
     }
 }

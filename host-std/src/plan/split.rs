@@ -12,7 +12,7 @@
 //! points), so a split that wins there wins at the render's spp too, and the pilot's four
 //! renders of 5% of the pixels cost a few per cent of the render.
 
-use crate::cpu_time::process_cpu_time;
+use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::plan::carrier::point_cost;
 use crate::plan::method::Lighting;
 use crate::plan::paired::{PilotCandidate, paired_scores, pilot_tiles};
@@ -91,15 +91,12 @@ pub fn choose(
     let (start, cpu_start) = (Instant::now(), process_cpu_time());
     let candidates = [rule, 2 * rule];
     let pilot_spp = (settings.spp / PILOT_SPP_DIVISOR).max(MIN_PILOT_SPP);
-    // `auto`'s own pilot would run again in every tile's render: its MIS plans stand in for it.
-    let method = if settings.method == Method::Auto { Method::Mis } else { settings.method };
     let candidate = |v: usize| PilotCandidate {
         scene,
         env,
         settings: Settings {
-            method,
             spp: pilot_spp,
-            shading_points: ShadingPoints::PerPoint(v).resolve(method, pilot_spp, Lighting::OneKind),
+            shading_points: ShadingPoints::PerPoint(v).resolve(settings.method, pilot_spp, Lighting::OneKind),
             ..*settings
         },
         point_cost: point_cost(settings.method),
@@ -107,7 +104,7 @@ pub fn choose(
     let scored = paired_scores(bvh, &candidates.map(candidate), &tiles, 0x5b11_7000);
     let scores: [f64; 2] = scored.try_into().expect("two splits");
     let samples_per_point = if scores[1] < scores[0] { candidates[1] } else { candidates[0] };
-    let cpu_seconds = cpu_start.zip(process_cpu_time()).map(|(a, b)| b.saturating_sub(a).as_secs_f64());
+    let cpu_seconds = cpu_seconds_since(cpu_start);
     let pixels = tiles.iter().map(Crop::area).sum();
     Some(SplitChoice {
         samples_per_point,

@@ -112,8 +112,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     // The pilots and the prepass are part of the render's cost.
     prepass.charge(&mut image);
     if let Some(c) = &carrier {
-        image.render_seconds += c.seconds;
-        image.render_cpu_seconds = image.render_cpu_seconds.zip(c.cpu_seconds).map(|(r, p)| r + p);
+        image.add_pilot(c.seconds, c.cpu_seconds);
     }
 
     output::write_exr_part(&exr_path, frame, crop, &image.pixels, Some(&record))?;
