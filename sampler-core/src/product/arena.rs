@@ -3,8 +3,9 @@
 //! node's branch probability computed in the same traversal.
 
 use super::bilinear::Corners;
+use super::keys::sort_keys;
 use super::params::{ProductError, ProductParams};
-use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder, sort_key};
+use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder};
 use super::sampler::ProductSampler;
 use crate::brdf::{Brdf, BrdfDraw};
 use crate::env::{EnvHierarchy, luminance};
@@ -31,7 +32,8 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     dirs: [Vec3; K],
     /// Usable samples' B·cos (luminance).
     values: [f32; K],
-    keys: Vec<u64, K>,
+    /// The usable samples' sort keys (`keys.rs`), sorted.
+    keys: [u64; K],
     nodes: Vec<Node, NODES>,
     /// Per node, the probability that the warp picks it among its parent's children (see
     /// [`branch_probabilities`]).
@@ -71,7 +73,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             draws: [BrdfDraw { wi: Vec3::ZERO, value: 0.0 }; K],
             dirs: [Vec3::ZERO; K],
             values: [0.0; K],
-            keys: Vec::new(),
+            keys: [0; K],
             nodes: Vec::new(),
             branches: [0.0; NODES],
             corners: Vec::new(),
@@ -97,7 +99,6 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let kind = Self::buildable(params.kind);
         let wo_local = frame.to_local(wo);
         let k = params.brdf_samples;
-        self.keys.clear();
         let mut count = 0;
         if !env.is_black() && k > 0 {
             // K BRDF samples from a randomised (0,2)-sequence, in one call.
@@ -115,10 +116,8 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             }
             let uvs = &mut self.points[..count];
             sphere_to_square_batch(&self.dirs[..count], uvs);
-            for (idx, uv) in uvs.iter().enumerate() {
-                let _ = self.keys.push(sort_key(uv.x, uv.y, idx));
-            }
-            self.keys.sort_unstable();
+            sort_keys(uvs, &mut self.keys[..count]);
+            self.keys[..count].sort_unstable();
         }
         // B·cos at a point of the square, and at four side by side (each lane as `eval` gives
         // it), for the cells the build probes.
@@ -135,7 +134,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             brdf.eval_luminance_x4(wo_local, [row(0), row(1), row(2)])
         };
         let mut builder = TreeBuilder {
-            keys: &self.keys,
+            keys: &self.keys[..count],
             values: &self.values[..count],
             env,
             nodes: &mut self.nodes,
