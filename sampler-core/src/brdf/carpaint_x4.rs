@@ -134,7 +134,8 @@ impl CarPaint {
             let coat = sp(self.coat) * sp(gc) * fresnel_schlick_x4(self.coat_f0, h.dot(wo)) * c.d_x4(&h) * c.g1_x4(&wi);
             let transmit = sp(transmit_o) * (Vec4::ONE - sp(self.coat) * fresnel_schlick_x4(self.coat_f0, wi.z));
             let value = coat + transmit * (sp(flake) * sp(gf) * f.d_x4(&h) * f.g1_x4(&wi) + sp(base) * wi.z);
-            let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO);
+            // An array, not `Vec4`'s index: see `Dir4::lane`.
+            let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO).to_array();
             for (j, o) in os.iter_mut().enumerate() {
                 o.value = value[j];
             }
