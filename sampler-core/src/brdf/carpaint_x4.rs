@@ -60,13 +60,10 @@ impl CarPaint {
         let mut pending = [[0usize; 4]; 3];
         let mut count = [0usize; 3];
         for (j, p) in u.iter().enumerate() {
-            let lobe = if p.x < view.p0 {
-                0
-            } else if p.x < view.p1 {
-                1
-            } else {
-                2
-            };
+            // The lobe without a branch (the points' lobes follow no pattern a predictor
+            // learns): 0 below p0, 1 below p1 (≥ p0), 2 from there; NaN takes 2, as `if` would.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            let lobe = usize::from(!(p.x < view.p0)) + usize::from(!(p.x < view.p1));
             pending[lobe][count[lobe]] = j;
             count[lobe] += 1;
             if count[lobe] == 4 {
