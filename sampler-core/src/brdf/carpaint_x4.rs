@@ -60,13 +60,10 @@ impl CarPaint {
         let mut pending = [[0usize; 4]; 3];
         let mut count = [0usize; 3];
         for (j, p) in u.iter().enumerate() {
-            let lobe = if p.x < view.p0 {
-                0
-            } else if p.x < view.p1 {
-                1
-            } else {
-                2
-            };
+            // The lobe without a branch (the points' lobes follow no pattern a predictor
+            // learns): 0 below p0, 1 below p1 (≥ p0), 2 from there; NaN takes 2, as `if` would.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            let lobe = usize::from(!(p.x < view.p0)) + usize::from(!(p.x < view.p1));
             pending[lobe][count[lobe]] = j;
             count[lobe] += 1;
             if count[lobe] == 4 {
@@ -134,7 +131,8 @@ impl CarPaint {
             let coat = sp(self.coat) * sp(gc) * fresnel_schlick_x4(self.coat_f0, h.dot(wo)) * c.d_x4(&h) * c.g1_x4(&wi);
             let transmit = sp(transmit_o) * (Vec4::ONE - sp(self.coat) * fresnel_schlick_x4(self.coat_f0, wi.z));
             let value = coat + transmit * (sp(flake) * sp(gf) * f.d_x4(&h) * f.g1_x4(&wi) + sp(base) * wi.z);
-            let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO);
+            // An array, not `Vec4`'s index: see `Dir4::lane`.
+            let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO).to_array();
             for (j, o) in os.iter_mut().enumerate() {
                 o.value = value[j];
             }

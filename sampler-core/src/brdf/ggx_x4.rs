@@ -27,8 +27,10 @@ impl Dir4 {
         Self { x: Vec4::new(a.x, b.x, c.x, d.x), y: Vec4::new(a.y, b.y, c.y, d.y), z: Vec4::new(a.z, b.z, c.z, d.z) }
     }
 
+    /// Lane k's direction. Read through arrays: `Vec4`'s index is a `match`, which a lane
+    /// number not known at compile time turns into a jump table, mispredicted lane after lane.
     pub(super) fn lane(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
+        Vec3::new(self.x.to_array()[k], self.y.to_array()[k], self.z.to_array()[k])
     }
 
     /// `a · self` per lane, as `Vec3::dot` orders it.

@@ -3,8 +3,9 @@
 //! node's branch probability computed in the same traversal.
 
 use super::bilinear::Corners;
+use super::keys::sort_keys;
 use super::params::{ProductError, ProductParams};
-use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder, sort_key};
+use super::quadtree::{COORD_BITS, Leaves, Node, ProductKind, TreeBuilder};
 use super::sampler::ProductSampler;
 use crate::brdf::{Brdf, BrdfDraw};
 use crate::env::{EnvHierarchy, luminance};
@@ -31,7 +32,8 @@ pub struct ProductArena<const K: usize = 256, const NODES: usize = 2048, const C
     dirs: [Vec3; K],
     /// Usable samples' B·cos (luminance).
     values: [f32; K],
-    keys: Vec<u64, K>,
+    /// The usable samples' sort keys (`keys.rs`), sorted.
+    keys: [u64; K],
     nodes: Vec<Node, NODES>,
     /// Per node, the probability that the warp picks it among its parent's children (see
     /// [`branch_probabilities`]).
@@ -71,7 +73,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             draws: [BrdfDraw { wi: Vec3::ZERO, value: 0.0 }; K],
             dirs: [Vec3::ZERO; K],
             values: [0.0; K],
-            keys: Vec::new(),
+            keys: [0; K],
             nodes: Vec::new(),
             branches: [0.0; NODES],
             corners: Vec::new(),
@@ -97,7 +99,6 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
         let kind = Self::buildable(params.kind);
         let wo_local = frame.to_local(wo);
         let k = params.brdf_samples;
-        self.keys.clear();
         let mut count = 0;
         if !env.is_black() && k > 0 {
             // K BRDF samples from a randomised (0,2)-sequence, in one call.
@@ -115,10 +116,8 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             }
             let uvs = &mut self.points[..count];
             sphere_to_square_batch(&self.dirs[..count], uvs);
-            for (idx, uv) in uvs.iter().enumerate() {
-                let _ = self.keys.push(sort_key(uv.x, uv.y, idx));
-            }
-            self.keys.sort_unstable();
+            sort_keys(uvs, &mut self.keys[..count]);
+            self.keys[..count].sort_unstable();
         }
         // B·cos at a point of the square, and at four side by side (each lane as `eval` gives
         // it), for the cells the build probes.
@@ -135,7 +134,7 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
             brdf.eval_luminance_x4(wo_local, [row(0), row(1), row(2)])
         };
         let mut builder = TreeBuilder {
-            keys: &self.keys,
+            keys: &self.keys[..count],
             values: &self.values[..count],
             env,
             nodes: &mut self.nodes,
@@ -192,9 +191,24 @@ impl<const K: usize, const NODES: usize, const CORNERS: usize> ProductArena<K, N
 /// each column's share computed once. The build calls it wherever it sets a parent's children
 /// (children always follow their parent in the arena's nodes); a descent multiplies them from
 /// the root down, so a leaf's path probability is the product of its branches in the warp's
-/// order.
+/// order. On x86-64 the six divisions run as three two-wide ones (the same correctly rounded
+/// quotients): they occupy the divider once per internal node of every build.
 #[inline]
 pub(crate) fn branch_probabilities(mass: [f32; 4]) -> [f64; 4] {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        branch_probabilities_sse2(mass)
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        branch_probabilities_scalar(mass)
+    }
+}
+
+/// [`branch_probabilities`] one division at a time.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "sse2"), allow(dead_code))]
+#[inline]
+fn branch_probabilities_scalar(mass: [f32; 4]) -> [f64; 4] {
     let m = mass.map(f64::from);
     let total = m[0] + m[1] + m[2] + m[3];
     let mut out = [0.0; 4];
@@ -206,6 +220,31 @@ pub(crate) fn branch_probabilities(mass: [f32; 4]) -> [f64; 4] {
         }
         let share = column / total;
         (out[dx], out[dx + 2]) = (share * (m[dx] / column), share * (m[dx + 2] / column));
+    }
+    out
+}
+
+/// [`branch_probabilities_scalar`] with both columns in the lanes of SSE2 registers: every
+/// quotient and product computed as there, a column that test skips set to 0 by a mask.
+#[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+#[inline(always)]
+#[allow(unused_unsafe)]
+fn branch_probabilities_sse2(mass: [f32; 4]) -> [f64; 4] {
+    use core::arch::x86_64::*;
+    let m = mass.map(f64::from);
+    let total = m[0] + m[1] + m[2] + m[3];
+    let mut out = [0.0; 4];
+    // SAFETY: SSE2 is enabled (the cfg); the stores write `out`'s four values.
+    unsafe {
+        let (top, bottom) = (_mm_set_pd(m[1], m[0]), _mm_set_pd(m[3], m[2]));
+        let column = _mm_add_pd(top, bottom);
+        let total = _mm_set1_pd(total);
+        let share = _mm_div_pd(column, total);
+        let zero = _mm_setzero_pd();
+        let skip = _mm_or_pd(_mm_cmple_pd(total, zero), _mm_cmple_pd(column, zero));
+        let branch = |rows: __m128d| _mm_andnot_pd(skip, _mm_mul_pd(share, _mm_div_pd(rows, column)));
+        _mm_storeu_pd(out.as_mut_ptr(), branch(top));
+        _mm_storeu_pd(out.as_mut_ptr().add(2), branch(bottom));
     }
     out
 }
@@ -239,8 +278,13 @@ mod tests {
             [1.0, 2.0, 3.0, 4.0],
             [5.0, 0.0, 0.0, 0.0],
             [f32::NAN, 1.0, 0.0, 2.0],
+            [f32::INFINITY, 1.0, 0.0, 2.0],
+            [1e-45, 0.0, 3e38, 3e38],
+            [-1.0, 2.0, 0.5, 0.0],
         ] {
             let got = branch_probabilities(mass);
+            let scalar = branch_probabilities_scalar(mass);
+            assert_eq!(got.map(f64::to_bits), scalar.map(f64::to_bits), "{mass:?}");
             for (k, g) in got.iter().enumerate() {
                 assert_eq!(g.to_bits(), branch_probability(mass, k).to_bits(), "{mass:?}, child {k}");
             }

@@ -2,7 +2,7 @@
 //! empty cells the counts say are dim, the leaves under [`Leaves::Probed`](super::Leaves) and
 //! the refinement's children. The cells of one node are probed side by side, four lanes of
 //! the BRDF's [`eval_luminance_x4`](crate::brdf::Brdf::eval_luminance_x4), each lane bit for bit
-//! the one-at-a-time probe.
+//! the one-at-a-time probe; so are the four corners of a cell whose centre reads 0.
 
 use super::quadtree::{EVAL_EMPTY_FROM, TreeBuilder};
 use crate::cell::Cell;
@@ -49,39 +49,43 @@ where
     /// surface), the largest of its four corners (inset by 1/64 of the cell), so that a cell
     /// straddling the horizon is not zeroed. NaN reads as unknown (+∞: keep the count fill).
     pub(super) fn probe(&mut self, cell: Cell) -> f32 {
-        let (Cell { x, y, .. }, inv) = (cell, cell.side());
-        let at = |s: f32, t: f32| Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv);
-        let centre = read_probe((self.eval)(at(0.5, 0.5)));
-        if centre > 0.0 {
-            return centre;
-        }
-        let (a, b) = (1.0 / 64.0, 63.0 / 64.0);
-        [at(a, a), at(b, a), at(a, b), at(b, b)].into_iter().map(|p| read_probe((self.eval)(p))).fold(0.0, f32::max)
+        let centre = read_probe((self.eval)(at(cell, 0.5, 0.5)));
+        if centre > 0.0 { centre } else { self.probe_corners(cell) }
     }
 
     /// [`probe`](Self::probe) of up to four cells (`cells[k]` into lane k), their centres
-    /// evaluated side by side and the corners of each whose centre reads 0 four at a time.
+    /// evaluated side by side.
     pub(super) fn probe4(&mut self, cells: &[Cell]) -> [f32; 4] {
-        let at = |cell: Cell, s: f32, t: f32| {
-            let (Cell { x, y, .. }, inv) = (cell, cell.side());
-            Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv)
-        };
-        let lanes = |p: [Vec2; 4]| (Vec4::from_array(p.map(|q| q.x)), Vec4::from_array(p.map(|q| q.y)));
         let centres: [Vec2; 4] = core::array::from_fn(|k| at(cells[k.min(cells.len() - 1)], 0.5, 0.5));
         let (u, v) = lanes(centres);
         let centre = (self.eval4)(u, v).to_array().map(read_probe);
         let mut out = [0.0f32; 4];
         for (k, &cell) in cells.iter().enumerate() {
-            out[k] = if centre[k] > 0.0 {
-                centre[k]
-            } else {
-                let (a, b) = (1.0 / 64.0, 63.0 / 64.0);
-                let (u, v) = lanes([at(cell, a, a), at(cell, b, a), at(cell, a, b), at(cell, b, b)]);
-                (self.eval4)(u, v).to_array().into_iter().map(read_probe).fold(0.0, f32::max)
-            };
+            out[k] = if centre[k] > 0.0 { centre[k] } else { self.probe_corners(cell) };
         }
         out
     }
+
+    /// The largest reading of B·cos at the four corners of `cell`, inset by 1/64 of the cell,
+    /// evaluated side by side (each lane bit for bit the scalar evaluation, in the same order).
+    fn probe_corners(&mut self, cell: Cell) -> f32 {
+        let (a, b) = (1.0 / 64.0, 63.0 / 64.0);
+        let (u, v) = lanes([at(cell, a, a), at(cell, b, a), at(cell, a, b), at(cell, b, b)]);
+        (self.eval4)(u, v).to_array().into_iter().map(read_probe).fold(0.0, f32::max)
+    }
+}
+
+/// The point (s, t) of `cell` in units of its side.
+#[inline(always)]
+fn at(cell: Cell, s: f32, t: f32) -> Vec2 {
+    let (Cell { x, y, .. }, inv) = (cell, cell.side());
+    Vec2::new((x as f32 + s) * inv, (y as f32 + t) * inv)
+}
+
+/// Four points' coordinates in lanes.
+#[inline(always)]
+fn lanes(p: [Vec2; 4]) -> (Vec4, Vec4) {
+    (Vec4::from_array(p.map(|q| q.x)), Vec4::from_array(p.map(|q| q.y)))
 }
 
 /// A probe's reading of B·cos: NaN is unknown (+∞), negative is 0.

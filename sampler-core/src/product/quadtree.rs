@@ -22,7 +22,7 @@
 
 use super::arena::branch_probabilities;
 use super::keys::digit;
-pub use super::keys::{COORD_BITS, morton, quantize, sort_key};
+pub use super::keys::{COORD_BITS, morton, quantize, sort_key, sort_keys};
 pub use super::params::{Leaves, ProductKind};
 use crate::bilinear::{self, Corners};
 use crate::cell::Cell;
