@@ -117,23 +117,76 @@ impl Block {
     }
 
     /// Whether the ray hits any primitive of the block in (t_min, t_max): the lanes
-    /// [`Block::triangles`] and [`Block::spheres`] find, decided in the lanes. A sphere lane
-    /// hits where either root is in the interval: its nearer root in it, or else its farther,
-    /// is the same test. Where q = 0 the scalar test takes 0 for both roots; then q's own lane
-    /// tests 0 and c/q (infinite or NaN) is in no interval, so the answer is the same.
+    /// [`Block::triangles`] and [`Block::spheres`] find, up to rounding at the edges of
+    /// triangles and of the interval, decided without a division or a square root where it
+    /// can be. A triangle's barycentrics and distance are compared scaled by its determinant
+    /// ([`Block::triangles_hit`]). A sphere hit anywhere ahead, t ∈ (0, ∞), needs only the
+    /// signs of the quadratic's coefficients ([`Block::spheres_ahead`]); in another interval
+    /// a sphere lane hits where either root is in it: its nearer root in it, or else its
+    /// farther, is the same test. Where q = 0 the scalar test takes 0 for both roots; then
+    /// q's own lane tests 0 and c/q (infinite or NaN) is in no interval, so the answer is the
+    /// same.
     #[inline(always)]
     pub(super) fn occludes(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        if self.triangles(o, d, t_min, t_max).0 != 0 {
+        if self.tris != 0 && self.triangles_hit(o, d, t_min, t_max) {
             return true;
         }
         if self.spheres == 0 {
             return false;
+        }
+        if t_min == 0.0 && t_max == f32::INFINITY {
+            return self.spheres_ahead(o, d);
         }
         let (disc, q, cq) = self.sphere_roots(o, d);
         let (lo, hi) = (F4::splat(t_min), F4::splat(t_max));
         let inside = |t: F4| lo.lt_mask(t) & t.lt_mask(hi);
         let real = !disc.lt_mask(F4::splat(0.0));
         real & (inside(q) | inside(cq)) & self.spheres != 0
+    }
+
+    /// Whether a triangle lane hits in (t_min, t_max): [`Block::triangles`]'s Möller–Trumbore
+    /// test with u, v and t left multiplied by the determinant det, so that u ∈ [0, 1]
+    /// becomes u·|det| ∈ [0, |det|] (u·det times the sign of det) and no lane divides.
+    #[inline(always)]
+    fn triangles_hit(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        let row = |r: &[[f32; 4]; 3]| r.each_ref().map(F4::load);
+        let (v0, e1, e2) = (row(&self.v0), row(&self.e1), row(&self.e2));
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let o = [o.x, o.y, o.z].map(F4::splat);
+        let p = cross(d, e2);
+        let det = dot(e1, p);
+        let (sign, scale) = (det.sign(), det.abs());
+        let mut ok = !scale.lt_mask(F4::splat(1e-20));
+        let s = [o[0].sub(v0[0]), o[1].sub(v0[1]), o[2].sub(v0[2])];
+        let u = dot(s, p).xor(sign);
+        ok &= F4::splat(0.0).le_mask(u) & u.le_mask(scale);
+        let q = cross(s, e1);
+        let v = dot(d, q).xor(sign);
+        ok &= !(v.lt_mask(F4::splat(0.0)) | scale.lt_mask(u.add(v)));
+        let t = dot(e2, q).xor(sign);
+        ok &= F4::splat(t_min).mul(scale).lt_mask(t) & t.lt_mask(F4::splat(t_max).mul(scale));
+        ok & self.tris != 0
+    }
+
+    /// Whether a sphere lane hits at some t ∈ (0, ∞). The quadratic t² − 2bt + c = 0 of
+    /// [`Block::sphere_roots`] has real roots where its discriminant is not negative; their
+    /// product is c and their sum 2b, so one is ahead where c < 0 (the origin inside) and
+    /// both are where c ≥ 0 and b > 0 (the sphere ahead; with c = 0 one root is 0 and the
+    /// other 2b). No root needs computing.
+    #[inline(always)]
+    fn spheres_ahead(&self, o: Vec3, d: Vec3) -> bool {
+        let center = self.v0.each_ref().map(F4::load);
+        let r2 = F4::load(&self.e1[0]);
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let f = [o.x, o.y, o.z].map(F4::splat);
+        let f = [f[0].sub(center[0]), f[1].sub(center[1]), f[2].sub(center[2])];
+        let b = dot(f, d).neg();
+        let perp = [f[0].add(b.mul(d[0])), f[1].add(b.mul(d[1])), f[2].add(b.mul(d[2]))];
+        let disc = r2.sub(dot(perp, perp));
+        let c = dot(f, f).sub(r2);
+        let zero = F4::splat(0.0);
+        let real = !disc.lt_mask(zero);
+        real & (c.lt_mask(zero) | zero.lt_mask(b)) & self.spheres != 0
     }
 
     /// Per sphere lane: the discriminant (its root's radicand), q and c/q, the roots of
