@@ -29,10 +29,21 @@ pub(super) struct Block {
 }
 
 impl Block {
-    /// The blocks of the primitives `first..first + count`, in order.
+    /// The blocks of the primitives `first..first + count`, in order, or triangles first
+    /// and spheres after them where that takes no more blocks: then a block is one kind and a
+    /// ray runs one of the two tests on it.
     pub(super) fn pack(prims: &[Primitive], first: u32, count: u32, out: &mut Vec<Block>) {
+        let is_sphere = |&id: &u32| matches!(prims[id as usize], Primitive::Sphere { .. });
+        let (spheres, tris): (Vec<u32>, Vec<u32>) = (first..first + count).partition(is_sphere);
+        let chunks: Vec<&[u32]> = if tris.len().div_ceil(4) + spheres.len().div_ceil(4) == (count as usize).div_ceil(4)
+        {
+            tris.chunks(4).chain(spheres.chunks(4)).collect()
+        } else {
+            Vec::new()
+        };
         let ids: Vec<u32> = (first..first + count).collect();
-        for chunk in ids.chunks(4) {
+        let chunks = if chunks.is_empty() { ids.chunks(4).collect() } else { chunks };
+        for chunk in chunks {
             let mut b = Block {
                 v0: [[f32::NAN; 4]; 3],
                 e1: [[f32::NAN; 4]; 3],
@@ -242,7 +253,7 @@ mod tests {
         let (mut hits, mut sphere_hits) = (0, 0);
         for (i, b) in blocks.iter().enumerate() {
             // Aimed near one lane's primitive, so that many rays hit and some graze edges.
-            let (lo, hi) = prims[4 * i + i % 4].bounds();
+            let (lo, hi) = prims[b.prim[i % 4] as usize].bounds();
             let o = v() * 3.0;
             let d = ((lo + hi) * 0.5 + v() * 0.02 - o).normalize();
             let (tris, t_tri) = b.triangles(o, d, 1e-3, 4.5);
@@ -252,7 +263,7 @@ mod tests {
             let unbounded = b.triangles(o, d, 0.0, f32::INFINITY).0 | b.spheres(o, d, 0.0, f32::INFINITY).0;
             assert_eq!(b.occludes(o, d, 0.0, f32::INFINITY), unbounded != 0, "block {i}: occlusion to ∞");
             for k in 0..4 {
-                let scalar = prims[4 * i + k].intersect(o, d, 1e-3, 4.5);
+                let scalar = prims[b.prim[k] as usize].intersect(o, d, 1e-3, 4.5);
                 let lane = match (tris & (1 << k) != 0, spheres & (1 << k) != 0) {
                     (true, _) => Some(t_tri[k]),
                     (_, true) => Some(t_sphere[k]),

@@ -181,9 +181,9 @@ impl Bvh {
         }
         match self.lone_leaf {
             Some((first, count)) => self.blocked_in(first, count, o, d, t_min, t_max),
-            None => {
-                traverse::any(&self.nodes, o, d, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
-            }
+            None => traverse::any(&self.nodes, o, d, t_max, |first, count| {
+                self.blocked_in(first, count, o, d, t_min, t_max)
+            }),
         }
     }
 
