@@ -13,6 +13,9 @@ const BINS: usize = 16;
 const LEAF_SIZE: usize = 4;
 /// A node of at most this many primitives may stay a leaf when no split is cheaper.
 const LEAF_MAX: usize = 16;
+/// A scene of at most this many primitives is one leaf: its two blocks tested outright
+/// cost a ray less than the root's box test and the traversal (docs/bvh.md, "Figures").
+const ONE_LEAF: usize = 8;
 /// Depth from which nodes split at the median.
 const MEDIAN_DEPTH: u32 = 40;
 /// Subtrees of at least this many primitives build their halves in parallel (below it the
@@ -73,6 +76,10 @@ pub(super) fn build(prims: Vec<Primitive>) -> (Vec<Primitive>, Vec<Node>) {
         prims.par_iter().enumerate().map(|(k, p)| Item { bounds: p.aabb(), prim: k as u32 }).collect();
     let mut nodes = Vec::with_capacity(2 * prims.len() / LEAF_SIZE + 1);
     let extent = Extent::of(&items);
+    if prims.len() <= ONE_LEAF {
+        nodes.push(Node { bounds: extent.bounds, offset: 0, count: prims.len() as u32 });
+        return (prims, nodes);
+    }
     subtree(&mut items, 0, 0, extent, &mut nodes);
     let ordered = items.par_iter().map(|it| prims[it.prim as usize]).collect();
     (ordered, nodes)

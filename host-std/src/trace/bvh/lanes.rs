@@ -115,6 +115,21 @@ mod imp {
                 _mm_or_ps(_mm_andnot_ps(bit, self.0), _mm_and_ps(bit, sign.0))
             })
         }
+
+        /// Each lane's sign bit alone (±0).
+        #[inline(always)]
+        pub(crate) fn sign(self) -> F4 {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            F4(unsafe { _mm_and_ps(_mm_set1_ps(-0.0), self.0) })
+        }
+
+        /// The bits of `self` and `o` exclusive-ored per lane: with `o` a [`F4::sign`], `self`
+        /// times that sign.
+        #[inline(always)]
+        pub(crate) fn xor(self, o: F4) -> F4 {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            F4(unsafe { _mm_xor_ps(self.0, o.0) })
+        }
     }
 }
 
@@ -207,6 +222,18 @@ mod imp {
         pub(crate) fn copysign(self, sign: F4) -> F4 {
             F4(std::array::from_fn(|k| self.0[k].copysign(sign.0[k])))
         }
+
+        /// Each lane's sign bit alone (±0).
+        #[inline(always)]
+        pub(crate) fn sign(self) -> F4 {
+            F4(self.0.map(|x| f32::from_bits(x.to_bits() & 0x8000_0000)))
+        }
+
+        /// The bits of `self` and `o` exclusive-ored per lane.
+        #[inline(always)]
+        pub(crate) fn xor(self, o: F4) -> F4 {
+            F4(std::array::from_fn(|k| f32::from_bits(self.0[k].to_bits() ^ o.0[k].to_bits())))
+        }
     }
 }
 
@@ -235,5 +262,8 @@ mod tests {
         let signs = F4::load(&[-1.0, 0.0, -0.0, f32::NAN]);
         let c = F4::load(&[2.0, -3.0, 4.0, -5.0]).copysign(signs).to_array();
         assert_eq!(c.map(f32::to_bits), [-2.0f32, 3.0, -4.0, 5.0f32.copysign(f32::NAN)].map(f32::to_bits));
+        let s = F4::load(&[-2.0, 0.0, -0.0, 3.0]).sign();
+        assert_eq!(s.to_array().map(f32::to_bits), [-0.0f32, 0.0, -0.0, 0.0].map(f32::to_bits));
+        assert_eq!(F4::load(&[1.0, -2.0, 3.0, -0.0]).xor(s).to_array(), [-1.0, -2.0, -3.0, 0.0]);
     }
 }

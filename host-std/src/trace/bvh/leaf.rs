@@ -29,10 +29,21 @@ pub(super) struct Block {
 }
 
 impl Block {
-    /// The blocks of the primitives `first..first + count`, in order.
+    /// The blocks of the primitives `first..first + count`, in order, or triangles first
+    /// and spheres after them where that takes no more blocks: then a block is one kind and a
+    /// ray runs one of the two tests on it.
     pub(super) fn pack(prims: &[Primitive], first: u32, count: u32, out: &mut Vec<Block>) {
+        let is_sphere = |&id: &u32| matches!(prims[id as usize], Primitive::Sphere { .. });
+        let (spheres, tris): (Vec<u32>, Vec<u32>) = (first..first + count).partition(is_sphere);
+        let chunks: Vec<&[u32]> = if tris.len().div_ceil(4) + spheres.len().div_ceil(4) == (count as usize).div_ceil(4)
+        {
+            tris.chunks(4).chain(spheres.chunks(4)).collect()
+        } else {
+            Vec::new()
+        };
         let ids: Vec<u32> = (first..first + count).collect();
-        for chunk in ids.chunks(4) {
+        let chunks = if chunks.is_empty() { ids.chunks(4).collect() } else { chunks };
+        for chunk in chunks {
             let mut b = Block {
                 v0: [[f32::NAN; 4]; 3],
                 e1: [[f32::NAN; 4]; 3],
@@ -117,23 +128,76 @@ impl Block {
     }
 
     /// Whether the ray hits any primitive of the block in (t_min, t_max): the lanes
-    /// [`Block::triangles`] and [`Block::spheres`] find, decided in the lanes. A sphere lane
-    /// hits where either root is in the interval: its nearer root in it, or else its farther,
-    /// is the same test. Where q = 0 the scalar test takes 0 for both roots; then q's own lane
-    /// tests 0 and c/q (infinite or NaN) is in no interval, so the answer is the same.
+    /// [`Block::triangles`] and [`Block::spheres`] find, up to rounding at the edges of
+    /// triangles and of the interval, decided without a division or a square root where it
+    /// can be. A triangle's barycentrics and distance are compared scaled by its determinant
+    /// ([`Block::triangles_hit`]). A sphere hit anywhere ahead, t ∈ (0, ∞), needs only the
+    /// signs of the quadratic's coefficients ([`Block::spheres_ahead`]); in another interval
+    /// a sphere lane hits where either root is in it: its nearer root in it, or else its
+    /// farther, is the same test. Where q = 0 the scalar test takes 0 for both roots; then
+    /// q's own lane tests 0 and c/q (infinite or NaN) is in no interval, so the answer is the
+    /// same.
     #[inline(always)]
     pub(super) fn occludes(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        if self.triangles(o, d, t_min, t_max).0 != 0 {
+        if self.tris != 0 && self.triangles_hit(o, d, t_min, t_max) {
             return true;
         }
         if self.spheres == 0 {
             return false;
+        }
+        if t_min == 0.0 && t_max == f32::INFINITY {
+            return self.spheres_ahead(o, d);
         }
         let (disc, q, cq) = self.sphere_roots(o, d);
         let (lo, hi) = (F4::splat(t_min), F4::splat(t_max));
         let inside = |t: F4| lo.lt_mask(t) & t.lt_mask(hi);
         let real = !disc.lt_mask(F4::splat(0.0));
         real & (inside(q) | inside(cq)) & self.spheres != 0
+    }
+
+    /// Whether a triangle lane hits in (t_min, t_max): [`Block::triangles`]'s Möller–Trumbore
+    /// test with u, v and t left multiplied by the determinant det, so that u ∈ [0, 1]
+    /// becomes u·|det| ∈ [0, |det|] (u·det times the sign of det) and no lane divides.
+    #[inline(always)]
+    fn triangles_hit(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        let row = |r: &[[f32; 4]; 3]| r.each_ref().map(F4::load);
+        let (v0, e1, e2) = (row(&self.v0), row(&self.e1), row(&self.e2));
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let o = [o.x, o.y, o.z].map(F4::splat);
+        let p = cross(d, e2);
+        let det = dot(e1, p);
+        let (sign, scale) = (det.sign(), det.abs());
+        let mut ok = !scale.lt_mask(F4::splat(1e-20));
+        let s = [o[0].sub(v0[0]), o[1].sub(v0[1]), o[2].sub(v0[2])];
+        let u = dot(s, p).xor(sign);
+        ok &= F4::splat(0.0).le_mask(u) & u.le_mask(scale);
+        let q = cross(s, e1);
+        let v = dot(d, q).xor(sign);
+        ok &= !(v.lt_mask(F4::splat(0.0)) | scale.lt_mask(u.add(v)));
+        let t = dot(e2, q).xor(sign);
+        ok &= F4::splat(t_min).mul(scale).lt_mask(t) & t.lt_mask(F4::splat(t_max).mul(scale));
+        ok & self.tris != 0
+    }
+
+    /// Whether a sphere lane hits at some t ∈ (0, ∞). The quadratic t² − 2bt + c = 0 of
+    /// [`Block::sphere_roots`] has real roots where its discriminant is not negative; their
+    /// product is c and their sum 2b, so one is ahead where c < 0 (the origin inside) and
+    /// both are where c ≥ 0 and b > 0 (the sphere ahead; with c = 0 one root is 0 and the
+    /// other 2b). No root needs computing.
+    #[inline(always)]
+    fn spheres_ahead(&self, o: Vec3, d: Vec3) -> bool {
+        let center = self.v0.each_ref().map(F4::load);
+        let r2 = F4::load(&self.e1[0]);
+        let d = [d.x, d.y, d.z].map(F4::splat);
+        let f = [o.x, o.y, o.z].map(F4::splat);
+        let f = [f[0].sub(center[0]), f[1].sub(center[1]), f[2].sub(center[2])];
+        let b = dot(f, d).neg();
+        let perp = [f[0].add(b.mul(d[0])), f[1].add(b.mul(d[1])), f[2].add(b.mul(d[2]))];
+        let disc = r2.sub(dot(perp, perp));
+        let c = dot(f, f).sub(r2);
+        let zero = F4::splat(0.0);
+        let real = !disc.lt_mask(zero);
+        real & (c.lt_mask(zero) | zero.lt_mask(b)) & self.spheres != 0
     }
 
     /// Per sphere lane: the discriminant (its root's radicand), q and c/q, the roots of
@@ -189,7 +253,7 @@ mod tests {
         let (mut hits, mut sphere_hits) = (0, 0);
         for (i, b) in blocks.iter().enumerate() {
             // Aimed near one lane's primitive, so that many rays hit and some graze edges.
-            let (lo, hi) = prims[4 * i + i % 4].bounds();
+            let (lo, hi) = prims[b.prim[i % 4] as usize].bounds();
             let o = v() * 3.0;
             let d = ((lo + hi) * 0.5 + v() * 0.02 - o).normalize();
             let (tris, t_tri) = b.triangles(o, d, 1e-3, 4.5);
@@ -199,7 +263,7 @@ mod tests {
             let unbounded = b.triangles(o, d, 0.0, f32::INFINITY).0 | b.spheres(o, d, 0.0, f32::INFINITY).0;
             assert_eq!(b.occludes(o, d, 0.0, f32::INFINITY), unbounded != 0, "block {i}: occlusion to ∞");
             for k in 0..4 {
-                let scalar = prims[4 * i + k].intersect(o, d, 1e-3, 4.5);
+                let scalar = prims[b.prim[k] as usize].intersect(o, d, 1e-3, 4.5);
                 let lane = match (tris & (1 << k) != 0, spheres & (1 << k) != 0) {
                     (true, _) => Some(t_tri[k]),
                     (_, true) => Some(t_sphere[k]),

@@ -81,6 +81,8 @@ pub struct Bvh {
     corner_attrs: Vec<CornerAttrs>,
     /// Disk lights' surfaces.
     disks: Vec<disk::Disk>,
+    /// The blocks (first, count) of a tree that is one leaf, which rays test directly.
+    lone_leaf: Option<(u32, u32)>,
 }
 
 impl Bvh {
@@ -90,7 +92,8 @@ impl Bvh {
         let gather::Gathered { prims, corner_attrs, disks } = gather::gather(scene);
         let (prims, binary) = build::build(prims);
         let (nodes, blocks) = wide::collapse(&binary, &prims);
-        Bvh { prims, nodes, blocks, corner_attrs, disks }
+        let lone_leaf = wide::lone_leaf(&nodes);
+        Bvh { prims, nodes, blocks, corner_attrs, disks, lone_leaf }
     }
 
     /// The number of primitives `build` makes of `scene`, without building: a sphere is
@@ -125,27 +128,12 @@ impl Bvh {
     pub fn intersect(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
         let mut best: Option<usize> = None;
         let mut t_max = t_max;
-        traverse::closest(&self.nodes, o, d, &mut t_max, |first, count, t_max| {
-            for b in &self.blocks[first as usize..(first + count) as usize] {
-                let (tris, t_tri) = b.triangles(o, d, t_min, *t_max);
-                let (spheres, t_sphere) = b.spheres(o, d, t_min, *t_max);
-                // Lane by lane as a loop over the primitives would meet them, so that the first
-                // of equal distances wins either way.
-                for k in 0..4 {
-                    let t = if tris & (1 << k) != 0 {
-                        t_tri[k]
-                    } else if spheres & (1 << k) != 0 {
-                        t_sphere[k]
-                    } else {
-                        continue;
-                    };
-                    if t < *t_max {
-                        *t_max = t;
-                        best = Some(b.prim[k] as usize);
-                    }
-                }
-            }
-        });
+        match self.lone_leaf {
+            Some((first, count)) => self.closest_in(first, count, o, d, t_min, &mut t_max, &mut best),
+            None => traverse::closest(&self.nodes, o, d, &mut t_max, |first, count, t_max| {
+                self.closest_in(first, count, o, d, t_min, t_max, &mut best)
+            }),
+        }
         if let Some((k, t)) = disk::closest(&self.disks, o, d, t_min, t_max) {
             let disk = &self.disks[k];
             let (point, normal) = (o + t * d, disk.normal);
@@ -191,9 +179,59 @@ impl Bvh {
         if self.disks.iter().any(|k| k.intersect(o, d, t_min, t_max).is_some()) {
             return true;
         }
-        traverse::any(&self.nodes, o, d, t_max, |first, count| {
-            self.blocks[first as usize..(first + count) as usize].iter().any(|b| b.occludes(o, d, t_min, t_max))
-        })
+        match self.lone_leaf {
+            Some((first, count)) => self.blocked_in(first, count, o, d, t_min, t_max),
+            None => traverse::any(&self.nodes, o, d, t_max, |first, count| {
+                self.blocked_in(first, count, o, d, t_min, t_max)
+            }),
+        }
+    }
+
+    /// The nearest hit in the blocks `first..first + count` within (t_min, `t_max`), if nearer
+    /// than `t_max`: `t_max` becomes its distance and `best` its primitive.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn closest_in(
+        &self,
+        first: u32,
+        count: u32,
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: &mut f32,
+        best: &mut Option<usize>,
+    ) {
+        for b in &self.blocks[first as usize..(first + count) as usize] {
+            let (tris, t_tri) = b.triangles(o, d, t_min, *t_max);
+            let (spheres, t_sphere) = b.spheres(o, d, t_min, *t_max);
+            // Lane by lane as a loop over the primitives would meet them, so that the first
+            // of equal distances wins either way.
+            for k in 0..4 {
+                let t = if tris & (1 << k) != 0 {
+                    t_tri[k]
+                } else if spheres & (1 << k) != 0 {
+                    t_sphere[k]
+                } else {
+                    continue;
+                };
+                if t < *t_max {
+                    *t_max = t;
+                    *best = Some(b.prim[k] as usize);
+                }
+            }
+        }
+    }
+
+    /// Whether a primitive of the blocks `first..first + count` blocks the ray in (t_min, t_max).
+    #[inline(always)]
+    fn blocked_in(&self, first: u32, count: u32, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        // A loop rather than `Iterator::any`, which is kept out of line in the traversal.
+        for b in &self.blocks[first as usize..(first + count) as usize] {
+            if b.occludes(o, d, t_min, t_max) {
+                return true;
+            }
+        }
+        false
     }
 
     /// [`Bvh::occluded`] for each ray: `out[k]` is ray k's answer, bit for bit the one-at-a-time

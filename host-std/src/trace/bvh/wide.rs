@@ -64,6 +64,17 @@ impl Node4 {
     }
 }
 
+/// The blocks (first, count) of the one leaf that is the whole tree, if it is: a ray then
+/// tests them without the root's box test, whose answer the primitive tests decide anyway.
+pub(super) fn lone_leaf(nodes: &[Node4]) -> Option<(u32, u32)> {
+    match nodes {
+        [root] if root.child[0] & LEAF != 0 && root.child[1..].iter().all(|&c| c == EMPTY) => {
+            Some((root.child[0] & !LEAF, root.count[0]))
+        }
+        _ => None,
+    }
+}
+
 /// The four-wide nodes over the binary tree `bin` of `prims` (root first, then each subtree
 /// depth first), and the blocks of its leaves.
 pub(super) fn collapse(bin: &[Node], prims: &[Primitive]) -> (Vec<Node4>, Vec<Block>) {
