@@ -115,12 +115,12 @@ impl Group {
     #[target_feature(enable = "avx2")]
     fn blocks<'p>(&self, pyramid: &'p [f32], level: u32) -> [&'p [f32; 16]; 8] {
         let ms = ints(self.morton);
-        let offset = level_offset(level + 2);
+        // The blocks of sixteen below `level`, one bounds check per lane.
+        let (below, _) = pyramid[level_offset(level + 2)..].as_chunks::<16>();
         let mut out = [&EMPTY; 8];
         for k in 0..8 {
             if self.alive & (1 << k) != 0 {
-                let at = offset + 16 * ms[k] as usize;
-                out[k] = pyramid[at..at + 16].try_into().expect("sixteen grandchildren");
+                out[k] = &below[ms[k] as usize];
             }
         }
         out
