@@ -10,6 +10,7 @@ use super::pyramid::level_offset;
 use super::texel_cdf::TexelCdf;
 use crate::cell::Cell;
 use crate::direction::DirectionSample;
+use crate::mapping::SPHERE_AREA;
 use crate::prefetch::prefetch;
 use crate::warp::{ONE_MINUS_EPSILON, child_offset, choose_child, choose_grandchild_branchless};
 use glam::{DVec2, Vec2, Vec3};
@@ -67,7 +68,9 @@ impl EnvHierarchy<'_> {
             // The points and densities, then the directions at once.
             let mut points = [(Vec2::ZERO, 0.0); IN_FLIGHT];
             for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
-                *p = self.point_in_texel(lane.cell, lane.xi.as_dvec2());
+                // `point_in_texel`'s density, by the Morton index the descent carried down.
+                let pdf = self.node_relative_at(self.finest, lane.morton) / SPHERE_AREA;
+                *p = (lane.cell.point(lane.xi.as_dvec2()), pdf);
             }
             let mut dirs = [Vec3::ZERO; IN_FLIGHT];
             self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
@@ -164,7 +167,6 @@ impl EnvHierarchy<'_> {
 mod tests {
     use super::*;
     use crate::env::{build_pyramid, pyramid_len};
-    use crate::mapping::SPHERE_AREA;
 
     #[test]
     fn sample_many_draws_what_sample_draws() {
