@@ -60,6 +60,30 @@ pub(super) fn to_unit_f32(u: DVec2) -> Vec2 {
 /// Returns the side, t's offset into it and its weight.
 #[inline(always)]
 fn pick_f32<const N: usize>(w: [f32; N], x: f32) -> Result<(usize, f32, f32), Refusal> {
+    side_f32(w, x, |prefix, t| (1..N).map(|j| usize::from(t >= prefix[j])).sum::<usize>())
+}
+
+/// [`pick_f32`] with a branch per prefix passed, for a descent alone: a predicted branch lets
+/// the next level's load start before the arithmetic ends (docs/tuning.md#batched-and-branch-free-sampling).
+/// The prefixes do not decrease, so the side is the count's, and the result the same bits.
+#[inline(always)]
+fn pick_f32_branching<const N: usize>(w: [f32; N], x: f32) -> Result<(usize, f32, f32), Refusal> {
+    side_f32(w, x, |prefix, t| {
+        let mut i = 0;
+        while i + 1 < N && t >= prefix[i + 1] {
+            i += 1;
+        }
+        i
+    })
+}
+
+/// The prefix sums of `w`, t = x·total and the side `find` gives for them, as [`pick_f32`] says.
+#[inline(always)]
+fn side_f32<const N: usize>(
+    w: [f32; N],
+    x: f32,
+    find: impl FnOnce(&[f32; 4], f32) -> usize,
+) -> Result<(usize, f32, f32), Refusal> {
     let mut prefix = [0.0f32; 4];
     prefix[1] = w[0];
     for i in 2..N {
@@ -73,12 +97,15 @@ fn pick_f32<const N: usize>(w: [f32; N], x: f32) -> Result<(usize, f32, f32), Re
         return Err(Refusal::Overflow);
     }
     let t = x * total;
-    let mut i = (1..N).map(|j| usize::from(t >= prefix[j])).sum::<usize>();
+    let mut i = find(&prefix, t);
     if !(w[i] > 0.0) {
         i = (0..N).rev().find(|&j| w[j] > 0.0).ok_or(Refusal::Empty)?;
     }
     Ok((i, t - prefix[i], w[i]))
 }
+
+/// A side chooser in f32: (weights, ξ) → (side, ξ's offset into it, its weight).
+type PickF32<const N: usize> = fn([f32; N], f32) -> Result<(usize, f32, f32), Refusal>;
 
 /// `v` clamped to [0, 1) (NaN stays NaN, as the register step's blends leave it).
 #[inline(always)]
@@ -90,11 +117,23 @@ fn clamp_unit_f32(v: f32) -> f32 {
 /// `(ox / wx, oy / wy)` (two divisions: a product of two small weights would underflow f32).
 #[inline(always)]
 pub(super) fn choose_grandchild_f32(mass: &[f32; 16], xi: &mut Vec2) -> Option<(usize, u32, u32)> {
+    grandchild_f32_by(mass, xi, pick_f32::<4>)
+}
+
+/// [`choose_grandchild_f32`] with a branch per prefix passed, for a descent alone: the same bits.
+#[inline(always)]
+fn choose_grandchild_f32_branching(mass: &[f32; 16], xi: &mut Vec2) -> Option<(usize, u32, u32)> {
+    grandchild_f32_by(mass, xi, pick_f32_branching::<4>)
+}
+
+/// The column, then the row within it, each by `pick`; see [`choose_grandchild_f32`].
+#[inline(always)]
+fn grandchild_f32_by(mass: &[f32; 16], xi: &mut Vec2, pick: PickF32<4>) -> Option<(usize, u32, u32)> {
     let at = |x: usize, y: usize| mass[grandchild_index(x as u32, y as u32)];
     let cols: [f32; 4] = core::array::from_fn(|x| (at(x, 0) + at(x, 1)) + (at(x, 2) + at(x, 3)));
-    let picked = pick_f32(cols, xi.x).and_then(|(x, ox, wx)| {
+    let picked = pick(cols, xi.x).and_then(|(x, ox, wx)| {
         let rows: [f32; 4] = core::array::from_fn(|y| at(x, y));
-        pick_f32(rows, xi.y).map(|(y, oy, wy)| (x, ox, wx, y, oy, wy))
+        pick(rows, xi.y).map(|(y, oy, wy)| (x, ox, wx, y, oy, wy))
     });
     match picked {
         Ok((x, ox, wx, y, oy, wy)) => {
@@ -110,9 +149,8 @@ pub(super) fn choose_grandchild_f32(mass: &[f32; 16], xi: &mut Vec2) -> Option<(
 /// [`choose_grandchild_f32`]: the last level of a map of odd finest level.
 #[inline(always)]
 pub(super) fn choose_child_f32(mass: [f32; 4], xi: &mut Vec2) -> Option<usize> {
-    let picked = pick_f32([mass[0] + mass[2], mass[1] + mass[3]], xi.x).and_then(|(dx, ox, wx)| {
-        pick_f32([mass[dx], mass[dx + 2]], xi.y).map(|(dy, oy, wy)| (dx, ox, wx, dy, oy, wy))
-    });
+    let picked = pick_f32([mass[0] + mass[2], mass[1] + mass[3]], xi.x)
+        .and_then(|(dx, ox, wx)| pick_f32([mass[dx], mass[dx + 2]], xi.y).map(|(dy, oy, wy)| (dx, ox, wx, dy, oy, wy)));
     match picked {
         Ok((dx, ox, wx, dy, oy, wy)) => {
             *xi = Vec2::new(clamp_unit_f32(ox / wx), clamp_unit_f32(oy / wy));
@@ -134,14 +172,15 @@ fn in_f64<T>(xi: &mut Vec2, step: impl FnOnce(&mut DVec2) -> Option<T>) -> Optio
 
 impl EnvHierarchy<'_> {
     /// Warps `xi` from the root down to a finest-level texel ∝ importance, in f32: the single
-    /// descent that [`descend_f32`](Self::descend_f32) runs side by side, with the same result.
+    /// descent that [`descend_f32`](Self::descend_f32) runs side by side, with the same result
+    /// (branching where the lanes count, as a descent alone waits on its loads).
     #[inline]
     pub(super) fn warp_down_f32(&self, xi: &mut Vec2) -> Option<Cell> {
         let (mut cell, mut m) = (Cell::ROOT, 0usize);
         while cell.level + 2 <= self.finest {
             let base = level_offset(cell.level + 2) + 16 * m;
             let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().ok()?;
-            let (c, gx, gy) = choose_grandchild_f32(g, xi)?;
+            let (c, gx, gy) = choose_grandchild_f32_branching(g, xi)?;
             (cell, m) = (cell.grandchild(gx, gy), 16 * m + c);
         }
         if cell.level < self.finest {
@@ -177,7 +216,9 @@ impl EnvHierarchy<'_> {
                 let nodes = self.next_nodes_f32(lane);
                 if let Ok(g) = <&[f32; 16]>::try_from(nodes) {
                     match choose_grandchild_f32(g, &mut lane.xi) {
-                        Some((c, gx, gy)) => (lane.cell, lane.morton) = (lane.cell.grandchild(gx, gy), 16 * lane.morton + c),
+                        Some((c, gx, gy)) => {
+                            (lane.cell, lane.morton) = (lane.cell.grandchild(gx, gy), 16 * lane.morton + c)
+                        }
                         None => lane.alive = false,
                     }
                 } else {

@@ -153,7 +153,8 @@ impl Group {
         let keep_i = _mm256_castps_si256(keep);
         self.xi_x = _mm256_blendv_ps(self.xi_x, nx, keep);
         self.xi_y = _mm256_blendv_ps(self.xi_y, ny, keep);
-        self.morton = _mm256_blendv_epi8(self.morton, _mm256_add_epi32(_mm256_slli_epi32::<4>(self.morton), child), keep_i);
+        self.morton =
+            _mm256_blendv_epi8(self.morton, _mm256_add_epi32(_mm256_slli_epi32::<4>(self.morton), child), keep_i);
         self.x = _mm256_blendv_epi8(self.x, _mm256_add_epi32(_mm256_slli_epi32::<2>(self.x), gx), keep_i);
         self.y = _mm256_blendv_epi8(self.y, _mm256_add_epi32(_mm256_slli_epi32::<2>(self.y), gy), keep_i);
         // Lanes without mass die where they are; the others move two levels down.

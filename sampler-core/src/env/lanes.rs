@@ -1,8 +1,9 @@
-//! Env-only descents side by side: many points warped [`IN_FLIGHT`] at a time, branch-free within a
+//! Descents side by side: many points warped [`IN_FLIGHT`] at a time, branch-free within a
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
-//! waiting on its own mispredicted branches (one per level and axis, each a coin flip). The
-//! product's lanes (`product/lanes.rs`) continue below their leaves with the same
-//! [`WarpLane`]s.
+//! waiting on its own mispredicted branches (one per level and axis, each a coin flip).
+//! Env-only draws ([`EnvHierarchy::sample_many`]) descend in f32 (`descent_f32.rs`); the
+//! product's lanes (`product/lanes.rs`) and the two-level product's continue below their leaves
+//! in f64 with the [`WarpLane`]s here.
 
 use super::EnvHierarchy;
 use super::descent_f32::DescentF32;
