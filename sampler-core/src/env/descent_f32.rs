@@ -90,7 +90,7 @@ fn side_f32<const N: usize>(
         prefix[i] = prefix[i - 1] + w[i - 1];
     }
     let total = prefix[N - 1] + w[N - 1];
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return Err(Refusal::Empty);
     }
     if total == f32::INFINITY {
@@ -98,7 +98,7 @@ fn side_f32<const N: usize>(
     }
     let t = x * total;
     let mut i = find(&prefix, t);
-    if !(w[i] > 0.0) {
+    if w[i].is_nan() || w[i] <= 0.0 {
         i = (0..N).rev().find(|&j| w[j] > 0.0).ok_or(Refusal::Empty)?;
     }
     Ok((i, t - prefix[i], w[i]))
