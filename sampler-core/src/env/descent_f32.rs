@@ -1,8 +1,8 @@
 //! Env-only descents in f32: [`choose_grandchild_branchless`]'s two-level step with ξ, the sums
 //! and the rescaling in f32, so that eight descents share an AVX2 register
-//! (`descent_f32_avx2.rs`). This portable step is the reference the register step reproduces
-//! bit for bit: the same operations in the same order, no fused multiply-adds, so images are
-//! the same on every CPU.
+//! (`descent_f32_avx2.rs`) and sixteen an AVX-512 one (`descent_f32_avx512.rs`). This portable
+//! step is the reference the register steps reproduce bit for bit: the same operations in the
+//! same order, no fused multiply-adds, so images are the same on every CPU.
 //!
 //! f32 is enough for env-only sampling, unlike for the product's descents below their leaves:
 //! every rounding moves a boundary between sides by a few ulps of the parent's share of ξ, so
