@@ -2,6 +2,7 @@
 //! texel ∝ importance, then placed uniformly inside it.
 
 use super::EnvHierarchy;
+use super::descent_f32::to_unit_f32;
 use super::pyramid::level_offset;
 use crate::cell::Cell;
 use crate::direction::DirectionSample;
@@ -31,20 +32,21 @@ impl EnvHierarchy<'_> {
         Some(cell)
     }
 
-    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy, or
-    /// through the texel table where one is attached).
+    /// Draws a direction with density ∝ importance (env-only sampling through the hierarchy, in
+    /// f32 as [`sample_many`](Self::sample_many) does, or through the texel table where one is
+    /// attached).
     #[inline]
     pub fn sample(&self, u: DVec2) -> Option<DirectionSample> {
         if self.is_black() {
             return None;
         }
-        let mut xi = u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON));
         if let Some(cdf) = &self.cdf {
-            let (uv, pdf) = cdf.sample_point(xi);
+            let (uv, pdf) = cdf.sample_point(u.clamp(DVec2::ZERO, DVec2::splat(crate::warp::ONE_MINUS_EPSILON)));
             return Some(DirectionSample { dir: self.dir_of(uv), uv, pdf });
         }
-        let texel = self.warp_down(Cell::ROOT, &mut xi)?;
-        Some(self.sample_in_texel(texel, xi))
+        let mut xi = to_unit_f32(u);
+        let texel = self.warp_down_f32(&mut xi)?;
+        Some(self.sample_in_texel(texel, xi.as_dvec2()))
     }
 
     /// The sample at point `xi` of a finest-level texel, with its density.
