@@ -38,32 +38,6 @@ fn detect_avx2() -> bool {
     xcr0 & 0b110 == 0b110 && leaf7.ebx & (1 << 5) != 0
 }
 
-/// Whether AVX-512F instructions may run here: the CPU has them and the OS saves the opmask
-/// and ZMM registers.
-#[cfg(target_arch = "x86_64")]
-#[inline]
-pub(crate) fn has_avx512f() -> bool {
-    use core::sync::atomic::{AtomicU8, Ordering};
-    /// 0: not asked yet; 1: no; 2: yes.
-    static ANSWER: AtomicU8 = AtomicU8::new(0);
-    match ANSWER.load(Ordering::Relaxed) {
-        1 => false,
-        2 => true,
-        _ => {
-            let yes = detect_avx2() && {
-                use core::arch::x86_64::__cpuid_count;
-                // SAFETY: AVX2 was found, so OSXSAVE is set and XGETBV is enabled.
-                let xcr0 = unsafe { xcr0() };
-                #[allow(unused_unsafe)]
-                let leaf7 = unsafe { __cpuid_count(7, 0) };
-                xcr0 & 0b1110_0110 == 0b1110_0110 && leaf7.ebx & (1 << 16) != 0
-            };
-            ANSWER.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
-            yes
-        }
-    }
-}
-
 /// The OS-enabled state components (XCR0).
 ///
 /// # Safety
@@ -81,6 +55,5 @@ mod tests {
     fn agrees_with_std() {
         assert_eq!(super::has_avx2(), std::is_x86_feature_detected!("avx2"));
         assert_eq!(super::has_avx2(), std::is_x86_feature_detected!("avx2"), "the cached answer");
-        assert_eq!(super::has_avx512f(), std::is_x86_feature_detected!("avx512f"));
     }
 }

@@ -1,6 +1,6 @@
 //! Env-only descents in f32: [`choose_grandchild_branchless`]'s two-level step with ξ, the sums
 //! and the rescaling in f32, so that eight descents share an AVX2 register
-//! (`descent_f32_avx2.rs`) and sixteen an AVX-512 one (`descent_f32_avx512.rs`). This portable
+//! (`descent_f32_avx2.rs`). This portable
 //! step is the reference the register steps reproduce bit for bit: the same operations in the
 //! same order, no fused multiply-adds, so images are the same on every CPU.
 //!
@@ -191,18 +191,15 @@ impl EnvHierarchy<'_> {
         Some(cell)
     }
 
-    /// Env-only descents from the root side by side, in f32: sixteen to an AVX-512 register or
-    /// eight to an AVX2 one where the CPU has them, the same bits as the portable lanes. A
-    /// black map's lanes all die.
+    /// Env-only descents from the root side by side, in f32: eight to an AVX2 register where
+    /// the CPU has it, the same bits as the portable lanes. A black map's lanes all die.
     pub(super) fn descend_f32(&self, lanes: &mut [DescentF32]) {
         if self.is_black() {
             lanes.iter_mut().for_each(|l| l.alive = false);
             return;
         }
         #[cfg(target_arch = "x86_64")]
-        if !self.descend_f32_avx512(lanes) {
-            self.descend_f32_avx2(lanes);
-        }
+        self.descend_f32_avx2(lanes);
         self.descend_f32_scalar(lanes);
     }
 

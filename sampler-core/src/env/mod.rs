@@ -14,8 +14,7 @@
 //!
 //! The pyramid's layout and builders are in `pyramid.rs`, the view over it in `hierarchy.rs`,
 //! env-only sampling in `sample.rs` (descending in f32, `descent_f32.rs`, eight to an AVX2
-//! register in `descent_f32_avx2.rs`, sixteen to an AVX-512 one in `descent_f32_avx512.rs`, where
-//! the CPU has them), the f64 descents the product
+//! register in `descent_f32_avx2.rs` where the CPU has it), the f64 descents the product
 //! samplers continue below their leaves side by side in `lanes.rs` (four to an AVX2 register in
 //! `lanes_avx2.rs`); with a
 //! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent. MIS with BRDF
@@ -25,8 +24,6 @@ mod compensation;
 mod descent_f32;
 #[cfg(target_arch = "x86_64")]
 mod descent_f32_avx2;
-#[cfg(target_arch = "x86_64")]
-mod descent_f32_avx512;
 mod frame;
 mod hierarchy;
 mod lanes;
