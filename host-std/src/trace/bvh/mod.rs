@@ -74,7 +74,7 @@ pub struct ShadowRay {
 /// The scene's primitives and their hierarchy.
 pub struct Bvh {
     prims: Vec<Primitive>,
-    nodes: Vec<wide::Node4>,
+    nodes: Vec<wide::WideNode>,
     /// The leaves' primitives, four to a block.
     blocks: Vec<leaf::Block>,
     /// Per-corner shading normals and texture coordinates of triangles that have them.

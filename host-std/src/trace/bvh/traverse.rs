@@ -1,60 +1,79 @@
-//! Traversal of the four-wide nodes with a fixed stack: closest hit visits the children a ray
+//! Traversal of the eight-wide nodes with a fixed stack: closest hit visits the children a ray
 //! meets nearest first and skips those that start beyond the best hit so far; occlusion tests
 //! leaf children as soon as their box is met and stops at the first blocker.
 
-use super::wide::{LEAF, Node4, RayLanes};
+use super::wide::{LEAF, RayLanes, WIDTH, WideNode};
 use sampler_core::glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Stack entries: a node descends at most one binary level per wide level, the binary build
-/// bounds its depth (median splits past depth 40), and each level leaves at most three
+/// bounds its depth (median splits past depth 40), and each level leaves at most seven
 /// entries behind.
-const STACK: usize = 256;
+const STACK: usize = 512;
 
 /// Visits the primitives of every leaf whose box the ray meets within `t_max`, nearest box
 /// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`.
 #[inline(always)]
-pub(super) fn closest(nodes: &[Node4], o: Vec3, d: Vec3, t_max: &mut f32, mut visit: impl FnMut(u32, u32, &mut f32)) {
+pub(super) fn closest(
+    nodes: &[WideNode],
+    o: Vec3,
+    d: Vec3,
+    t_max: &mut f32,
+    mut visit: impl FnMut(u32, u32, &mut f32),
+) {
     if nodes.is_empty() {
         return;
     }
     let ray = RayLanes::new(o, d);
     // Left uninitialised: zeroing the stack per ray is a noticeable share of simple scenes.
     let mut stack = [const { MaybeUninit::<(u32, u32, f32)>::uninit() }; STACK];
-    stack[0].write((0, 0, 0.0));
-    let mut sp = 1;
-    while sp > 0 {
-        sp -= 1;
-        // SAFETY: entries below `sp` were all written (the root above, children below).
-        let (child, count, entry) = unsafe { stack[sp].assume_init() };
-        if entry > *t_max {
-            continue;
-        }
+    let mut sp = 0;
+    let mut current = (0, 0);
+    loop {
+        let (child, count) = current;
         if child & LEAF != 0 {
             visit(child & !LEAF, count, t_max);
-            continue;
-        }
-        let node = &nodes[child as usize];
-        let (mut mask, near) = node.hit(&ray, *t_max);
-        // Pushed farthest first so that the nearest is popped next.
-        let mut order = [(0u32, 0u32, 0.0f32); 4];
-        let mut n = 0;
-        while mask != 0 {
-            let k = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            let item = (node.child[k], node.count[k], near[k]);
-            let mut j = n;
-            while j > 0 && order[j - 1].2 < item.2 {
-                order[j] = order[j - 1];
-                j -= 1;
+        } else {
+            let node = &nodes[child as usize];
+            let (mut mask, near) = node.hit(&ray, *t_max);
+            // Sorted farthest first: all but the nearest are pushed in that order, and the
+            // nearest is visited next without a trip through the stack.
+            let mut order = [(0u32, 0u32, 0.0f32); WIDTH];
+            let mut n = 0;
+            while mask != 0 {
+                let k = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let item = (node.child[k], node.count[k], near[k]);
+                let mut j = n;
+                while j > 0 && order[j - 1].2 < item.2 {
+                    order[j] = order[j - 1];
+                    j -= 1;
+                }
+                order[j] = item;
+                n += 1;
             }
-            order[j] = item;
-            n += 1;
+            if n > 0 {
+                debug_assert!(sp + n - 1 <= STACK);
+                for item in &order[..n - 1] {
+                    stack[sp].write(*item);
+                    sp += 1;
+                }
+                current = (order[n - 1].0, order[n - 1].1);
+                continue;
+            }
         }
-        debug_assert!(sp + n <= STACK);
-        for item in &order[..n] {
-            stack[sp].write(*item);
-            sp += 1;
+        // The nearest entry left that starts within the best hit so far.
+        loop {
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            // SAFETY: entries below `sp` were all written.
+            let (child, count, entry) = unsafe { stack[sp].assume_init() };
+            if entry <= *t_max {
+                current = (child, count);
+                break;
+            }
         }
     }
 }
@@ -62,20 +81,19 @@ pub(super) fn closest(nodes: &[Node4], o: Vec3, d: Vec3, t_max: &mut f32, mut vi
 /// True when `test(first, count)` finds a blocker in a leaf whose box the ray meets within
 /// `t_max`.
 #[inline(always)]
-pub(super) fn any(nodes: &[Node4], o: Vec3, d: Vec3, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
+pub(super) fn any(nodes: &[WideNode], o: Vec3, d: Vec3, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
     if nodes.is_empty() {
         return false;
     }
     let ray = RayLanes::new(o, d);
     let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
-    stack[0].write(0);
-    let mut sp = 1;
-    while sp > 0 {
-        sp -= 1;
-        // SAFETY: as in `closest`.
-        let index = unsafe { stack[sp].assume_init() };
+    let mut sp = 0;
+    let mut index = 0;
+    loop {
         let node = &nodes[index as usize];
         let (mut mask, _) = node.hit(&ray, t_max);
+        // The first inner child met is visited next without a trip through the stack.
+        let mut next = None;
         while mask != 0 {
             let k = mask.trailing_zeros() as usize;
             mask &= mask - 1;
@@ -84,12 +102,22 @@ pub(super) fn any(nodes: &[Node4], o: Vec3, d: Vec3, t_max: f32, mut test: impl 
                 if test(child & !LEAF, node.count[k]) {
                     return true;
                 }
+            } else if next.is_none() {
+                next = Some(child);
             } else {
                 debug_assert!(sp < STACK);
                 stack[sp].write(child);
                 sp += 1;
             }
         }
+        index = match next {
+            Some(child) => child,
+            None if sp > 0 => {
+                sp -= 1;
+                // SAFETY: entries below `sp` were all written.
+                unsafe { stack[sp].assume_init() }
+            }
+            None => return false,
+        };
     }
-    false
 }

@@ -1,9 +1,11 @@
-//! The four-wide hierarchy that rays traverse: each node holds its four children's boxes as
-//! structure of arrays (one four-lane row per box plane), so one ray tests all four in a few
-//! SIMD operations ([`super::lanes::F4`]). It is collapsed from the binary SAH tree
+//! The eight-wide hierarchy that rays traverse: each node holds its eight children's boxes as
+//! structure of arrays (one eight-lane row per box plane), so one ray tests all eight in two
+//! halves of four SIMD lanes ([`super::lanes::F4`]). It is collapsed from the binary SAH tree
 //! (`build.rs`): a node takes its binary children and keeps opening the largest inner one
-//! until it has four, so the boxes are the binary tree's boxes and only the levels between
-//! them go.
+//! until it has eight, so the boxes are the binary tree's boxes and only the levels between
+//! them go. Eight children make the tree half as deep as four do, so a ray pops, loads and
+//! branches over fewer nodes, and the box tests of a node's two halves run back to back
+//! without a dependency between them.
 
 use super::lanes::F4;
 use super::leaf::Block;
@@ -15,16 +17,19 @@ pub(super) const LEAF: u32 = 1 << 31;
 /// A lane with no child (its box is empty, so no ray enters it).
 const EMPTY: u32 = u32::MAX;
 
-/// Four children's boxes and links.
+/// Children per node.
+pub(super) const WIDTH: usize = 8;
+
+/// Eight children's boxes and links: four cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node4 {
+pub(super) struct WideNode {
     /// Rows min x, max x, min y, max y, min z, max z; lane k is child k.
-    planes: [[f32; 4]; 6],
+    planes: [[f32; WIDTH]; 6],
     /// An inner child's node index, or `LEAF | first block`, or `EMPTY`.
-    pub(super) child: [u32; 4],
+    pub(super) child: [u32; WIDTH],
     /// A leaf child's number of blocks (0 for the others).
-    pub(super) count: [u32; 4],
+    pub(super) count: [u32; WIDTH],
 }
 
 /// A ray prepared for box tests: origin and reciprocal direction in all lanes, and per axis
@@ -46,17 +51,29 @@ impl RayLanes {
     }
 }
 
-impl Node4 {
+impl WideNode {
     /// Which children's boxes the ray meets within [0, t_max] (bit k for child k) and the
     /// entry distance of each. NaN slab distances (a ray in a box's plane) leave the interval
     /// as it is, so such boxes count as met.
     #[inline(always)]
-    pub(super) fn hit(&self, r: &RayLanes, t_max: f32) -> (u32, [f32; 4]) {
+    pub(super) fn hit(&self, r: &RayLanes, t_max: f32) -> (u32, [f32; WIDTH]) {
+        let (low, near_low) = self.hit_half(r, t_max, 0);
+        let (high, near_high) = self.hit_half(r, t_max, 4);
+        let mut near = [0.0; WIDTH];
+        near[..4].copy_from_slice(&near_low);
+        near[4..].copy_from_slice(&near_high);
+        (low | high << 4, near)
+    }
+
+    /// [`WideNode::hit`] for the four children from `first`.
+    #[inline(always)]
+    fn hit_half(&self, r: &RayLanes, t_max: f32, first: usize) -> (u32, [f32; 4]) {
+        let row = |plane: usize| -> &[f32; 4] { self.planes[plane][first..first + 4].try_into().unwrap() };
         let mut near = F4::splat(0.0);
         let mut far = F4::splat(t_max);
         for axis in 0..3 {
-            let lo = F4::load(&self.planes[2 * axis + r.near[axis]]);
-            let hi = F4::load(&self.planes[2 * axis + 1 - r.near[axis]]);
+            let lo = F4::load(row(2 * axis + r.near[axis]));
+            let hi = F4::load(row(2 * axis + 1 - r.near[axis]));
             near = lo.sub(r.o[axis]).mul(r.inv[axis]).max_or(near);
             far = hi.sub(r.o[axis]).mul(r.inv[axis]).min_or(far);
         }
@@ -66,7 +83,7 @@ impl Node4 {
 
 /// The blocks (first, count) of the one leaf that is the whole tree, if it is: a ray then
 /// tests them without the root's box test, whose answer the primitive tests decide anyway.
-pub(super) fn lone_leaf(nodes: &[Node4]) -> Option<(u32, u32)> {
+pub(super) fn lone_leaf(nodes: &[WideNode]) -> Option<(u32, u32)> {
     match nodes {
         [root] if root.child[0] & LEAF != 0 && root.child[1..].iter().all(|&c| c == EMPTY) => {
             Some((root.child[0] & !LEAF, root.count[0]))
@@ -75,10 +92,10 @@ pub(super) fn lone_leaf(nodes: &[Node4]) -> Option<(u32, u32)> {
     }
 }
 
-/// The four-wide nodes over the binary tree `bin` of `prims` (root first, then each subtree
+/// The eight-wide nodes over the binary tree `bin` of `prims` (root first, then each subtree
 /// depth first), and the blocks of its leaves.
-pub(super) fn collapse(bin: &[Node], prims: &[Primitive]) -> (Vec<Node4>, Vec<Block>) {
-    let mut tree = Tree { bin, prims, nodes: Vec::with_capacity(bin.len() / 2 + 1), blocks: Vec::new() };
+pub(super) fn collapse(bin: &[Node], prims: &[Primitive]) -> (Vec<WideNode>, Vec<Block>) {
+    let mut tree = Tree { bin, prims, nodes: Vec::with_capacity(bin.len() / 4 + 1), blocks: Vec::new() };
     if !bin.is_empty() {
         tree.emit(0);
     }
@@ -89,20 +106,20 @@ pub(super) fn collapse(bin: &[Node], prims: &[Primitive]) -> (Vec<Node4>, Vec<Bl
 struct Tree<'a> {
     bin: &'a [Node],
     prims: &'a [Primitive],
-    nodes: Vec<Node4>,
+    nodes: Vec<WideNode>,
     blocks: Vec<Block>,
 }
 
 impl Tree<'_> {
     /// Appends the node whose children are the binary node `index`'s (or the leaf `index`
-    /// alone), opened up to four, and their subtrees; returns its index.
+    /// alone), opened up to eight, and their subtrees; returns its index.
     fn emit(&mut self, index: usize) -> u32 {
         let children = open(self.bin, index);
         let me = self.nodes.len();
         let empty = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
-        let mut node = Node4 { planes: [[0.0; 4]; 6], child: [EMPTY; 4], count: [0; 4] };
+        let mut node = WideNode { planes: [[0.0; WIDTH]; 6], child: [EMPTY; WIDTH], count: [0; WIDTH] };
         self.nodes.push(node);
-        for k in 0..4 {
+        for k in 0..WIDTH {
             let b = children.get(k).map_or(empty, |&c| self.bin[c].bounds);
             for axis in 0..3 {
                 node.planes[2 * axis][k] = b.min[axis];
@@ -126,7 +143,7 @@ impl Tree<'_> {
 }
 
 /// The binary nodes that become one wide node's children: the binary node's two children,
-/// the inner one of largest surface area replaced by its two until there are four (or only
+/// the inner one of largest surface area replaced by its two until there are eight (or only
 /// leaves), in depth-first order.
 fn open(bin: &[Node], index: usize) -> Vec<usize> {
     let node = bin[index];
@@ -134,7 +151,7 @@ fn open(bin: &[Node], index: usize) -> Vec<usize> {
         return vec![index];
     }
     let mut children = vec![index + 1, node.offset as usize];
-    while children.len() < 4 {
+    while children.len() < WIDTH {
         let widest = (0..children.len())
             .filter(|&k| bin[children[k]].count == 0)
             .max_by(|&a, &b| bin[children[a]].bounds.area().total_cmp(&bin[children[b]].bounds.area()));
