@@ -10,7 +10,7 @@ use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
 use sampler_core::estimator::{BATCH, ShadingPoint};
-use sampler_core::glam::{DVec3, Vec3};
+use sampler_core::glam::{DVec2, DVec3, Vec3};
 use sampler_core::points::Sobol02;
 use sampler_core::rng::hash_combine;
 
@@ -118,33 +118,29 @@ pub(crate) fn shade_wavefront(
             Weighting::Split { sampler, brdf }
         }
     };
-    buffers.samples.clear();
     // A pixel's shading points share its sequences, each taking its own run of them.
     let seed = runs.first().map_or(0, |r| r.seed);
     debug_assert!(runs.iter().all(|r| r.seed == seed), "a wavefront is one pixel's");
     let sequences = (Sobol02::new(hash_combine(seed, 1)), Sobol02::new(hash_combine(seed, 2)));
-    for (point, run) in runs.iter().enumerate() {
-        push_samples(layout, point, run.block, sequences, &mut buffers.samples);
+    let per_point = layout.len();
+    let total = per_point * runs.len();
+    // The buffers only grow: every entry up to `total` is overwritten below.
+    let unused = WaveSample { point: 0, technique: Technique::Sampler, u: DVec2::ZERO };
+    let samples = at_least(&mut buffers.samples, total, unused);
+    for (point, (run, s)) in runs.iter().zip(samples.chunks_exact_mut(per_point)).enumerate() {
+        write_samples(layout, point, run.block, sequences, s);
     }
-    buffers.candidates.clear();
-    buffers.candidates.resize(buffers.samples.len(), Candidate::default());
+    let candidates = at_least(&mut buffers.candidates, total, Candidate::default());
     match sampling {
-        Sampling::ProductMis { sampler, .. } => {
-            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
-        }
-        Sampling::Mis { sampler, .. } => {
-            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
-        }
-        Sampling::TwoLevelMis { sampler, .. } => {
-            wavefront(sampler, points, &buffers.samples, weighting, &mut buffers.candidates)
-        }
-        _ => wavefront(env, points, &buffers.samples, weighting, &mut buffers.candidates),
+        Sampling::ProductMis { sampler, .. } => wavefront(sampler, points, samples, weighting, candidates),
+        Sampling::Mis { sampler, .. } => wavefront(sampler, points, samples, weighting, candidates),
+        Sampling::TwoLevelMis { sampler, .. } => wavefront(sampler, points, samples, weighting, candidates),
+        _ => wavefront(env, points, samples, weighting, candidates),
     }
     // Each shadow ray as its sample is summed: a ray's answer is used where it is found, and
     // no list of rays and answers is written and read back.
     let mut rays = 0;
-    let per_point = layout.len();
-    for (k, (candidates, o)) in buffers.candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
+    for (k, (candidates, o)) in candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
         let mut value = |c: &Candidate| {
             if !c.needs_ray {
                 return DVec3::ZERO;
@@ -157,29 +153,47 @@ pub(crate) fn shade_wavefront(
     Some(rays)
 }
 
-/// A shading point's samples in the order its estimate sums them, from its `block` of the
-/// pixel's sequences for each technique (the same points [`shade::shade`] draws).
-fn push_samples(
+/// The first `n` entries of `buffer`, grown to hold them (with `fill`) if it is shorter.
+fn at_least<T: Copy>(buffer: &mut Vec<T>, n: usize, fill: T) -> &mut [T] {
+    if buffer.len() < n {
+        buffer.resize(n, fill);
+    }
+    &mut buffer[..n]
+}
+
+/// A shading point's samples into `out` (its [`Layout::len`] entries) in the order its
+/// estimate sums them, from its `block` of the pixel's sequences for each technique (the same
+/// points [`shade::shade`] draws).
+fn write_samples(
     layout: Layout,
     point: usize,
     block: usize,
     (first_seq, brdf_seq): (Sobol02, Sobol02),
-    samples: &mut Vec<WaveSample>,
+    out: &mut [WaveSample],
 ) {
-    let mut push = |technique, u| samples.push(WaveSample { point, technique, u });
+    let sample = |technique, u| WaveSample { point, technique, u };
     match layout {
         Layout::Single { technique, n } => {
-            first_seq.points((block * n) as u32).take(n).for_each(|u| push(technique, u));
+            for (o, u) in out.iter_mut().zip(first_seq.points((block * n) as u32)) {
+                *o = sample(technique, u);
+            }
         }
         Layout::Pairs { n } => {
-            for (u, v) in first_seq.points((block * n) as u32).zip(brdf_seq.points((block * n) as u32)).take(n) {
-                push(Technique::Sampler, u);
-                push(Technique::Brdf, v);
+            let first = (block * n) as u32;
+            let points = first_seq.points(first).zip(brdf_seq.points(first));
+            for (o, (u, v)) in out.chunks_exact_mut(2).zip(points) {
+                o[0] = sample(Technique::Sampler, u);
+                o[1] = sample(Technique::Brdf, v);
             }
         }
         Layout::Split { first, brdf } => {
-            first_seq.points((block * first) as u32).take(first).for_each(|u| push(Technique::Sampler, u));
-            brdf_seq.points((block * brdf) as u32).take(brdf).for_each(|u| push(Technique::Brdf, u));
+            let (sampled, brdfs) = out.split_at_mut(first);
+            for (o, u) in sampled.iter_mut().zip(first_seq.points((block * first) as u32)) {
+                *o = sample(Technique::Sampler, u);
+            }
+            for (o, u) in brdfs.iter_mut().zip(brdf_seq.points((block * brdf) as u32)) {
+                *o = sample(Technique::Brdf, u);
+            }
         }
     }
 }

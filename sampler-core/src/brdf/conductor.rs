@@ -95,6 +95,10 @@ impl Brdf for RoughConductor {
         self.sample_x4(wo, u, out);
     }
 
+    fn sample_many_views(&self, wo: &[Vec3], u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        self.sample_views_x4(wo, u, out);
+    }
+
     fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
         self.eval_pdf_many_x4(wo, wi, out);
     }

@@ -33,9 +33,19 @@ impl Dir4 {
         Vec3::new(self.x.to_array()[k], self.y.to_array()[k], self.z.to_array()[k])
     }
 
+    /// The same direction in every lane.
+    pub(super) fn splat(v: Vec3) -> Self {
+        Self { x: Vec4::splat(v.x), y: Vec4::splat(v.y), z: Vec4::splat(v.z) }
+    }
+
     /// `a · self` per lane, as `Vec3::dot` orders it.
     pub(super) fn dot(&self, a: Vec3) -> Vec4 {
-        Vec4::splat(a.x) * self.x + Vec4::splat(a.y) * self.y + Vec4::splat(a.z) * self.z
+        self.dot_lanes(&Self::splat(a))
+    }
+
+    /// `a · self` per lane with a lane's own `a`, as `Vec3::dot` orders it.
+    pub(super) fn dot_lanes(&self, a: &Self) -> Vec4 {
+        a.x * self.x + a.y * self.y + a.z * self.z
     }
 
     pub(super) fn length_squared(&self) -> Vec4 {
@@ -46,16 +56,17 @@ impl Dir4 {
 impl Ggx {
     /// [`Ggx::sample_visible_stretched`] for four points.
     pub(super) fn sample_visible_stretched_x4(&self, w: Vec3, ux: Vec4, uy: Vec4) -> Dir4 {
+        self.sample_visible_stretched_lanes(&Dir4::splat(w), ux, uy)
+    }
+
+    /// [`Ggx::sample_visible_stretched`] for four points, each lane with its own view `w`.
+    pub(super) fn sample_visible_stretched_lanes(&self, w: &Dir4, ux: Vec4, uy: Vec4) -> Dir4 {
         let one = Vec4::ONE;
         let a = Vec4::splat(self.alpha());
         let (sin_phi, cos_phi) = sin_cos_2pi_x4(ux);
-        let z = (one - uy) * Vec4::splat(1.0 + w.z) - Vec4::splat(w.z);
+        let z = (one - uy) * (one + w.z) - w.z;
         let sin_theta = sqrt4((one - z * z).max(Vec4::ZERO).min(one));
-        let h = Dir4 {
-            x: sin_theta * cos_phi + Vec4::splat(w.x),
-            y: sin_theta * sin_phi + Vec4::splat(w.y),
-            z: z + Vec4::splat(w.z),
-        };
+        let h = Dir4 { x: sin_theta * cos_phi + w.x, y: sin_theta * sin_phi + w.y, z: z + w.z };
         let m = Dir4 { x: h.x * a, y: h.y * a, z: h.z.max(Vec4::ZERO) };
         let len2 = m.length_squared();
         let ok = len2.cmpgt(Vec4::ZERO) & len2.is_finite_mask();
@@ -88,19 +99,25 @@ impl RoughConductor {
     /// [`Brdf::eval_pdf`](super::Brdf::eval_pdf) for four directions (`wo.z > 0`, `g1_o` = G1(ωo)):
     /// the scalar factor of BRDF × cos (times `specular`) and the density, per lane.
     fn eval_pdf_x4(&self, wo: Vec3, g1_o: f32, wi: &Dir4) -> (Vec4, Vec4) {
+        self.eval_pdf_lanes(&Dir4::splat(wo), Vec4::splat(g1_o), wi)
+    }
+
+    /// [`Self::eval_pdf_x4`] with each lane's own view `wo` (`wo.z > 0` in the lanes that
+    /// count) and its `g1_o`.
+    fn eval_pdf_lanes(&self, wo: &Dir4, g1_o: Vec4, wi: &Dir4) -> (Vec4, Vec4) {
         let g = &self.ggx;
         // The half vector, where it exists.
-        let s = Dir4 { x: Vec4::splat(wo.x) + wi.x, y: Vec4::splat(wo.y) + wi.y, z: Vec4::splat(wo.z) + wi.z };
+        let s = Dir4 { x: wo.x + wi.x, y: wo.y + wi.y, z: wo.z + wi.z };
         let len2 = s.length_squared();
         let exists = len2.cmpgt(Vec4::splat(1e-24)) & len2.is_finite_mask();
         let len = sqrt4(len2);
         let h = Dir4 { x: s.x / len, y: s.y / len, z: s.z / len };
         let d = g.d_x4(&h);
-        let (g1_o, four_cos_o) = (Vec4::splat(g1_o), Vec4::splat(4.0 * wo.z));
+        let four_cos_o = Vec4::splat(4.0) * wo.z;
         let value = d * g.g1_x4(wi) * g1_o / four_cos_o;
         let pdf = g1_o * d / four_cos_o;
         let value = Vec4::select(exists & wi.z.cmpgt(Vec4::ZERO), value, Vec4::ZERO);
-        let pdf = Vec4::select(exists & h.dot(wo).cmpgt(Vec4::ZERO), pdf, Vec4::ZERO);
+        let pdf = Vec4::select(exists & h.dot_lanes(wo).cmpgt(Vec4::ZERO), pdf, Vec4::ZERO);
         (value, pdf)
     }
 
@@ -133,26 +150,55 @@ impl RoughConductor {
         }
         let g = &self.ggx;
         // Per view, once.
-        let (w, g1_o) = (g.stretch(wo), g.g1(wo));
+        let (wo4, w, g1_o) = (Dir4::splat(wo), Dir4::splat(g.stretch(wo)), Vec4::splat(g.g1(wo)));
         for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
-            let at = |k: usize| us.get(k).copied().unwrap_or(Vec2::ZERO);
-            let (ux, uy) =
-                (Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x), Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y));
-            let m = g.sample_visible_stretched_x4(w, ux, uy);
-            // wi = reflect(wo, m), normalised as `Vec3::normalize` does (times 1/length).
-            let two_dot = Vec4::splat(2.0) * m.dot(wo);
-            let r = Dir4 {
-                x: two_dot * m.x - Vec4::splat(wo.x),
-                y: two_dot * m.y - Vec4::splat(wo.y),
-                z: two_dot * m.z - Vec4::splat(wo.z),
-            };
-            let recip = Vec4::ONE / sqrt4(r.length_squared());
-            let wi = Dir4 { x: r.x * recip, y: r.y * recip, z: r.z * recip };
-            let (value, pdf) = self.eval_pdf_x4(wo, g1_o, &wi);
-            let keep: [bool; 4] = (pdf.cmpgt(Vec4::ZERO) & pdf.is_finite_mask()).into();
-            for (k, o) in os.iter_mut().take(us.len()).enumerate() {
-                *o = keep[k].then(|| BrdfSample { wi: wi.lane(k), value: self.specular * value[k], pdf: pdf[k] });
-            }
+            self.draws_lanes(&wo4, &w, g1_o, us, [false; 4], os);
+        }
+    }
+
+    /// [`Brdf::sample_many_views`](super::Brdf::sample_many_views): `out[k]` from `u[k]` seen
+    /// from `wo[k]`, four at a time whatever the views.
+    pub(crate) fn sample_views_x4(&self, wo: &[Vec3], u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        let g = &self.ggx;
+        for ((ws, us), os) in wo.chunks(4).zip(u.chunks(4)).zip(out.chunks_mut(4)) {
+            let view = |k: usize| ws.get(k).copied().unwrap_or(Vec3::Z);
+            let lanes = |f: &dyn Fn(Vec3) -> f32| Vec4::from_array(core::array::from_fn(|k| f(view(k))));
+            let wo4 = Dir4::gather(ws);
+            let w = Dir4::gather(&core::array::from_fn::<_, 4, _>(|k| g.stretch(view(k))));
+            let g1_o = lanes(&|v| g.g1(v));
+            let below = core::array::from_fn(|k| ws.get(k).is_none_or(|v| v.z <= 0.0));
+            self.draws_lanes(&wo4, &w, g1_o, &us[..us.len().min(ws.len())], below, os);
+        }
+    }
+
+    /// Up to four draws into `out` (lane k `None` where `below[k]`), lane k seen from `wo`'s
+    /// lane k, its stretched view `w` and G1 `g1_o`.
+    #[inline]
+    fn draws_lanes(
+        &self,
+        wo: &Dir4,
+        w: &Dir4,
+        g1_o: Vec4,
+        us: &[Vec2],
+        below: [bool; 4],
+        out: &mut [Option<BrdfSample>],
+    ) {
+        let at = |k: usize| us.get(k).copied().unwrap_or(Vec2::ZERO);
+        let (ux, uy) = (Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x), Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y));
+        let m = self.ggx.sample_visible_stretched_lanes(w, ux, uy);
+        // wi = reflect(wo, m), normalised as `Vec3::normalize` does (times 1/length).
+        let two_dot = Vec4::splat(2.0) * m.dot_lanes(wo);
+        let r = Dir4 { x: two_dot * m.x - wo.x, y: two_dot * m.y - wo.y, z: two_dot * m.z - wo.z };
+        let recip = Vec4::ONE / sqrt4(r.length_squared());
+        let wi = Dir4 { x: r.x * recip, y: r.y * recip, z: r.z * recip };
+        let (value, pdf) = self.eval_pdf_lanes(wo, g1_o, &wi);
+        let keep: [bool; 4] = (pdf.cmpgt(Vec4::ZERO) & pdf.is_finite_mask()).into();
+        for (k, o) in out.iter_mut().take(us.len()).enumerate() {
+            *o = (!below[k] && keep[k]).then(|| BrdfSample {
+                wi: wi.lane(k),
+                value: self.specular * value[k],
+                pdf: pdf[k],
+            });
         }
     }
 

@@ -20,6 +20,22 @@ impl Lambert {
     pub fn new(albedo: Vec3) -> Self {
         Self { albedo }
     }
+
+    /// [`Brdf::sample`] of up to four points at once into `out` (lane j `None` where
+    /// `below[j]`: its view is below the surface): the warp's bits are the scalar ones
+    /// (`square_to_cosine_hemisphere_x4`), and the density and value are `sample`'s products.
+    #[inline]
+    fn draws_x4(&self, us: &[Vec2], below: [bool; 4], out: &mut [Option<BrdfSample>]) {
+        let [x, y, z] = square_to_cosine_hemisphere_x4(lanes(us, |p| p.x), lanes(us, |p| p.y));
+        let pdf = z * Vec4::splat(FRAC_1_PI);
+        for (j, o) in out.iter_mut().take(us.len()).enumerate() {
+            *o = (!below[j] && pdf[j] > 0.0).then(|| BrdfSample {
+                wi: Vec3::new(x[j], y[j], z[j]),
+                value: self.albedo * pdf[j],
+                pdf: pdf[j],
+            });
+        }
+    }
 }
 
 impl Brdf for Lambert {
@@ -43,6 +59,23 @@ impl Brdf for Lambert {
         if wo.z <= 0.0 { 0.0 } else { square_to_cosine_hemisphere_pdf(wi) }
     }
 
+    fn sample_many(&self, wo: Vec3, u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        if wo.z <= 0.0 {
+            out.iter_mut().zip(u).for_each(|(o, _)| *o = None);
+            return;
+        }
+        for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
+            self.draws_x4(us, [false; 4], os);
+        }
+    }
+
+    fn sample_many_views(&self, wo: &[Vec3], u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        for ((ws, us), os) in wo.chunks(4).zip(u.chunks(4)).zip(out.chunks_mut(4)) {
+            let below = core::array::from_fn(|j| ws.get(j).is_none_or(|w| w.z <= 0.0));
+            self.draws_x4(&us[..us.len().min(ws.len())], below, os);
+        }
+    }
+
     fn sample_batch(&self, wo: Vec3, u: &[Vec2], out: &mut [BrdfDraw]) -> usize {
         if wo.z <= 0.0 {
             return 0;
@@ -50,10 +83,7 @@ impl Brdf for Lambert {
         // Four at a time: the same bits as one by one (`square_to_cosine_hemisphere_x4`).
         let scale = Vec4::splat(luminance(self.albedo) * FRAC_1_PI);
         for (us, os) in u.chunks(4).zip(out.chunks_mut(4)) {
-            let at = |j: usize| us.get(j).copied().unwrap_or(Vec2::ZERO);
-            let (ux, uy) =
-                (Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x), Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y));
-            let [x, y, z] = square_to_cosine_hemisphere_x4(ux, uy);
+            let [x, y, z] = square_to_cosine_hemisphere_x4(lanes(us, |p| p.x), lanes(us, |p| p.y));
             let value = scale * z.max(Vec4::ZERO);
             for (j, o) in os.iter_mut().take(us.len()).enumerate() {
                 *o = BrdfDraw { wi: Vec3::new(x[j], y[j], z[j]), value: value[j] };
@@ -80,4 +110,11 @@ impl Brdf for Lambert {
     fn reflectance_bound(&self, wo: Vec3) -> Option<f32> {
         Some(if wo.z > 0.0 { luminance(self.albedo) } else { 0.0 })
     }
+}
+
+/// One coordinate of up to four points in lanes, the missing lanes zero.
+#[inline]
+fn lanes(us: &[Vec2], coordinate: impl Fn(Vec2) -> f32) -> Vec4 {
+    let at = |j: usize| us.get(j).map_or(0.0, |p| coordinate(*p));
+    Vec4::new(at(0), at(1), at(2), at(3))
 }

@@ -70,6 +70,22 @@ pub trait Brdf {
         }
     }
 
+    /// [`Brdf::sample`] of each point of `u` seen from its own view (`out[k]` from `wo[k]` and
+    /// `u[k]`, as many as all three hold), bit for bit: the draws of many shading points of one
+    /// BRDF at once. Implementations may draw across views (Lambert: four lanes); the default
+    /// hands each run of equal views to [`Brdf::sample_many`].
+    fn sample_many_views(&self, wo: &[Vec3], u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        let n = wo.len().min(u.len()).min(out.len());
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        let mut start = 0;
+        while start < n {
+            let view = bits(wo[start]);
+            let end = start + 1 + wo[start + 1..n].iter().take_while(|w| bits(**w) == view).count();
+            self.sample_many(wo[start], &u[start..end], &mut out[start..end]);
+            start = end;
+        }
+    }
+
     /// [`Brdf::eval_pdf`] for every direction of `wi` (as many as both hold), bit for bit.
     fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
         for (o, w) in out.iter_mut().zip(wi) {
@@ -156,6 +172,9 @@ impl<B: Brdf + ?Sized> Brdf for &B {
     }
     fn sample_many(&self, wo: Vec3, u: &[Vec2], out: &mut [Option<BrdfSample>]) {
         (**self).sample_many(wo, u, out)
+    }
+    fn sample_many_views(&self, wo: &[Vec3], u: &[Vec2], out: &mut [Option<BrdfSample>]) {
+        (**self).sample_many_views(wo, u, out)
     }
     fn eval_pdf_many(&self, wo: Vec3, wi: &[Vec3], out: &mut [(Vec3, f32)]) {
         (**self).eval_pdf_many(wo, wi, out)

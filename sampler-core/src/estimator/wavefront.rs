@@ -111,26 +111,43 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
 ) {
     let n = samples.len().min(WAVE);
     let env = sampler.env();
+    // Each technique's samples in order, split in one pass.
+    let (mut u_brdf, mut brdf_points, mut n_brdf) = ([Vec2::ZERO; WAVE], [0usize; WAVE], 0);
+    let (mut u_sampler, mut sampler_points, mut n_sampler) = ([DVec2::ZERO; WAVE], [0usize; WAVE], 0);
+    for s in &samples[..n] {
+        if s.technique == Technique::Brdf {
+            (u_brdf[n_brdf], brdf_points[n_brdf]) = (s.u.as_vec2(), s.point);
+            n_brdf += 1;
+        } else {
+            (u_sampler[n_sampler], sampler_points[n_sampler]) = (s.u, s.point);
+            n_sampler += 1;
+        }
+    }
     // The BRDF's draws first, each at its own shading point, and their points of the square:
     // the texels they read (radiance, the sampler's density) are asked for now and arrive
     // while the sampler's descents below run.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
     let mut dirs = [Vec3::Z; WAVE];
-    let mut u_brdf = [Vec2::ZERO; WAVE];
-    let mut brdf_points = [0usize; WAVE];
-    let mut n_brdf = 0;
-    for s in samples.iter().filter(|s| s.technique == Technique::Brdf) {
-        (u_brdf[n_brdf], brdf_points[n_brdf]) = (s.u.as_vec2(), s.point);
-        n_brdf += 1;
-    }
-    // Each shading point's draws in one call: the BRDF's per-view work is done once per point.
-    for run in point_runs(&brdf_points[..n_brdf]) {
-        let sp = &points[brdf_points[run.start]];
-        sp.brdf.sample_many(sp.frame.to_local(sp.wo), &u_brdf[run.clone()], &mut brdf[run.clone()]);
-        for (d, b) in dirs[run.clone()].iter_mut().zip(&brdf[run]) {
-            if let Some(b) = b {
-                *d = sp.frame.to_world(b.wi);
+    // Each sample's view in its point's frame, found once per point.
+    let mut views = [Vec3::Z; WAVE];
+    for k in 0..n_brdf {
+        views[k] = match k.checked_sub(1) {
+            Some(j) if brdf_points[j] == brdf_points[k] => views[j],
+            _ => {
+                let sp = &points[brdf_points[k]];
+                sp.frame.to_local(sp.wo)
             }
+        };
+    }
+    // The draws of the points that share one BRDF in one call: it may draw across them.
+    let same_brdf = |a: usize, b: usize| core::ptr::addr_eq(points[a].brdf, points[b].brdf);
+    for run in runs(&brdf_points[..n_brdf], same_brdf) {
+        let brdf_of = points[brdf_points[run.start]].brdf;
+        brdf_of.sample_many_views(&views[run.clone()], &u_brdf[run.clone()], &mut brdf[run]);
+    }
+    for k in 0..n_brdf {
+        if let Some(b) = &brdf[k] {
+            dirs[k] = points[brdf_points[k]].frame.to_world(b.wi);
         }
     }
     let mut uvs = [Vec2::ZERO; WAVE];
@@ -142,14 +159,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
         env.prefetch_texel(t.0, t.1);
     }
     // The sampler's draws, all in one batch (its descents side by side).
-    let mut u_sampler = [DVec2::ZERO; WAVE];
-    let mut sampler_points = [0usize; WAVE];
     let mut drawn = [None; WAVE];
-    let mut n_sampler = 0;
-    for s in samples.iter().filter(|s| s.technique == Technique::Sampler) {
-        (u_sampler[n_sampler], sampler_points[n_sampler]) = (s.u, s.point);
-        n_sampler += 1;
-    }
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
     // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
     // for now, it arrives meanwhile (their density came with the draw).
@@ -168,7 +178,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     let mut evaluated = [(Vec3::ZERO, 0.0f32); WAVE];
     if weighting != Weighting::Single {
         let mut local = [Vec3::Z; WAVE];
-        for run in point_runs(&sampler_points[..n_sampler]) {
+        for run in runs(&sampler_points[..n_sampler], |a, b| a == b) {
             let sp = &points[sampler_points[run.start]];
             for (l, d) in local[run.clone()].iter_mut().zip(&drawn[run.clone()]) {
                 *l = d.map_or(Vec3::Z, |d| sp.frame.to_local(d.dir));
@@ -183,14 +193,13 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     // Every sample's value, in order.
     let (mut i_sampler, mut i_brdf) = (0, 0);
     for (s, o) in samples[..n].iter().zip(out.iter_mut()) {
-        let sp = &points[s.point];
         *o = match s.technique {
             Technique::Sampler => {
                 let k = i_sampler;
                 i_sampler += 1;
                 drawn[k].map_or(Candidate::default(), |d| {
                     let (x, y) = texels_drawn[k];
-                    sampler_candidate(sp, d, env.radiance_texel(x, y), evaluated[k], weighting)
+                    sampler_candidate(&points[s.point], d, env.radiance_texel(x, y), evaluated[k], weighting)
                 })
             }
             Technique::Brdf => {
@@ -211,12 +220,13 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     }
 }
 
-/// The ranges of equal consecutive entries of `owners`: the samples of one shading point.
-fn point_runs(owners: &[usize]) -> impl Iterator<Item = Range<usize>> + '_ {
+/// The ranges of consecutive entries of `owners` whose shading points are the `same` as
+/// their run's first's (e.g. the samples of one shading point).
+fn runs<'a>(owners: &'a [usize], same: impl Fn(usize, usize) -> bool + 'a) -> impl Iterator<Item = Range<usize>> + 'a {
     let mut start = 0;
     core::iter::from_fn(move || {
         let first = *owners.get(start)?;
-        let end = start + owners[start..].iter().take_while(|&&p| p == first).count();
+        let end = start + 1 + owners[start + 1..].iter().take_while(|&&p| same(first, p)).count();
         let run = start..end;
         start = end;
         Some(run)

@@ -110,6 +110,16 @@ fn many_at_once_is_one_at_a_time() {
                 }
                 assert!(many[n..].iter().all(Option::is_none), "wrote past the inputs");
             }
+            // Each draw seen from its own view: runs of one view, views alternating, below.
+            let mixed: Vec<Vec3> = (0..u.len())
+                .map(|k| if (k / 3) % 2 == 0 { wo } else { views[(k / 2) % views.len()].normalize() })
+                .collect();
+            let mut many = vec![None; u.len() + 3];
+            brdf.sample_many_views(&mixed, &u, &mut many);
+            for (k, p) in u.iter().enumerate() {
+                assert_eq!(bits(&many[k]), bits(&brdf.sample(mixed[k], *p)), "wo {}, u {p}", mixed[k]);
+            }
+            assert!(many[u.len()..].iter().all(Option::is_none), "wrote past the inputs");
             let wis: Vec<Vec3> =
                 u.iter().map(|p| Vec3::new(2.0 * p.x - 1.0, 2.0 * p.y - 1.0, p.x - p.y).normalize()).collect();
             let mut many = vec![(Vec3::NAN, f32::NAN); wis.len()];
