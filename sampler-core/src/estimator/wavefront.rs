@@ -128,28 +128,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     // while the sampler's descents below run.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
     let mut dirs = [Vec3::Z; WAVE];
-    // Each sample's view in its point's frame, found once per point.
-    let mut views = [Vec3::Z; WAVE];
-    for k in 0..n_brdf {
-        views[k] = match k.checked_sub(1) {
-            Some(j) if brdf_points[j] == brdf_points[k] => views[j],
-            _ => {
-                let sp = &points[brdf_points[k]];
-                sp.frame.to_local(sp.wo)
-            }
-        };
-    }
-    // The draws of the points that share one BRDF in one call: it may draw across them.
-    let same_brdf = |a: usize, b: usize| core::ptr::addr_eq(points[a].brdf, points[b].brdf);
-    for run in runs(&brdf_points[..n_brdf], same_brdf) {
-        let brdf_of = points[brdf_points[run.start]].brdf;
-        brdf_of.sample_many_views(&views[run.clone()], &u_brdf[run.clone()], &mut brdf[run]);
-    }
-    for k in 0..n_brdf {
-        if let Some(b) = &brdf[k] {
-            dirs[k] = points[brdf_points[k]].frame.to_world(b.wi);
-        }
-    }
+    draw_brdf(points, &brdf_points[..n_brdf], &u_brdf[..n_brdf], &mut brdf[..n_brdf], &mut dirs[..n_brdf]);
     let mut uvs = [Vec2::ZERO; WAVE];
     env.squares_of(&dirs[..n_brdf], &mut uvs[..n_brdf]);
     // Each sample's texel found once: asked for now, read in the last loops.
@@ -177,14 +156,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     // Under MIS the BRDF's value and density at the sampler's draws, each point's in one call.
     let mut evaluated = [(Vec3::ZERO, 0.0f32); WAVE];
     if weighting != Weighting::Single {
-        let mut local = [Vec3::Z; WAVE];
-        for run in runs(&sampler_points[..n_sampler], |a, b| a == b) {
-            let sp = &points[sampler_points[run.start]];
-            for (l, d) in local[run.clone()].iter_mut().zip(&drawn[run.clone()]) {
-                *l = d.map_or(Vec3::Z, |d| sp.frame.to_local(d.dir));
-            }
-            sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[run.clone()], &mut evaluated[run]);
-        }
+        eval_at_draws(points, &sampler_points[..n_sampler], &drawn[..n_sampler], &mut evaluated[..n_sampler]);
     }
     let mut radiance_brdf = [Vec3::ZERO; WAVE];
     for (r, &(x, y)) in radiance_brdf.iter_mut().zip(&texels_brdf[..n_brdf]) {
@@ -206,17 +178,64 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
                 let k = i_brdf;
                 i_brdf += 1;
                 brdf[k].map_or(Candidate::default(), |b| {
-                    let f = times(radiance_brdf[k], b.value);
-                    let p_other = p_square[k] / SPHERE_AREA;
-                    let pdf = match weighting {
-                        Weighting::Single => b.pdf,
-                        Weighting::Balance => b.pdf + p_other,
-                        Weighting::Split { sampler, brdf } => brdf * b.pdf + sampler * p_other,
-                    };
-                    Candidate::new(f, pdf, dirs[k])
+                    brdf_candidate(b, dirs[k], radiance_brdf[k], p_square[k], weighting)
                 })
             }
         };
+    }
+}
+
+/// The BRDF's draws of `u` at `owners`' shading points (`brdf[k]`, its world direction in
+/// `dirs[k]`): each sample's view in its point's frame found once per point, and the draws of
+/// the points that share one BRDF in one call, which may draw across them.
+#[inline(always)]
+fn draw_brdf<B: Brdf + ?Sized>(
+    points: &[ShadingPoint<'_, B>],
+    owners: &[usize],
+    u: &[Vec2],
+    brdf: &mut [Option<BrdfSample>],
+    dirs: &mut [Vec3],
+) {
+    let mut views = [Vec3::Z; WAVE];
+    let mut last: Option<(usize, Vec3)> = None;
+    for (view, &owner) in views.iter_mut().zip(owners) {
+        *view = match last {
+            Some((o, v)) if o == owner => v,
+            _ => {
+                let sp = &points[owner];
+                sp.frame.to_local(sp.wo)
+            }
+        };
+        last = Some((owner, *view));
+    }
+    let same_brdf = |a: usize, b: usize| core::ptr::addr_eq(points[a].brdf, points[b].brdf);
+    for run in runs(owners, same_brdf) {
+        let brdf_of = points[owners[run.start]].brdf;
+        brdf_of.sample_many_views(&views[run.clone()], &u[run.clone()], &mut brdf[run]);
+    }
+    for ((d, b), &owner) in dirs.iter_mut().zip(brdf.iter()).zip(owners) {
+        if let Some(b) = b {
+            *d = points[owner].frame.to_world(b.wi);
+        }
+    }
+}
+
+/// The BRDF × cos and the BRDF's density at the sampler's draws (`evaluated[k]` at `drawn[k]`
+/// of `owners[k]`'s shading point), each point's draws in one call.
+#[inline(always)]
+fn eval_at_draws<B: Brdf + ?Sized>(
+    points: &[ShadingPoint<'_, B>],
+    owners: &[usize],
+    drawn: &[Option<DirectionSample>],
+    evaluated: &mut [(Vec3, f32)],
+) {
+    let mut local = [Vec3::Z; WAVE];
+    for run in runs(owners, |a, b| a == b) {
+        let sp = &points[owners[run.start]];
+        for (l, d) in local[run.clone()].iter_mut().zip(&drawn[run.clone()]) {
+            *l = d.map_or(Vec3::Z, |d| sp.frame.to_local(d.dir));
+        }
+        sp.brdf.eval_pdf_many(sp.frame.to_local(sp.wo), &local[run.clone()], &mut evaluated[run]);
     }
 }
 
@@ -231,6 +250,20 @@ fn runs<'a>(owners: &'a [usize], same: impl Fn(usize, usize) -> bool + 'a) -> im
         start = end;
         Some(run)
     })
+}
+
+/// The candidate of the BRDF's draw `b` in world direction `dir`, where the map's radiance is
+/// `radiance` and, under MIS, the sampler's density in the square is `p_square`.
+#[inline(always)]
+fn brdf_candidate(b: BrdfSample, dir: Vec3, radiance: Vec3, p_square: f32, weighting: Weighting) -> Candidate {
+    let f = times(radiance, b.value);
+    let p_other = p_square / SPHERE_AREA;
+    let pdf = match weighting {
+        Weighting::Single => b.pdf,
+        Weighting::Balance => b.pdf + p_other,
+        Weighting::Split { sampler, brdf } => brdf * b.pdf + sampler * p_other,
+    };
+    Candidate::new(f, pdf, dir)
 }
 
 /// The candidate of a direction the sampler drew at `sp`, where the map's radiance is
