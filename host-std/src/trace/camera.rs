@@ -16,6 +16,8 @@ pub struct Camera {
     up: Vec3,
     tan_half: f32,
     aspect: f32,
+    /// `width` and `height` as f32: the same values, converted once rather than per ray.
+    film: (f32, f32),
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
@@ -37,6 +39,7 @@ impl Camera {
             up,
             tan_half: (spec.fov_y_deg.to_radians() * 0.5).tan(),
             aspect: spec.width as f32 * spec.pixel_aspect / spec.height as f32,
+            film: (spec.width as f32, spec.height as f32),
             width: spec.width,
             height: spec.height,
             near_clip: spec.near_clip,
@@ -45,8 +48,8 @@ impl Camera {
 
     /// Unit direction through film position (x, y).
     pub fn direction(&self, x: f32, y: f32) -> Vec3 {
-        let sx = (2.0 * x / self.width as f32 - 1.0) * self.tan_half * self.aspect;
-        let sy = (1.0 - 2.0 * y / self.height as f32) * self.tan_half;
+        let sx = (2.0 * x / self.film.0 - 1.0) * self.tan_half * self.aspect;
+        let sy = (1.0 - 2.0 * y / self.film.1) * self.tan_half;
         (self.forward + sx * self.right + sy * self.up).normalize()
     }
 }
