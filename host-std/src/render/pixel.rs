@@ -53,8 +53,43 @@ pub struct Scratch {
     waves: WaveBuffers,
     /// Lightcuts' cut.
     cuts: Vec<CutEntry>,
+    /// The group's per-point arrays.
+    group: GroupBuffers,
     /// What the tile's pixels did so far.
     pub counters: Counters,
+}
+
+/// A group of shading points' per-point arrays, kept with the tile so that a pixel neither
+/// zero-fills nor copies them: each use writes the entries it reads.
+struct GroupBuffers {
+    /// The film positions of the group's camera rays.
+    film: [DVec2; GROUP],
+    /// Each hit's estimate, by hit.
+    values: [DVec3; GROUP],
+    /// Whether a hit is shaded yet, by hit.
+    done: [bool; GROUP],
+    /// The hits of one material, in order.
+    members: [usize; GROUP],
+    /// The members' runs of the pixel's sequences.
+    runs: [Run; GROUP],
+    /// Where the members' shadow rays start.
+    origins: [Vec3; GROUP],
+    /// The members' estimates.
+    out: [DVec3; GROUP],
+}
+
+impl Default for GroupBuffers {
+    fn default() -> Self {
+        Self {
+            film: [DVec2::ZERO; GROUP],
+            values: [DVec3::ZERO; GROUP],
+            done: [false; GROUP],
+            members: [0; GROUP],
+            runs: [Run { seed: 0, block: 0 }; GROUP],
+            origins: [Vec3::ZERO; GROUP],
+            out: [DVec3::ZERO; GROUP],
+        }
+    }
 }
 
 impl Scratch {
@@ -66,6 +101,7 @@ impl Scratch {
             hits: Vec::with_capacity(shading_points.clamp(1, GROUP)),
             waves: WaveBuffers::default(),
             cuts: Vec::new(),
+            group: GroupBuffers::default(),
             counters: Counters::default(),
         }
     }
@@ -88,15 +124,15 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
     let pixel = hash_combine(ctx.options.seed, (y * ctx.camera.width as usize + x) as u64);
     let seeds = Seeds { pixel, light: hash_combine(pixel, 0x11647) };
     let p = ctx.options.shading_points.max(1);
-    let mut film = [DVec2::ZERO; GROUP];
     // Accumulated in f64: single samples of a 1e30 map can exceed the f32 range.
     let mut sum = DVec3::ZERO;
     let mut done = 0;
     while done < p {
         let m = (p - done).min(GROUP);
-        sobol02(seeds.pixel, done as u32, &mut film[..m]);
+        let film = &mut scratch.group.film[..m];
+        sobol02(seeds.pixel, done as u32, film);
         scratch.hits.clear();
-        for (k, f) in film[..m].iter().enumerate() {
+        for (k, f) in film.iter().enumerate() {
             let dir = camera_ray(ctx.camera, x, y, *f, &mut scratch.counters);
             let Some(hit) = ctx.bvh.intersect(ctx.camera.origin, dir, ctx.camera.near_clip, f32::INFINITY) else {
                 if let Some(radiance) = background(ctx, dir) {
@@ -210,15 +246,14 @@ fn sample_light(
     scratch: &mut Scratch,
     sum: &mut DVec3,
 ) {
-    let Scratch { cache, hits, waves, counters, .. } = scratch;
+    let Scratch { cache, hits, waves, group: buffers, counters, .. } = scratch;
     let n = hits.len();
     let p = ctx.options.shading_points.max(1);
     let shadows = ctx.options.shadows;
     let run_of = |h: &Hit| run(seeds, h, p);
-    let mut values = [DVec3::ZERO; GROUP];
-    let mut done = [false; GROUP];
+    buffers.done[..n].fill(false);
     for first in 0..n {
-        if done[first] {
+        if buffers.done[first] {
             continue;
         }
         let lead = &hits[first];
@@ -227,18 +262,13 @@ fn sample_light(
         let lead_sp = shading_point(ctx.scene, lead);
         let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
         let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });
-        let (members, m) = members_of(hits, first);
+        let m = members_of(hits, first, &mut buffers.members);
         let mut rays = 0u64;
-        let mut visible = |k: usize, d: Vec3| {
-            rays += 1;
-            !shadows || !ctx.bvh.occluded(hits[k].origin, d, 0.0, f32::INFINITY)
-        };
         let shaded = if wavefront::fits(&sampling, budget) {
-            let members = &members[..m];
-            let (out, traced) = shade_members(ctx, env, &sampling, hits, members, run_of, budget, waves);
-            rays += traced;
-            for (i, &k) in members.iter().enumerate() {
-                (values[k], done[k]) = (out[i], true);
+            rays += shade_members(ctx, env, &sampling, hits, m, run_of, budget, waves, buffers);
+            let GroupBuffers { values, done, members, out, .. } = buffers;
+            for (&k, &o) in members[..m].iter().zip(&out[..m]) {
+                (values[k], done[k]) = (o, true);
             }
             m
         } else {
@@ -246,17 +276,15 @@ fn sample_light(
             // shared sampler.
             let shared = matches!(sampling, Sampling::ProductMis { .. } | Sampling::TwoLevelMis { .. });
             let shaded = if shared { m } else { 1 };
-            for &k in &members[..shaded] {
-                let mut vis = CountingVisibility { test: |d: Vec3| visible(k, d), rays: 0 };
-                values[k] = shade::shade(
-                    &sampling,
-                    env,
-                    &shading_point(ctx.scene, &hits[k]),
-                    budget,
-                    run_of(&hits[k]),
-                    &mut vis,
-                );
-                done[k] = true;
+            for i in 0..shaded {
+                let k = buffers.members[i];
+                let origin = hits[k].origin;
+                let test = |d: Vec3| !shadows || !ctx.bvh.occluded(origin, d, 0.0, f32::INFINITY);
+                let mut vis = CountingVisibility { test, rays: 0 };
+                let sp = shading_point(ctx.scene, &hits[k]);
+                buffers.values[k] = shade::shade(&sampling, env, &sp, budget, run_of(&hits[k]), &mut vis);
+                buffers.done[k] = true;
+                rays += vis.rays;
             }
             shaded
         };
@@ -264,48 +292,54 @@ fn sample_light(
         // Only rays traced count.
         counters.shadow_rays += if shadows { rays } else { 0 };
     }
-    add_in_order(ctx, hits, &values[..n], sum);
+    add_in_order(ctx, hits, &buffers.values[..n], sum);
 }
 
-/// The estimates of a material's `members` shaded as one wavefront through `sampling` (see
-/// [`wavefront::fits`]), and the shadow rays traced; `run_of` gives each hit's run.
+/// The estimates of the first `m` of `buffers.members` shaded as one wavefront through
+/// `sampling` (see [`wavefront::fits`]) into `buffers.out`; returns the shadow rays traced.
+/// `run_of` gives each hit's run.
 #[allow(clippy::too_many_arguments)]
 fn shade_members(
     ctx: &Context<'_, '_>,
     env: &EnvHierarchy<'_>,
     sampling: &Sampling<'_, '_>,
     hits: &[Hit],
-    members: &[usize],
+    m: usize,
     run_of: impl Fn(&Hit) -> Run,
     budget: usize,
     waves: &mut WaveBuffers,
-) -> ([DVec3; GROUP], u64) {
-    // Sized to the members: a group's full array would cost more to fill than its few points.
-    let points: Vec<ShadingPoint<'_, dyn Brdf + '_>> =
-        members.iter().map(|&k| shading_point(ctx.scene, &hits[k])).collect();
-    let mut runs = [Run { seed: 0, block: 0 }; GROUP];
-    for (r, &k) in runs.iter_mut().zip(members) {
-        *r = run_of(&hits[k]);
+    buffers: &mut GroupBuffers,
+) -> u64 {
+    let GroupBuffers { members, runs, origins, out, .. } = buffers;
+    // On the stack and filled only as far as the members: a pixel's few points cost no
+    // allocation and no fill of a group's full array.
+    let mut points: heapless::Vec<ShadingPoint<'_, dyn Brdf + '_>, GROUP> = heapless::Vec::new();
+    for (i, &k) in members[..m].iter().enumerate() {
+        let h = &hits[k];
+        // At most GROUP members: the push cannot fail.
+        let _ = points.push(shading_point(ctx.scene, h));
+        (runs[i], origins[i]) = (run_of(h), h.origin);
     }
-    let mut out = [DVec3::ZERO; GROUP];
     let shadows = ctx.options.shadows;
-    let occluded = |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(hits[members[i]].origin, dir, 0.0, f32::INFINITY);
-    let runs = &runs[..members.len()];
-    let traced = wavefront::shade_wavefront(sampling, env, &points, runs, budget, waves, occluded, &mut out)
-        .map_or(0, |r| r as u64);
-    (out, traced)
+    let origins = &origins[..m];
+    let occluded = |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(origins[i], dir, 0.0, f32::INFINITY);
+    wavefront::shade_wavefront(sampling, env, &points, &runs[..m], budget, waves, occluded, &mut out[..m])
+        .map_or(0, |r| r as u64)
 }
 
-/// The indices of the hits of `hits[first]`'s material from `first` on (in order), and their
-/// count: the points a wavefront or a shared sampler shades together.
-fn members_of(hits: &[Hit], first: usize) -> ([usize; GROUP], usize) {
-    let mut members = [0usize; GROUP];
+/// Writes the indices of the hits of `hits[first]`'s material from `first` on (in order) to
+/// `members` and returns their count: the points a wavefront or a shared sampler shades
+/// together.
+fn members_of(hits: &[Hit], first: usize, members: &mut [usize; GROUP]) -> usize {
+    let material = hits[first].material;
     let mut m = 0;
-    for k in (first..hits.len()).filter(|&k| hits[k].material == hits[first].material) {
-        members[m] = k;
-        m += 1;
+    for (k, h) in hits.iter().enumerate().skip(first) {
+        if h.material == material {
+            members[m] = k;
+            m += 1;
+        }
     }
-    (members, m)
+    m
 }
 
 /// Adds the points' estimates to `sum` in hit order, a product-MIS material's points
