@@ -4,6 +4,7 @@
 //! into caller-provided slices; doubles carry 32 random bits, which the deep warps need.
 
 mod sobol;
+mod sobol_x4;
 
 pub use sobol::{Sobol02, nested_uniform_scramble, sobol_dim0, sobol_dim1, sobol02, sobol02_shifted};
 

@@ -2,10 +2,11 @@
 //! each point to the next, with Owen scrambling by hashing ([`Sobol02`]) or a digital shift
 //! ([`sobol02_shifted`]).
 
+use super::sobol_x4::scrambled_four;
 use crate::rng::hash_combine;
 use glam::{DVec2, Vec2};
 
-const INV_2_32: f64 = 1.0 / 4_294_967_296.0;
+pub(super) const INV_2_32: f64 = 1.0 / 4_294_967_296.0;
 
 /// Generator matrix columns of the first two Sobol' dimensions: the identity (van der
 /// Corput, bits reversed) and the primitive polynomial x + 1 (vₖ = vₖ₋₁ ⊕ (vₖ₋₁ >> 1)).
@@ -131,7 +132,7 @@ pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
 
 /// [`nested_uniform_scramble`] of the point whose bits reversed are `v`.
 #[inline(always)]
-fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
+pub(super) fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
     v = v.wrapping_add(seed);
     v ^= v.wrapping_mul(0x6c50_b47c);
     v ^= v.wrapping_mul(0xb82f_1e52);
@@ -162,10 +163,24 @@ impl Sobol02 {
         Self { s0: hash_combine(seed, 0x5eed_0000) as u32, s1: hash_combine(seed, 0x5eed_0001) as u32 }
     }
 
-    /// Points `first .. first + out.len()`.
-    #[inline]
+    /// Points `first .. first + out.len()`, four at a time (`sobol_x4.rs`).
     pub fn fill(&self, first: u32, out: &mut [DVec2]) {
-        for (p, q) in out.iter_mut().zip(self.points(first)) {
+        let seeds = (self.s0, self.s1);
+        let mut y_reversed = dim1_reversed(first);
+        let mut i = first;
+        let (fours, rest) = out.as_chunks_mut::<4>();
+        for four in fours {
+            // The first dimension is the index with its bits reversed, so reversed it is the
+            // index; the second steps from each point to the next.
+            let ys = core::array::from_fn(|k| {
+                let y = y_reversed;
+                y_reversed ^= SOBOL_DIM1_STEPS_REVERSED[i.wrapping_add(k as u32).trailing_ones() as usize];
+                y
+            });
+            scrambled_four(i, ys, seeds, four);
+            i = i.wrapping_add(4);
+        }
+        for (p, q) in rest.iter_mut().zip(self.points(i)) {
             *p = q;
         }
     }
@@ -177,9 +192,7 @@ impl Sobol02 {
         let Self { s0, s1 } = *self;
         // The second dimension's reversed point from the byte tables once, then from each
         // point to the next by one step (`SOBOL_STEPS`, reversed): the same points.
-        let b = first.to_le_bytes();
-        let t = &SOBOL_DIM1_REVERSED;
-        let mut y_reversed = t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize];
+        let mut y_reversed = dim1_reversed(first);
         let mut i = first;
         core::iter::from_fn(move || {
             // The first dimension is the index with its bits reversed, so reversed it is the index.
@@ -190,6 +203,14 @@ impl Sobol02 {
             Some(DVec2::new(x as f64 * INV_2_32, y as f64 * INV_2_32))
         })
     }
+}
+
+/// Point `index` of the second dimension with its bits reversed, from the byte tables.
+#[inline(always)]
+fn dim1_reversed(index: u32) -> u32 {
+    let b = index.to_le_bytes();
+    let t = &SOBOL_DIM1_REVERSED;
+    t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize]
 }
 
 /// Points `first .. first + out.len()` of the (0,2)-sequence randomised by a digital shift
