@@ -269,29 +269,6 @@ impl<'a> EnvHierarchy<'a> {
         }
     }
 
-    /// [`pdf_square`](Self::pdf_square) for every point of `uv` (as many as both hold), the
-    /// same bits: the source chosen once for the batch and the finest level's slice indexed
-    /// directly, where each call would choose and locate them again.
-    pub fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
-        let n = self.resolution();
-        match &self.cdf {
-            Some(cdf) => {
-                for (o, p) in out.iter_mut().zip(uv) {
-                    let (x, y) = texel_of(*p, n);
-                    *o = cdf.relative(morton2(x, y));
-                }
-            }
-            None => {
-                let start = level_offset(self.finest);
-                let finest = &self.pyramid[start..start + (n as usize) * (n as usize)];
-                for (o, p) in out.iter_mut().zip(uv) {
-                    let (x, y) = texel_of(*p, n);
-                    *o = finest[morton2(x, y)] * self.inv_mean;
-                }
-            }
-        }
-    }
-
     /// The importance of the finest-level texel at `uv` relative to the map's mean: the
     /// pyramid's env-only density, which the product samplers continue below their leaves.
     #[inline]
@@ -336,33 +313,6 @@ mod tests {
         }
         // The finest level reads back the row-major input.
         assert_eq!(e.node_relative(Cell::new(3, 5, 2)) / e.inv_mean, luminance(Vec3::from_array(rgb[2 * 8 + 5])));
-    }
-
-    #[test]
-    fn batched_densities_are_the_single_densities() {
-        use crate::env::{build_texel_cdf, texel_cdf_len, texel_guide_len};
-        let mut rgb = [[0.0f32; 3]; 256];
-        for (i, t) in rgb.iter_mut().enumerate() {
-            *t = [(i * 7 % 11) as f32, (i % 3) as f32, if i == 40 { 1e5 } else { 0.25 }];
-        }
-        let mut p = [0.0f32; 341];
-        build_pyramid(4, &rgb, &mut p).unwrap();
-        let (mut ends, mut guide) = (std::vec![0u32; texel_cdf_len(4)], std::vec![0u32; texel_guide_len(4)]);
-        build_texel_cdf(4, &p, &mut ends, &mut guide).unwrap();
-        let plain = EnvHierarchy::new(4, &p, &rgb).unwrap();
-        let table = plain.with_texel_cdf(TexelCdf::new(4, &ends, &guide).unwrap()).unwrap();
-        let mut uv = [Vec2::ZERO; 300];
-        for (k, q) in uv.iter_mut().enumerate() {
-            *q = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.414_213_57).fract());
-        }
-        (uv[0], uv[1], uv[2]) = (Vec2::ONE, Vec2::new(-0.5, f32::NAN), Vec2::splat(2.0));
-        for env in [plain, table] {
-            let mut out = [0.0f32; 300];
-            env.pdf_square_many(&uv, &mut out);
-            for (q, o) in uv.iter().zip(out) {
-                assert_eq!(o.to_bits(), env.pdf_square(*q).to_bits(), "{q:?}");
-            }
-        }
     }
 
     #[test]
