@@ -69,6 +69,9 @@ impl DirectionSampler for EnvHierarchy<'_> {
     fn sample_many(&self, u: &[DVec2], out: &mut [Option<DirectionSample>]) {
         EnvHierarchy::sample_many(self, u, out)
     }
+    fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
+        EnvHierarchy::pdf_square_many(self, uv, out)
+    }
 }
 
 impl DirectionSampler for ProductSampler<'_, '_> {

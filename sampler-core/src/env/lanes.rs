@@ -59,25 +59,26 @@ impl EnvHierarchy<'_> {
         if let Some(cdf) = &self.cdf {
             return self.sample_many_by_table(cdf, u, out);
         }
+        // The buffers live across chunks: each chunk writes the entries it reads, so they are
+        // not cleared again for every 64 points.
+        let mut lanes = [DescentF32::default(); IN_FLIGHT];
+        let mut uvs = [Vec2::ZERO; IN_FLIGHT];
+        let mut dirs = [Vec3::ZERO; IN_FLIGHT];
         for (us, os) in u.chunks(IN_FLIGHT).zip(out.chunks_mut(IN_FLIGHT)) {
             let n = us.len().min(os.len());
-            let mut lanes = [DescentF32::default(); IN_FLIGHT];
             for (lane, u) in lanes.iter_mut().zip(&us[..n]) {
                 *lane = DescentF32::from_root(*u);
             }
             self.descend_f32(&mut lanes[..n]);
-            // The points and densities, then the directions at once.
-            let mut points = [(Vec2::ZERO, 0.0); IN_FLIGHT];
-            for (p, lane) in points.iter_mut().zip(&lanes[..n]) {
-                // `point_in_texel`'s density, by the Morton index the descent carried down.
-                let pdf = self.node_relative_at(self.finest, lane.morton) / SPHERE_AREA;
-                *p = (lane.cell.point(lane.xi.as_dvec2()), pdf);
+            // The points, then the directions at once.
+            for (uv, lane) in uvs.iter_mut().zip(&lanes[..n]) {
+                *uv = lane.cell.point_f32(lane.xi);
             }
-            let mut dirs = [Vec3::ZERO; IN_FLIGHT];
-            self.dirs_of(&points.map(|(uv, _)| uv)[..n], &mut dirs[..n]);
+            self.dirs_of(&uvs[..n], &mut dirs[..n]);
             for (k, (o, lane)) in os.iter_mut().zip(&lanes[..n]).enumerate() {
-                let (uv, pdf) = points[k];
-                *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv, pdf });
+                // `sample_in_texel`'s density, by the Morton index the descent carried down.
+                let pdf = self.node_relative_at(self.finest, lane.morton) / SPHERE_AREA;
+                *o = lane.alive.then_some(DirectionSample { dir: dirs[k], uv: uvs[k], pdf });
             }
         }
     }

@@ -21,6 +21,7 @@
 //! samples draws from a compensated pyramid (`compensation.rs`) where one is attached.
 
 mod compensation;
+mod density;
 mod descent_f32;
 #[cfg(target_arch = "x86_64")]
 mod descent_f32_avx2;

@@ -46,20 +46,14 @@ impl EnvHierarchy<'_> {
         }
         let mut xi = to_unit_f32(u);
         let texel = self.warp_down_f32(&mut xi)?;
-        Some(self.sample_in_texel(texel, xi.as_dvec2()))
+        Some(self.sample_in_texel(texel, xi))
     }
 
-    /// The sample at point `xi` of a finest-level texel, with its density.
+    /// The sample at point `xi` of a finest-level texel, with its density (solid angle).
     #[inline]
-    pub(crate) fn sample_in_texel(&self, texel: Cell, xi: DVec2) -> DirectionSample {
-        let (uv, pdf) = self.point_in_texel(texel, xi);
-        DirectionSample { dir: self.dir_of(uv), uv, pdf }
-    }
-
-    /// The point of a finest-level texel at `xi` and the density there (solid angle).
-    #[inline]
-    pub(crate) fn point_in_texel(&self, texel: Cell, xi: DVec2) -> (Vec2, f32) {
-        (texel.point(xi), self.node_relative(texel) / SPHERE_AREA)
+    fn sample_in_texel(&self, texel: Cell, xi: Vec2) -> DirectionSample {
+        let uv = texel.point_f32(xi);
+        DirectionSample { dir: self.dir_of(uv), uv, pdf: self.node_relative(texel) / SPHERE_AREA }
     }
 }
 

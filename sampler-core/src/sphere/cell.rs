@@ -89,6 +89,24 @@ impl Cell {
         };
         Vec2::new(coord(self.x, xi.x), coord(self.y, xi.y))
     }
+
+    /// [`point`](Self::point) of a point with f32 coordinates, in f32 and the same bits: the
+    /// sum `i + f` rounds once in either precision (f64 holds more than twice f32's digits, so
+    /// rounding through it is rounding once) and the scale by 2^−level is exact, so f32 needs
+    /// no widening. For cells of level < 24 (their coordinates exact in f32).
+    #[inline]
+    #[must_use]
+    pub fn point_f32(self, xi: Vec2) -> Vec2 {
+        debug_assert!(self.level < 24);
+        let inv = f32::from_bits((127 - self.level) << 23);
+        let coord = |i: u32, f: f32| -> f32 {
+            let lo = i as f32 * inv;
+            let hi = (i + 1) as f32 * inv;
+            let c = (i as f32 + f) * inv;
+            if c >= hi { next_down(hi).max(lo) } else { c.max(lo) }
+        };
+        Vec2::new(coord(self.x, xi.x), coord(self.y, xi.y))
+    }
 }
 
 /// Interleaves the bits of two 16-bit coordinates (x in the even bits): a cell's index within
@@ -164,6 +182,27 @@ mod tests {
         assert_eq!(c.grandchild(1, 3).ancestor(0), Cell::ROOT);
         assert_eq!(Cell::new(1, 1, 1).morton(), 3);
         assert_eq!(c.inverse_area(), 64.0);
+    }
+
+    #[test]
+    fn f32_points_are_the_f64_points() {
+        let mut rng = crate::rng::Pcg32::new(5, 6);
+        let edges = [0.0, f32::MIN_POSITIVE, 1e-40, 0.5, 1.0 - f32::EPSILON / 2.0, f32::NAN];
+        for level in [0u32, 1, 5, 11, 13, 16, 23] {
+            let n = 1u32 << level;
+            for k in 0..4000 {
+                let (x, y) = (rng.next_u32() & (n - 1), rng.next_u32() & (n - 1));
+                let unit = |r: u32| (r >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+                let xi = if k < edges.len() * edges.len() {
+                    Vec2::new(edges[k % edges.len()], edges[k / edges.len()])
+                } else {
+                    Vec2::new(unit(rng.next_u32()), f32::from_bits(rng.next_u32() % 0x3f80_0000))
+                };
+                let c = Cell::new(level, x, y);
+                let (a, b) = (c.point(xi.as_dvec2()), c.point_f32(xi));
+                assert_eq!((a.x.to_bits(), a.y.to_bits()), (b.x.to_bits(), b.y.to_bits()), "{c:?} {xi:?}");
+            }
+        }
     }
 
     #[test]
