@@ -1,42 +1,44 @@
 //! Env-only densities of a batch of points of the square ([`EnvHierarchy::pdf_square_many`]):
-//! the source (texel table or pyramid) chosen once, and over the pyramid eight points to an
-//! AVX2 register — texel, Morton index and a gather — the same bits as one at a time.
+//! over the pyramid eight points to an AVX2 register — texel, Morton index and a gather — the
+//! same bits as one at a time; the texel table's, and the rest, one at a time.
 
 use super::EnvHierarchy;
+#[cfg(target_arch = "x86_64")]
 use super::pyramid::level_offset;
-use crate::cell::morton2;
-use crate::mapping::texel_of;
 use glam::Vec2;
 
 impl EnvHierarchy<'_> {
     /// [`pdf_square`](Self::pdf_square) for every point of `uv` (as many as both hold), the
     /// same bits.
     pub fn pdf_square_many(&self, uv: &[Vec2], out: &mut [f32]) {
-        let n = self.resolution();
-        if let Some(cdf) = &self.cdf {
-            for (o, p) in out.iter_mut().zip(uv) {
-                let (x, y) = texel_of(*p, n);
-                *o = cdf.relative(morton2(x, y));
-            }
-            return;
+        let len = uv.len().min(out.len());
+        let done = self.pdf_square_eights(&uv[..len], &mut out[..len]);
+        for (o, p) in out[done..len].iter_mut().zip(&uv[done..len]) {
+            *o = self.pdf_square(*p);
         }
+    }
+
+    /// The densities of the leading groups of eight points over the pyramid where the CPU has
+    /// AVX2; how many points it wrote (none under a texel table, or without AVX2).
+    #[cfg(target_arch = "x86_64")]
+    fn pdf_square_eights(&self, uv: &[Vec2], out: &mut [f32]) -> usize {
+        if self.cdf.is_some() || !crate::cpu::has_avx2() {
+            return 0;
+        }
+        let n = self.resolution();
         let start = level_offset(self.finest);
         let finest = &self.pyramid[start..start + (n as usize) * (n as usize)];
-        let len = uv.len().min(out.len());
-        let mut done = 0;
-        #[cfg(target_arch = "x86_64")]
-        if crate::cpu::has_avx2() {
-            let (eights, _) = uv[..len].as_chunks::<8>();
-            for (p, o) in eights.iter().zip(out[..len].as_chunks_mut::<8>().0) {
-                // SAFETY: AVX2 is available (checked above).
-                *o = unsafe { avx2::densities(finest, n, self.inv_mean, p) };
-            }
-            done = 8 * eights.len();
+        let (eights, _) = uv.as_chunks::<8>();
+        for (p, o) in eights.iter().zip(out.as_chunks_mut::<8>().0) {
+            // SAFETY: AVX2 is available (checked above).
+            *o = unsafe { avx2::densities(finest, n, self.inv_mean, p) };
         }
-        for (o, p) in out[done..len].iter_mut().zip(&uv[done..len]) {
-            let (x, y) = texel_of(*p, n);
-            *o = finest[morton2(x, y)] * self.inv_mean;
-        }
+        8 * eights.len()
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    fn pdf_square_eights(&self, _uv: &[Vec2], _out: &mut [f32]) -> usize {
+        0
     }
 }
 
