@@ -234,7 +234,7 @@ fn wavefront(sampler: &ProductSampler<'_, '_>, sp: &ShadingPoint<'_, dyn Brdf + 
     });
     let mut candidates = [Candidate::default(); 4];
     let mut sink = 0.0;
-    for w in [Weighting::Single, Weighting::Balance] {
+    for w in [Weighting::Single, Weighting::Pairs] {
         estimator::wavefront::wavefront(sampler, core::slice::from_ref(sp), &wave, w, &mut candidates);
         sink += candidates.iter().map(|c| c.value.x).sum::<f64>();
     }

@@ -32,10 +32,26 @@ pub struct PilotCandidate<'a> {
 /// settings' seed, `salt` and the candidate's index (lower is better).
 #[must_use]
 pub fn paired_scores(bvh: &Bvh, candidates: &[PilotCandidate<'_>], tiles: &[Crop], salt: u64) -> Vec<f64> {
+    let indices: Vec<usize> = (0..candidates.len()).collect();
+    paired_scores_at(bvh, candidates, &indices, tiles, salt)
+}
+
+/// [`paired_scores`] with the seeds of the candidates at `indices` of a call with the same
+/// `salt`: a candidate that differs from that call's only in how its samples are weighed draws
+/// the same samples, and the two scores differ by the weighing alone, not by their samples'
+/// luck.
+#[must_use]
+pub fn paired_scores_at(
+    bvh: &Bvh,
+    candidates: &[PilotCandidate<'_>],
+    indices: &[usize],
+    tiles: &[Crop],
+    salt: u64,
+) -> Vec<f64> {
     let renders: Vec<[(Vec<[f32; 3]>, f64); 2]> = candidates
         .iter()
-        .enumerate()
-        .map(|(k, c)| {
+        .zip(indices)
+        .map(|(c, &k)| {
             std::array::from_fn(|rep| {
                 let s = Settings {
                     // `auto`'s own pilot would run again in every tile's render: its MIS plans

@@ -7,6 +7,12 @@
 //! "Shading points per pixel"). Neither wins on every scene, so a pilot measures the scene:
 //! paired renders of a few tiles with each split (`plan::paired`), scored by variance × cost.
 //!
+//! At the split it chooses, the pilot also renders the MIS methods (not `auto`, whose pilot
+//! renders its materials as MIS) with the power heuristic instead of the balance heuristic, and
+//! keeps whichever scores lower: neither wins on every map (`sampler_core::env::MisHeuristic`).
+//! It does so where most of the map's light stands above its mean ([`POWER_EXCESS_SHARE`]),
+//! the maps where the power heuristic can win by more than the pilot costs.
+//!
 //! The pilot renders at an eighth of the render's samples per pixel (at least 32): the
 //! footprint's share of the error falls with spp faster than the light's (stratified shading
 //! points), so a split that wins there wins at the render's spp too, and the pilot's four
@@ -15,12 +21,12 @@
 use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::plan::carrier::point_cost;
 use crate::plan::method::Lighting;
-use crate::plan::paired::{PilotCandidate, paired_scores, pilot_tiles};
+use crate::plan::paired::{PilotCandidate, paired_scores, paired_scores_at, pilot_tiles};
 use crate::plan::{Method, Settings, ShadingPoints};
 use crate::render::crop::Crop;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
-use sampler_core::env::EnvHierarchy;
+use sampler_core::env::{EnvHierarchy, MisHeuristic};
 use std::time::Instant;
 
 /// Samples per pixel from which the pilot runs: below, its renders (at least
@@ -43,6 +49,15 @@ pub const MIN_PILOT_TILES: usize = 8;
 /// The fewest samples per pixel the pilot renders with: four shading points at four pairs.
 pub const MIN_PILOT_SPP: usize = 32;
 
+/// What the pilot's seeds derive from, with the render's seed.
+const SALT: u64 = 0x5b11_7000;
+
+/// The least share of the map's light above its mean (`EnvHierarchy::excess_share`) at which
+/// the pilot measures the power heuristic: below it, on every map measured, the power
+/// heuristic gained at most a few per cent or lost, and the pilot's extra renders and its
+/// occasional wrong choice cost more than it could win (docs/perf.md, "MIS heuristic").
+pub const POWER_EXCESS_SHARE: f32 = 0.75;
+
 /// What the pilot measured and chose.
 #[derive(Clone, Copy, Debug)]
 pub struct SplitChoice {
@@ -52,6 +67,12 @@ pub struct SplitChoice {
     pub candidates: [usize; 2],
     /// Their variance × cost at the pilot's spp (lower is better).
     pub scores: [f64; 2],
+    /// The heuristic MIS weighs by in the render.
+    pub heuristic: MisHeuristic,
+    /// The variance × cost of the chosen split under the power heuristic, where the pilot
+    /// measured it (`None` where the heuristic was given, for `auto`, or where the map's light
+    /// is not concentrated enough to try it).
+    pub power_score: Option<f64>,
     /// Samples per pixel of the pilot's renders.
     pub pilot_spp: usize,
     /// Pixels of each of the pilot's renders.
@@ -63,10 +84,11 @@ pub struct SplitChoice {
 }
 
 /// The split for `settings` (its method, spp and seed) on `scene` lit by `env`, where `points`
-/// leaves it to the rule and the rule allows a choice; `None` otherwise (the rule's split).
-/// `env` is the view the render samples, its compensated pyramid attached where the render
-/// reads one ([`Prepass`](crate::plan::prepass::Prepass)), so that the pilot's renders do not
-/// build it again.
+/// leaves it to the rule and the rule allows a choice, and the MIS heuristic where `heuristic`
+/// leaves it to the pilot; `None` otherwise (the rule's split, and the heuristic given or the
+/// balance heuristic). `env` is the view the render samples, its compensated pyramid attached
+/// where the render reads one ([`Prepass`](crate::plan::prepass::Prepass)), so that the
+/// pilot's renders do not build it again.
 #[must_use]
 pub fn choose(
     scene: &Scene,
@@ -74,6 +96,7 @@ pub fn choose(
     env: Option<&EnvHierarchy<'_>>,
     settings: &Settings,
     points: ShadingPoints,
+    heuristic: Option<MisHeuristic>,
 ) -> Option<SplitChoice> {
     let rule = settings.method.samples_per_point_under(Lighting::of(env.is_some(), scene.lights.len()));
     let applies = points == ShadingPoints::Rule
@@ -91,9 +114,11 @@ pub fn choose(
     let (start, cpu_start) = (Instant::now(), process_cpu_time());
     let candidates = [rule, 2 * rule];
     let pilot_spp = (settings.spp / PILOT_SPP_DIVISOR).max(MIN_PILOT_SPP);
-    let candidate = |v: usize| PilotCandidate {
+    // The view under the heuristic given (else the balance heuristic), and under the power heuristic.
+    let views = [heuristic.unwrap_or_default(), MisHeuristic::Power].map(|h| env.map(|e| e.with_mis_heuristic(h)));
+    let candidate = |v: usize, view: usize| PilotCandidate {
         scene,
-        env,
+        env: views[view].as_ref(),
         settings: Settings {
             spp: pilot_spp,
             shading_points: ShadingPoints::PerPoint(v).resolve(settings.method, pilot_spp, Lighting::OneKind),
@@ -101,15 +126,27 @@ pub fn choose(
         },
         point_cost: point_cost(settings.method),
     };
-    let scored = paired_scores(bvh, &candidates.map(candidate), &tiles, 0x5b11_7000);
+    let scored = paired_scores(bvh, &candidates.map(|v| candidate(v, 0)), &tiles, SALT);
     let scores: [f64; 2] = scored.try_into().expect("two splits");
-    let samples_per_point = if scores[1] < scores[0] { candidates[1] } else { candidates[0] };
+    let best = usize::from(scores[1] < scores[0]);
+    let samples_per_point = candidates[best];
+    // The power heuristic at the chosen split, with its renders' seeds: the same samples,
+    // weighed otherwise.
+    let concentrated = env.and_then(EnvHierarchy::excess_share).is_some_and(|s| s >= POWER_EXCESS_SHARE);
+    let power_score = (heuristic.is_none() && settings.method != Method::Auto && concentrated)
+        .then(|| paired_scores_at(bvh, &[candidate(samples_per_point, 1)], &[best], &tiles, SALT)[0]);
+    let heuristic = match power_score {
+        Some(p) if p < scores[best] => MisHeuristic::Power,
+        _ => heuristic.unwrap_or_default(),
+    };
     let cpu_seconds = cpu_seconds_since(cpu_start);
     let pixels = tiles.iter().map(Crop::area).sum();
     Some(SplitChoice {
         samples_per_point,
         candidates,
         scores,
+        heuristic,
+        power_score,
         pilot_spp,
         pixels,
         seconds: start.elapsed().as_secs_f64(),
@@ -157,7 +194,7 @@ mod tests {
         let mut scene = crate::scene::builtin::scene();
         (scene.camera.width, scene.camera.height) = (224, 192);
         let bvh = Bvh::build(&scene);
-        let run = |method, spp, points, env| choose(&scene, &bvh, env, &settings(method, spp), points);
+        let run = |method, spp, points, env| choose(&scene, &bvh, env, &settings(method, spp), points, None);
         let some = Some(&hierarchy);
         assert!(run(Method::Mis, 64, ShadingPoints::Rule, some).is_none(), "below MIN_SPP");
         assert!(run(Method::Mis, 128, ShadingPoints::Given(16), some).is_none(), "--shading-points forces P");
@@ -166,12 +203,13 @@ mod tests {
         let mut small = scene.clone();
         (small.camera.width, small.camera.height) = (160, 90);
         let small_settings = settings(Method::Mis, 128);
-        assert!(choose(&small, &bvh, some, &small_settings, ShadingPoints::Rule).is_none(), "too few tiles");
+        assert!(choose(&small, &bvh, some, &small_settings, ShadingPoints::Rule, None).is_none(), "too few tiles");
         let (a, b) = (
             run(Method::Mis, 128, ShadingPoints::Rule, some).unwrap(),
             run(Method::Mis, 128, ShadingPoints::Rule, some).unwrap(),
         );
         assert_eq!((a.samples_per_point, a.scores, a.pixels), (b.samples_per_point, b.scores, b.pixels));
+        assert_eq!((a.heuristic, a.power_score), (MisHeuristic::Balance, None), "a constant map: nothing to try");
         assert_eq!((a.candidates, a.pilot_spp, a.pixels), ([4, 8], 32, 8 * 16 * 16));
         assert!(a.scores.iter().all(|s| s.is_finite() && *s > 0.0), "{:?}", a.scores);
         let best = if a.scores[1] < a.scores[0] { 8 } else { 4 };
@@ -179,5 +217,44 @@ mod tests {
         let s = settings(Method::Mis, 128);
         assert_eq!(shading_points(Some(&a), ShadingPoints::Rule, &s, Lighting::OneKind), 128 / best);
         assert_eq!(shading_points(None, ShadingPoints::Rule, &s, Lighting::OneKind), 32);
+    }
+
+    /// A map whose light sits in one bright patch: the pilot measures the power heuristic for
+    /// MIS at its chosen split, with that split's seeds, and keeps the better; a heuristic given
+    /// stands, and `auto` keeps the balance heuristic.
+    #[test]
+    fn the_pilot_weighs_the_heuristics_where_the_light_is_concentrated() {
+        let level = 5;
+        let n = 1usize << level;
+        let rgb: Vec<[f32; 3]> =
+            (0..n * n).map(|i| if i % n < 4 && i / n < 4 { [200.0; 3] } else { [0.1; 3] }).collect();
+        let mut pyramid = vec![0.0f32; sampler_core::env::pyramid_len(level)];
+        sampler_core::env::build_pyramid(level, &rgb, &mut pyramid).unwrap();
+        let plain = EnvHierarchy::new(level, &pyramid, &rgb).unwrap();
+        let mut compensated = vec![0.0f32; pyramid.len()];
+        assert!(plain.compensate_into(&mut compensated).unwrap());
+        let view = plain.with_compensated(&compensated).unwrap();
+        assert!(view.excess_share().unwrap() >= POWER_EXCESS_SHARE);
+        let mut scene = crate::scene::builtin::scene();
+        (scene.camera.width, scene.camera.height) = (224, 192);
+        let bvh = Bvh::build(&scene);
+        let run = |method, heuristic| {
+            choose(&scene, &bvh, Some(&view), &settings(method, 128), ShadingPoints::Rule, heuristic).unwrap()
+        };
+        let a = run(Method::Mis, None);
+        let power = a.power_score.expect("MIS measures the power heuristic");
+        assert!(power.is_finite() && power > 0.0);
+        let chosen = a.scores[usize::from(a.samples_per_point == a.candidates[1])];
+        let expected = if power < chosen { MisHeuristic::Power } else { MisHeuristic::Balance };
+        assert_eq!(a.heuristic, expected);
+        assert_eq!((a.heuristic, a.power_score), (run(Method::Mis, None).heuristic, Some(power)), "repeatable");
+        let given = run(Method::Mis, Some(MisHeuristic::Power));
+        assert_eq!((given.heuristic, given.power_score), (MisHeuristic::Power, None), "a given heuristic stands");
+        let auto = run(Method::Auto, None);
+        assert_eq!(
+            (auto.heuristic, auto.power_score),
+            (MisHeuristic::Balance, None),
+            "auto keeps the balance heuristic"
+        );
     }
 }

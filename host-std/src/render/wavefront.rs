@@ -112,7 +112,7 @@ pub(crate) fn shade_wavefront(
     let layout = layout(sampling, budget)?;
     let weighting = match layout {
         Layout::Single { .. } => Weighting::Single,
-        Layout::Pairs { .. } => Weighting::Balance,
+        Layout::Pairs { .. } => Weighting::Pairs,
         Layout::Split { first, brdf } => {
             let (sampler, brdf) = split_shares(first, brdf);
             Weighting::Split { sampler, brdf }

@@ -48,6 +48,16 @@ impl<'a> EnvHierarchy<'a> {
         Ok(self)
     }
 
+    /// The share of the map's light above its mean, Σ max(0, L − L̄) / Σ L over its texels
+    /// (the compensated pyramid's root over the plain one's): near 1 where compact bright
+    /// regions hold nearly all of it, lower where the light is spread. `None` without a
+    /// compensated pyramid attached, or for a black map.
+    #[must_use]
+    pub fn excess_share(&self) -> Option<f32> {
+        let (pyramid, _) = self.compensated?;
+        (self.pyramid[0] > 0.0).then(|| pyramid[0] / self.pyramid[0])
+    }
+
     /// Whether a compensated pyramid is attached.
     #[inline]
     #[must_use]
@@ -109,6 +119,8 @@ mod tests {
         let attached = view.with_compensated(&c).unwrap();
         assert!(attached.has_compensated());
         assert_eq!(attached.compensated().pdf_square(glam::Vec2::new(0.75, 0.75)), 4.0);
+        // Luminances 0, 1, 2, 5: 3 of their 8 above the mean.
+        assert_eq!((view.excess_share(), attached.excess_share()), (None, Some(0.375)));
         assert!(matches!(view.compensate_into(&mut c[..4]), Err(EnvError::WrongLength { .. })));
     }
 

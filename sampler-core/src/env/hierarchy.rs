@@ -34,6 +34,8 @@ pub struct EnvHierarchy<'a> {
     /// The MIS-compensated pyramid ([`compensate_pyramid`](super::compensate_pyramid)) and its
     /// `inv_mean`, when attached.
     pub(super) compensated: Option<(&'a [f32], f32)>,
+    /// How MIS weighs this view's samples against BRDF samples.
+    pub(super) mis_heuristic: super::MisHeuristic,
 }
 
 impl<'a> EnvHierarchy<'a> {
@@ -50,6 +52,7 @@ impl<'a> EnvHierarchy<'a> {
             map_to_world: Mat3::IDENTITY,
             cdf: None,
             compensated: None,
+            mis_heuristic: super::MisHeuristic::Balance,
         })
     }
 

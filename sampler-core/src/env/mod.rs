@@ -18,7 +18,8 @@
 //! samplers continue below their leaves side by side in `lanes.rs` (four to an AVX2 register in
 //! `lanes_avx2.rs`); with a
 //! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent. MIS with BRDF
-//! samples draws from a compensated pyramid (`compensation.rs`) where one is attached.
+//! samples draws from a compensated pyramid (`compensation.rs`) where one is attached, and weighs
+//! its samples by the view's heuristic (`mis_heuristic.rs`).
 
 mod compensation;
 mod density;
@@ -32,6 +33,7 @@ mod lanes;
 mod lanes_avx2;
 #[cfg(target_arch = "x86_64")]
 mod lanes_avx2_ops;
+mod mis_heuristic;
 mod pyramid;
 mod sample;
 mod texel_cdf;
@@ -39,6 +41,7 @@ mod texel_cdf;
 pub use compensation::compensate_pyramid;
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::{IN_FLIGHT, LANES, WarpLane};
+pub use mis_heuristic::MisHeuristic;
 pub use pyramid::{
     EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, pyramid_index,
     pyramid_len, sanitize_rgb,

@@ -102,7 +102,7 @@ pub fn brdf_many<B: Brdf + ?Sized>(
     }
 }
 
-/// Balance-heuristic MIS of up to [`BATCH`] directions drawn by one technique and as many BRDF
+/// MIS (by the view's heuristic) of up to [`BATCH`] directions drawn by one technique and as many BRDF
 /// samples, the BRDF's draws and evaluations batched ([`Brdf::sample_many`],
 /// [`Brdf::eval_pdf_many`]: four lanes for GGX) and the other technique's densities at the
 /// BRDF samples' points by `pdf_square_many` — bit for bit the values of
@@ -170,10 +170,11 @@ fn brdf_draws<B: Brdf + ?Sized>(
 }
 
 /// Any sampler of the environment (a product, the env-only sampler…) and BRDF sampling in MIS
-/// with the budget split unevenly (Veach's multi-sample
-/// balance heuristic): `shares = (c_p, c_b)` are the fractions of the shading point's samples
-/// that each technique draws (c_p + c_b = 1), and every sample, whichever technique drew it,
-/// weighs f·V / (c_p·p_product + c_b·p_brdf). Returns the sum over these points — any number
+/// with the budget split unevenly (Veach's multi-sample heuristics): `shares = (c_p, c_b)` are
+/// the fractions of the shading point's samples that each technique draws (c_p + c_b = 1), and
+/// every sample, whichever technique drew it, weighs f·V / (c_p·p_product + c_b·p_brdf) under
+/// the balance heuristic, or by the view's other heuristic with each density scaled by its share
+/// ([`MisHeuristic::denominator`](crate::env::MisHeuristic::denominator)). Returns the sum over these points — any number
 /// of each technique; the estimate is the sum over all of a shading point's points divided by
 /// their count. Unbiased for any split: each technique's density covers what it samples, and
 /// together they cover every direction where L·B > 0 (the product through its defensive part).
@@ -203,8 +204,9 @@ pub fn sampled_mis_split<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     sum
 }
 
-/// Adds f·V / (c_d·p_drawn + c_b·p_brdf) of up to [`BATCH`] directions drawn by the first
-/// technique to `sum`, one by one (the same order and rounding however the points are batched).
+/// Adds f·V / (c_d·p_drawn + c_b·p_brdf) (the view's heuristic's denominator,
+/// [`MisHeuristic::denominator`](crate::env::MisHeuristic::denominator)) of up to [`BATCH`]
+/// directions drawn by the first technique to `sum`, one by one (the same order and rounding however the points are batched).
 fn add_drawn<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
     sp: &ShadingPoint<'_, B>,
@@ -216,12 +218,13 @@ fn add_drawn<B: Brdf + ?Sized>(
     let evaluated = evaluate_drawn(sp, drawn);
     for (d, (b, p_brdf)) in drawn.iter().zip(evaluated) {
         if let Some(DirectionSample { dir, uv, pdf: p }) = *d {
-            *sum += weighted(times(env_h.radiance_at(uv), b), c_d * p + c_b * p_brdf, vis, dir);
+            let pdf = env_h.mis_heuristic().denominator(c_d * p, c_b * p_brdf);
+            *sum += weighted(times(env_h.radiance_at(uv), b), pdf, vis, dir);
         }
     }
 }
 
-/// Adds f·V / (c_b·p_brdf + c_d·p_drawn) of up to [`BATCH`] BRDF samples to `sum`, the first
+/// Adds f·V / (c_b·p_brdf + c_d·p_drawn) (as [`add_drawn`]) of up to [`BATCH`] BRDF samples to `sum`, the first
 /// technique's densities at their points by `pdf_square_many`.
 fn add_brdf<B: Brdf + ?Sized>(
     env_h: &EnvHierarchy<'_>,
@@ -235,7 +238,7 @@ fn add_brdf<B: Brdf + ?Sized>(
     let (brdf, p_drawn) = brdf_draws(env_h, sp, u_brdf, pdf_square_many);
     for (b, p_square) in brdf[..u_brdf.len().min(BATCH)].iter().zip(p_drawn) {
         if let Some((dir, uv, s)) = *b {
-            let p = c_b * s.pdf + c_d * (p_square / SPHERE_AREA);
+            let p = env_h.mis_heuristic().denominator(c_b * s.pdf, c_d * (p_square / SPHERE_AREA));
             *sum += weighted(times(env_h.radiance_at(uv), s.value), p, vis, dir);
         }
     }

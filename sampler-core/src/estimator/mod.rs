@@ -160,7 +160,8 @@ pub fn sampled_mis_drawn<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     mis_with_brdf(sampler.env(), sp, drawn, |uv| sampler.pdf_square(uv), u_brdf, vis)
 }
 
-/// Balance-heuristic MIS of one direction `drawn` (direction, point of the square, density) by
+/// MIS (by the view's heuristic, [`EnvHierarchy::mis_heuristic`]) of one direction `drawn`
+/// (direction, point of the square, density) by
 /// a technique whose density per unit square area is `pdf_square`, and one BRDF sample. The
 /// BRDF sample's point of the square is computed once, for its radiance and the other density.
 fn mis_with_brdf<B: Brdf + ?Sized>(
@@ -178,7 +179,7 @@ fn mis_with_brdf<B: Brdf + ?Sized>(
     [first, mis_brdf_half(env_h, (dir, uv, s), pdf_square(uv) / SPHERE_AREA, vis)]
 }
 
-/// The balance-heuristic share of a direction drawn by the other technique (direction, point
+/// The MIS share of a direction drawn by the other technique (direction, point
 /// of the square, density).
 #[inline]
 fn mis_drawn_half<B: Brdf + ?Sized>(
@@ -200,10 +201,11 @@ pub(crate) fn drawn_half(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let f = times(env_h.radiance_at(uv), b);
-    Contribution { dir, value: weighted(f, p + p_brdf, vis, dir), pdf: p, other_pdf: p_brdf }
+    let pdf = env_h.mis_heuristic().denominator(p, p_brdf);
+    Contribution { dir, value: weighted(f, pdf, vis, dir), pdf: p, other_pdf: p_brdf }
 }
 
-/// The balance-heuristic share of a BRDF sample (world direction, its point of the square, the
+/// The MIS share of a BRDF sample (world direction, its point of the square, the
 /// draw), where the other technique's density is `p_other`.
 #[inline]
 pub(crate) fn mis_brdf_half(
@@ -213,7 +215,8 @@ pub(crate) fn mis_brdf_half(
     vis: &mut impl Visibility,
 ) -> Contribution {
     let f = times(env_h.radiance_at(uv), s.value);
-    Contribution { dir, value: weighted(f, s.pdf + p_other, vis, dir), pdf: s.pdf, other_pdf: p_other }
+    let pdf = env_h.mis_heuristic().denominator(s.pdf, p_other);
+    Contribution { dir, value: weighted(f, pdf, vis, dir), pdf: s.pdf, other_pdf: p_other }
 }
 
 /// Resampled importance sampling (Talbot et al. 2005): `candidates.len()` candidates from the

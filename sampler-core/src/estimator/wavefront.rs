@@ -14,6 +14,7 @@
 
 use crate::brdf::{Brdf, BrdfSample};
 use crate::direction::{DirectionSample, DirectionSampler};
+use crate::env::MisHeuristic;
 use crate::estimator::{ShadingPoint, times};
 use crate::mapping::SPHERE_AREA;
 use core::ops::Range;
@@ -49,10 +50,12 @@ pub struct WaveSample {
 pub enum Weighting {
     /// One technique alone: f/p.
     Single,
-    /// The balance heuristic of one sample of each technique: f/(p_sampler + p_brdf).
-    Balance,
-    /// The multi-sample balance heuristic of a split budget, each technique's share of the
-    /// shading point's samples: f/(c_sampler·p_sampler + c_brdf·p_brdf).
+    /// One sample of each technique, weighed by the sampler's view's heuristic
+    /// ([`MisHeuristic`]): f/(p_sampler + p_brdf) under the balance heuristic.
+    Pairs,
+    /// The multi-sample heuristic of a split budget, each technique's share of the shading
+    /// point's samples scaling its density: f/(c_sampler·p_sampler + c_brdf·p_brdf) under the
+    /// balance heuristic.
     Split {
         /// The sampler's share c_sampler.
         sampler: f32,
@@ -95,14 +98,21 @@ pub fn wavefront<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
     weighting: Weighting,
     out: &mut [Candidate],
 ) {
+    // One copy of the wave per heuristic: the choice is made once, not per sample.
+    let power = sampler.env().mis_heuristic() == MisHeuristic::Power;
     for (s, o) in samples.chunks(WAVE).zip(out.chunks_mut(WAVE)) {
         let n = s.len().min(o.len());
-        wave(sampler, points, &s[..n], weighting, &mut o[..n]);
+        if power {
+            wave::<S, B, true>(sampler, points, &s[..n], weighting, &mut o[..n]);
+        } else {
+            wave::<S, B, false>(sampler, points, &s[..n], weighting, &mut o[..n]);
+        }
     }
 }
 
-/// [`wavefront`] of at most [`WAVE`] samples.
-fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
+/// [`wavefront`] of at most [`WAVE`] samples, MIS weighing by the power heuristic where
+/// `POWER`, else by the balance heuristic.
+fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized, const POWER: bool>(
     sampler: &S,
     points: &[ShadingPoint<'_, B>],
     samples: &[WaveSample],
@@ -111,6 +121,7 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
 ) {
     let n = samples.len().min(WAVE);
     let env = sampler.env();
+    let heuristic = if POWER { MisHeuristic::Power } else { MisHeuristic::Balance };
     // Each technique's samples in order, split in one pass.
     let (mut u_brdf, mut brdf_points, mut n_brdf) = ([Vec2::ZERO; WAVE], [0usize; WAVE], 0);
     let (mut u_sampler, mut sampler_points, mut n_sampler) = ([DVec2::ZERO; WAVE], [0usize; WAVE], 0);
@@ -171,14 +182,20 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized>(
                 i_sampler += 1;
                 drawn[k].map_or(Candidate::default(), |d| {
                     let (x, y) = texels_drawn[k];
-                    sampler_candidate(&points[s.point], d, env.radiance_texel(x, y), evaluated[k], weighting)
+                    sampler_candidate(
+                        &points[s.point],
+                        d,
+                        env.radiance_texel(x, y),
+                        evaluated[k],
+                        (weighting, heuristic),
+                    )
                 })
             }
             Technique::Brdf => {
                 let k = i_brdf;
                 i_brdf += 1;
                 brdf[k].map_or(Candidate::default(), |b| {
-                    brdf_candidate(b, dirs[k], radiance_brdf[k], p_square[k], weighting)
+                    brdf_candidate(b, dirs[k], radiance_brdf[k], p_square[k], (weighting, heuristic))
                 })
             }
         };
@@ -253,36 +270,43 @@ fn runs<'a>(owners: &'a [usize], same: impl Fn(usize, usize) -> bool + 'a) -> im
 }
 
 /// The candidate of the BRDF's draw `b` in world direction `dir`, where the map's radiance is
-/// `radiance` and, under MIS, the sampler's density in the square is `p_square`.
+/// `radiance` and, under MIS (weighed by `heuristic`), the sampler's density in the square is
+/// `p_square`.
 #[inline(always)]
-fn brdf_candidate(b: BrdfSample, dir: Vec3, radiance: Vec3, p_square: f32, weighting: Weighting) -> Candidate {
+fn brdf_candidate(
+    b: BrdfSample,
+    dir: Vec3,
+    radiance: Vec3,
+    p_square: f32,
+    (weighting, heuristic): (Weighting, MisHeuristic),
+) -> Candidate {
     let f = times(radiance, b.value);
     let p_other = p_square / SPHERE_AREA;
     let pdf = match weighting {
         Weighting::Single => b.pdf,
-        Weighting::Balance => b.pdf + p_other,
-        Weighting::Split { sampler, brdf } => brdf * b.pdf + sampler * p_other,
+        Weighting::Pairs => heuristic.denominator(b.pdf, p_other),
+        Weighting::Split { sampler, brdf } => heuristic.denominator(brdf * b.pdf, sampler * p_other),
     };
     Candidate::new(f, pdf, dir)
 }
 
 /// The candidate of a direction the sampler drew at `sp`, where the map's radiance is
 /// `radiance` and, under MIS, the BRDF × cos and the BRDF's density there are `evaluated`.
-#[inline]
+#[inline(always)]
 fn sampler_candidate<B: Brdf + ?Sized>(
     sp: &ShadingPoint<'_, B>,
     d: DirectionSample,
     radiance: Vec3,
     evaluated: (Vec3, f32),
-    weighting: Weighting,
+    (weighting, heuristic): (Weighting, MisHeuristic),
 ) -> Candidate {
     if weighting == Weighting::Single {
         return Candidate::new(times(radiance, sp.eval(d.dir)), d.pdf, d.dir);
     }
     let (b, p_brdf) = evaluated;
     let pdf = match weighting {
-        Weighting::Split { sampler, brdf } => sampler * d.pdf + brdf * p_brdf,
-        _ => d.pdf + p_brdf,
+        Weighting::Split { sampler, brdf } => heuristic.denominator(sampler * d.pdf, brdf * p_brdf),
+        _ => heuristic.denominator(d.pdf, p_brdf),
     };
     Candidate::new(times(radiance, b), pdf, d.dir)
 }

@@ -11,7 +11,7 @@ mod units;
 use crate::common::*;
 use glam::{DVec2, Vec2, Vec3};
 use sampler_core::brdf::{Brdf, CarPaint, Lambert, Phong, RoughConductor};
-use sampler_core::env::{EnvHierarchy, luminance};
+use sampler_core::env::{EnvHierarchy, MisHeuristic, luminance};
 use sampler_core::estimator::{self, ShadingPoint, luminance64};
 use sampler_core::frame::Frame;
 use sampler_core::points::sobol02;
@@ -132,11 +132,17 @@ fn check(label: &str, (reference, quadrature_error): (f64, f64), stats: &Stats, 
 
 fn run(label: &str) {
     let env = environment();
-    // The MIS estimators as the renderer runs them: env samples from the compensated density.
-    let (estimator, e) = match label.strip_suffix(", compensated") {
-        Some(plain) => (plain, env.compensated_view()),
-        None => (label, env.view()),
+    // The MIS estimators as the renderer runs them: env samples from the compensated density,
+    // weighed by the balance heuristic or, with ", power", the power heuristic.
+    let (label_h, heuristic) = match label.strip_suffix(", power") {
+        Some(rest) => (rest, MisHeuristic::Power),
+        None => (label, MisHeuristic::Balance),
     };
+    let (estimator, e) = match label_h.strip_suffix(", compensated") {
+        Some(plain) => (plain, env.compensated_view()),
+        None => (label_h, env.view()),
+    };
+    let e = e.with_mis_heuristic(heuristic);
     assert!(env.compensated.is_some(), "the test map has texels above its mean");
     let mut failures = Vec::new();
     let mut arena: Box<ProductArena> = Box::new(ProductArena::new());
@@ -162,7 +168,7 @@ fn run(label: &str) {
             // Compensated, the env samples leave the map's dim parts to the BRDF samples: a needle
             // lobe whose mirror direction is occluded is then found only through the GGX tail's
             // rare BRDF samples (heavy-tailed, though bounded by L / c_brdf), so it draws more.
-            "mis split 3:1" => (0..if label.ends_with("compensated") { 80_000 } else { 20_000 })
+            "mis split 3:1" => (0..if label_h.ends_with("compensated") { 80_000 } else { 20_000 })
                 .map(|_| {
                     // Env-heavy MIS, as `auto` runs it on diffuse surfaces under extended light.
                     let pts: Vec<DVec2> = (0..12).map(|_| u()).collect();
@@ -297,4 +303,19 @@ fn mis_estimator_with_the_compensated_density_is_unbiased() {
 #[test]
 fn mis_split_with_the_compensated_density_is_unbiased() {
     run("mis split 3:1, compensated");
+}
+
+/// The power heuristic, in pairs (one by one and batched), with a split budget and under the
+/// product: each sample's weights still sum to one over the techniques.
+#[test]
+fn mis_with_the_power_heuristic_is_unbiased() {
+    run("mis, compensated, power");
+    run("mis batched, compensated, power");
+    run("mis split 3:1, compensated, power");
+}
+
+#[test]
+fn product_mis_with_the_power_heuristic_is_unbiased() {
+    run("product-mis, power");
+    run("product-mis split 3:1, power");
 }

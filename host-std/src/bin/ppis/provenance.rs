@@ -13,18 +13,20 @@ use clap::ValueEnum;
 use host_std::light::lights::LightSelection;
 use host_std::plan::Settings;
 use host_std::plan::carrier::Carrier;
+use sampler_core::env::MisHeuristic;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// The settings text for a render of a `width`×`height` frame of a scene that reads `files`
 /// besides its own file, its distant lights with an angle carried by `carrier` (the one `auto`
-/// chose: the same pixels whether chosen or given; `None` where nothing is carried).
+/// chose: the same pixels whether chosen or given; `None` where nothing is carried) and MIS
+/// weighing by `heuristic` (given or chosen by the split pilot).
 pub(crate) fn settings_text(
     args: &RenderArgs,
     settings: &Settings,
     frame: (usize, usize),
     files: &[PathBuf],
-    carrier: Option<Carrier>,
+    (carrier, heuristic): (Option<Carrier>, MisHeuristic),
 ) -> Result<String> {
     let scene = &args.scene;
     let mut lines: Vec<(&str, String)> = vec![("ppis", env!("CARGO_PKG_VERSION").to_string())];
@@ -66,6 +68,7 @@ pub(crate) fn settings_text(
     lines.push(("lightcut_error", lights.lightcut_error.to_string()));
     let carrier = carrier.and_then(|c| c.to_possible_value()).map(|v| v.get_name().to_string());
     lines.push(("distant_carrier", carrier.unwrap_or_default()));
+    lines.push(("mis_heuristic", crate::render_cmd::heuristic_name(heuristic).into()));
     // By name and content, not by folder or order: the same inputs on any machine.
     let own = scene.scene.as_ref().and_then(|p| p.canonicalize().ok());
     let mut reads = Vec::new();

@@ -15,6 +15,7 @@ use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
 use host_std::render::crop::Crop;
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
+use sampler_core::env::MisHeuristic;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -39,6 +40,11 @@ pub(crate) struct RenderArgs {
     pub(crate) brdf_samples: Option<u32>,
     #[command(flatten)]
     pub(crate) sampling: SamplingArgs,
+    /// How MIS weighs a sample against the other technique's density: `balance`, `power`
+    /// (Veach's heuristics) or `pilot` (whichever the split pilot measures better, where it
+    /// runs: the MIS methods other than `auto` from 128 spp; the balance heuristic elsewhere).
+    #[arg(long, value_enum, value_name = "balance|power|pilot", default_value = "pilot")]
+    pub(crate) mis_heuristic: HeuristicArg,
     /// Output EXR; a PNG is written beside it. Default: render.exr in the current folder.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
@@ -99,14 +105,16 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     let carries = prepared.environment.is_some() && carrier::has_wide_distant_light(&prepared.scene);
     let carrier = pool.install(|| carry_distant_lights(args.sampling.carrier(), &mut prepared, &settings, points));
     let hierarchy = prepared.environment.as_ref().map(Environment::hierarchy);
-    let prepass = pool.install(|| Prepass::run(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, points));
+    let heuristic = args.mis_heuristic.given();
+    let prepass =
+        pool.install(|| Prepass::run(&prepared.scene, &prepared.bvh, hierarchy.as_ref(), &settings, points, heuristic));
     let shading_points = prepass.shading_points as u32;
     settings.shading_points = prepass.shading_points;
     let camera = &prepared.scene.camera;
     let frame = (camera.width as usize, camera.height as usize);
     let crop = prepared.crop;
     let used = carries.then(|| carrier.as_ref().map_or(args.sampling.carrier(), |c| c.carrier));
-    let record = provenance::settings_text(&args, &settings, frame, &prepared.files, used)?;
+    let record = provenance::settings_text(&args, &settings, frame, &prepared.files, (used, prepass.mis_heuristic))?;
     let view = hierarchy.as_ref().map(|h| prepass.view(h));
     let mut image = pool.install(|| plan::render_crop(&prepared.scene, &prepared.bvh, view.as_ref(), &settings, crop));
     // The pilots and the prepass are part of the render's cost.
@@ -149,7 +157,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     }
     if let Some(c) = &prepass.split {
         eprintln!(
-            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}; {:.2} s)",
+            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}{}; {:.2} s)",
             c.samples_per_point,
             c.pixels,
             c.pilot_spp,
@@ -157,8 +165,13 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
             c.candidates[0],
             c.scores[1],
             c.candidates[1],
+            c.power_score
+                .map_or(String::new(), |p| format!(", {p:.3e} at {} by the power heuristic", c.samples_per_point)),
             c.seconds
         );
+        if c.power_score.is_some() {
+            eprintln!("ppis: MIS heuristic: {}", heuristic_name(c.heuristic));
+        }
     }
     report_pilot(&prepared.scene, &image);
     if image.non_finite > 0 {
@@ -263,4 +276,34 @@ fn check_writable(path: &Path) -> Result<()> {
         bail!("{}: the output folder does not exist", path.display());
     }
     Ok(())
+}
+
+/// `--mis-heuristic`: one of Veach's heuristics, or the split pilot's choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum HeuristicArg {
+    /// The balance heuristic.
+    Balance,
+    /// The power heuristic (β = 2).
+    Power,
+    /// Whichever the split pilot measures better where it runs, else the balance heuristic.
+    Pilot,
+}
+
+impl HeuristicArg {
+    /// The heuristic given, `None` for the pilot's.
+    pub(crate) fn given(self) -> Option<MisHeuristic> {
+        match self {
+            Self::Balance => Some(MisHeuristic::Balance),
+            Self::Power => Some(MisHeuristic::Power),
+            Self::Pilot => None,
+        }
+    }
+}
+
+/// The heuristic's name, as `--mis-heuristic` spells it.
+pub(crate) fn heuristic_name(h: MisHeuristic) -> &'static str {
+    match h {
+        MisHeuristic::Balance => "balance",
+        MisHeuristic::Power => "power",
+    }
 }

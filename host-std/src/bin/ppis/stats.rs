@@ -80,6 +80,10 @@ struct SplitPilot {
     pilot_spp: usize,
     /// Per candidate samples per shading point, its variance × cost.
     scores: BTreeMap<usize, f64>,
+    /// The MIS heuristic the render weighed by (`balance` or `power`).
+    mis_heuristic: &'static str,
+    /// The chosen split's variance × cost under the power heuristic (`null`: not measured).
+    power_score: Option<f64>,
 }
 
 /// What `auto`'s pilot measured for one material.
@@ -160,6 +164,8 @@ impl Stats {
                 pilot_pixels: c.pixels,
                 pilot_spp: c.pilot_spp,
                 scores: c.candidates.into_iter().zip(c.scores).collect(),
+                mis_heuristic: crate::render_cmd::heuristic_name(c.heuristic),
+                power_score: c.power_score,
             }),
             spp: args.spp,
             threads,
