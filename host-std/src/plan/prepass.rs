@@ -1,8 +1,8 @@
 //! What a render plans once before its tiles: the MIS-compensated pyramid its env samples draw
 //! from (built once, so that the split pilot's renders and the render share it), the light
-//! samples per shading point and the MIS heuristic ([`split`]). The split's pilot is part of the render's cost: its
-//! time is added to the render's ([`Prepass::charge`]); the pyramid, like the map's own, is the
-//! map's preprocessing.
+//! samples per shading point and the MIS heuristic ([`split`]). The split's pilot is part of
+//! the render's cost: its time is added to the render's ([`Prepass::charge`]); the pyramid,
+//! like the map's own, is the map's preprocessing.
 
 use crate::light::map_buffer::MapBuffer;
 use crate::plan::method::Lighting;
