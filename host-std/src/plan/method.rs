@@ -38,6 +38,9 @@ pub enum Method {
     /// lights in a light tree, a cut per shading point under a relative error bound.
     /// Deterministic and biased.
     Lightcuts,
+    /// On diffuse planes, the map × the plane's cosine, sampled from a pyramid per plane
+    /// (`render::plane_products`); everything else MIS pairs.
+    PlaneProduct,
     /// Per material, the strategy of `auto`'s rules ([`rules::auto_strategy`]), checked by a
     /// pilot render of the material's pixels that replaces it where another measures
     /// [`OVERRIDE_MARGIN`](crate::plan::pilot::OVERRIDE_MARGIN)× as good (`plan::pilot`).
@@ -46,7 +49,7 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order `--help` lists them.
-    pub const ALL: [Method; 13] = [
+    pub const ALL: [Method; 14] = [
         Method::Product,
         Method::Wavelet,
         Method::Env,
@@ -59,6 +62,7 @@ impl Method {
         Method::TwoLevelMis,
         Method::Sis,
         Method::Lightcuts,
+        Method::PlaneProduct,
         Method::Auto,
     ];
 
@@ -87,6 +91,7 @@ impl Method {
             Method::TwoLevelMis => "two-level-mis",
             Method::Sis => "sis",
             Method::Lightcuts => "lightcuts",
+            Method::PlaneProduct => "plane-product",
             Method::Auto => "auto",
         }
     }
@@ -107,7 +112,7 @@ impl Method {
         match self {
             Method::Env | Method::Brdf | Method::Ris => 1,
             Method::Sis | Method::Lightcuts => 64,
-            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::Auto => 4,
+            Method::Mis | Method::ProductMis | Method::TwoLevelMis | Method::PlaneProduct | Method::Auto => 4,
             Method::TwoLevel => 2,
             Method::TwoStage => 4,
             Method::Product | Method::Wavelet => 16,
@@ -144,6 +149,8 @@ impl Method {
             Method::TwoLevelMis => Strategy::TwoLevelMis { two_level_share: 0.5 },
             Method::Sis => Strategy::Sis,
             Method::Lightcuts => Strategy::Lightcuts,
+            Method::PlaneProduct if bsdf.as_brdf().is_diffuse() => Strategy::PlaneProduct,
+            Method::PlaneProduct => Strategy::Mis { env_share: 0.5 },
             Method::Auto => rules::auto_strategy(bsdf, env_peak),
         }
     }
@@ -164,6 +171,7 @@ impl Method {
             Strategy::TwoLevelMis { .. } => Method::TwoLevelMis,
             Strategy::Sis => Method::Sis,
             Strategy::Lightcuts => Method::Lightcuts,
+            Strategy::PlaneProduct => Method::PlaneProduct,
         }
     }
 

@@ -23,7 +23,8 @@ use crate::light::lights::{LightOptions, LightTable};
 use crate::light::map_buffer::MapBuffer;
 use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
-use crate::render::strategy::MaterialPlan;
+use crate::render::plane_products::{PlaneProducts, on_planes_only};
+use crate::render::strategy::{MaterialPlan, Strategy};
 use crate::render::tiles::render_tiles;
 use crate::render::{Context, Lightcuts, Options, budgets, compensated_pyramid, summed_area_table, two_level_cones};
 use crate::scene::Scene;
@@ -144,7 +145,16 @@ fn material_plans(scene: &Scene, env: Option<&EnvHierarchy<'_>>, settings: &Sett
     let plans = scene
         .materials
         .iter()
-        .map(|m| MaterialPlan::new(settings.method.strategy(&m.bsdf, env_peak), &m.bsdf, settings.brdf_samples))
+        .enumerate()
+        .map(|(i, m)| {
+            let strategy = match settings.method {
+                Method::Auto if rules::samples_plane_product(&m.bsdf, on_planes_only(scene, i)) => {
+                    Strategy::PlaneProduct
+                }
+                method => method.strategy(&m.bsdf, env_peak),
+            };
+            MaterialPlan::new(strategy, &m.bsdf, settings.brdf_samples)
+        })
         .collect();
     (env_peak, plans)
 }
@@ -179,6 +189,9 @@ pub fn render_crop(
     // The summed-area table exists only for the strategy that reads it.
     let sat = env.and_then(|e| summed_area_table(e, &plans));
     let cones = env.and_then(|e| two_level_cones(e, &plans, env_peak < rules::SUN_PEAK));
+    let planes = env.and_then(|e| {
+        PlaneProducts::of_scene(scene, e.finest_level(), |m| plans[m].strategy == Strategy::PlaneProduct)
+    });
     let camera = Camera::new(&scene.camera);
     let options = settings.options();
     let baselines = Baselines::build(scene, env, settings);
@@ -196,6 +209,7 @@ pub fn render_crop(
         cones: cones.as_ref(),
         strata: baselines.strata.as_deref(),
         lightcuts: cut_tree.as_ref(),
+        planes: planes.as_ref(),
         camera: &camera,
         options: &options,
         plans: &plans,

@@ -150,6 +150,7 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
         | Strategy::TwoStage
         | Strategy::TwoLevel
         | Strategy::Sis
+        | Strategy::PlaneProduct
         | Strategy::Lightcuts => false,
     }
 }
@@ -220,7 +221,7 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
     // twice.
     let v = samples_per_point(ctx.options);
     let tasks: Vec<(usize, usize)> = (0..materials)
-        .filter(|&m| found[m].len() >= MIN_PIXELS)
+        .filter(|&m| found[m].len() >= MIN_PIXELS && ctx.plans[m].strategy != Strategy::PlaneProduct)
         .flat_map(|m| {
             let bsdf = &ctx.scene.materials[m].bsdf;
             (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))

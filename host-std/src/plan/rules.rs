@@ -67,6 +67,16 @@ pub fn auto_strategy(bsdf: &Bsdf, env_peak: f32) -> Strategy {
     }
 }
 
+/// Whether `auto` samples a material of `bsdf` whose objects are all flat (`on_planes`) by the
+/// plane product (`render::plane_products`): where the BRDF is diffuse, whatever the map. There
+/// the product of the map and the plane's cosine is exact, so env-only sampling of it leaves
+/// only visibility to vary the estimate, at env sampling's cost; it has no candidate in the
+/// pilot (docs/perf.md, "Plane products").
+#[must_use]
+pub fn samples_plane_product(bsdf: &Bsdf, on_planes: bool) -> bool {
+    on_planes && bsdf.as_brdf().is_diffuse()
+}
+
 /// The share of a material's product-MIS budget spent on product samples (the rest are BRDF
 /// samples; see [`WIDE_LOBE_PRODUCT_SHARE`]).
 #[must_use]

@@ -13,6 +13,7 @@
 pub mod brdf_samples;
 pub mod crop;
 pub mod pixel;
+pub mod plane_products;
 pub mod product_arena;
 pub mod sampler_cache;
 pub mod shade;
@@ -75,6 +76,8 @@ pub struct Context<'a, 'e> {
     /// Lightcuts' tree, when the method is Lightcuts: it then shades the environment and the
     /// lights it holds at every shading point, in place of the environment's estimators.
     pub lightcuts: Option<&'a Lightcuts<'a>>,
+    /// The pyramids of the planes whose materials sample the plane product, where any does.
+    pub planes: Option<&'a plane_products::PlaneProducts>,
     /// The camera.
     pub camera: &'a Camera,
     /// How pixels are sampled.
@@ -140,12 +143,15 @@ pub fn two_level_cones(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], extended:
 }
 
 /// The MIS-compensated pyramid of `env` ([`EnvHierarchy::compensated`]), built when a plan
-/// samples MIS or two-level-MIS (whose cells it compensates) or `auto`'s pilot may choose
-/// them, and `env` has none attached; `None` also where nothing of the map stands above its
+/// samples MIS, two-level-MIS (whose cells it compensates) or the plane product (MIS off its
+/// planes), or `auto`'s pilot may choose them, and `env` has none attached; `None` also where nothing of the map stands above its
 /// mean (the plain pyramid then serves MIS).
 #[must_use]
 pub fn compensated_pyramid(env: &EnvHierarchy<'_>, plans: &[MaterialPlan], pilot: bool) -> Option<MapBuffer<f32>> {
-    let mis = pilot || plans.iter().any(|p| matches!(p.strategy, Strategy::Mis { .. } | Strategy::TwoLevelMis { .. }));
+    let mis = pilot
+        || plans.iter().any(|p| {
+            matches!(p.strategy, Strategy::Mis { .. } | Strategy::TwoLevelMis { .. } | Strategy::PlaneProduct)
+        });
     if !mis || env.has_compensated() {
         return None;
     }

@@ -39,6 +39,9 @@ pub(crate) struct Hit {
     pub origin: Vec3,
     /// The hit's material.
     pub material: usize,
+    /// The plane whose product it samples (`Context::planes`), where its material samples
+    /// the plane product and it lies on one of the scene's planes.
+    pub plane: Option<usize>,
     /// The shading point's index in the pixel.
     pub index: usize,
 }
@@ -219,6 +222,10 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material: usize, in
         return None;
     }
     let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
+    let plane = match (ctx.planes, ctx.plans[material].strategy) {
+        (Some(planes), Strategy::PlaneProduct) => planes.find(ns),
+        _ => None,
+    };
     Some(Hit {
         frame: Frame::from_normal(ns),
         wo,
@@ -228,6 +235,7 @@ fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material: usize, in
         },
         origin: hit.point + n * eps,
         material,
+        plane,
         index,
     })
 }
@@ -261,7 +269,12 @@ fn sample_light(
         let budget = ctx.plans[group].env_budget.unwrap_or(budget);
         let lead_sp = shading_point(ctx.scene, lead);
         let seed = hash_combine(seeds.pixel, 0xb5df ^ (group as u64) << 20);
-        let sampling = cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed });
+        // A plane's points sample its product: env-only sampling of the plane's view.
+        let plane_view = lead.plane.zip(ctx.planes).map(|(k, planes)| planes.view(env, k));
+        let (env, sampling) = match &plane_view {
+            Some(view) => (view, Sampling::Env),
+            None => (env, cache.sampling(ctx, env, &Lead { hit: lead, sp: &lead_sp, seed })),
+        };
         let m = members_of(hits, first, &mut buffers.members);
         let mut rays = 0u64;
         let shaded = if wavefront::fits(&sampling, budget) {
@@ -327,14 +340,14 @@ fn shade_members(
         .map_or(0, |r| r as u64)
 }
 
-/// Writes the indices of the hits of `hits[first]`'s material from `first` on (in order) to
-/// `members` and returns their count: the points a wavefront or a shared sampler shades
-/// together.
+/// Writes the indices of the hits of `hits[first]`'s material (and plane) from `first` on (in
+/// order) to `members` and returns their count: the points a wavefront or a shared sampler
+/// shades together.
 fn members_of(hits: &[Hit], first: usize, members: &mut [usize; GROUP]) -> usize {
-    let material = hits[first].material;
+    let (material, plane) = (hits[first].material, hits[first].plane);
     let mut m = 0;
     for (k, h) in hits.iter().enumerate().skip(first) {
-        if h.material == material {
+        if h.material == material && h.plane == plane {
             members[m] = k;
             m += 1;
         }

@@ -131,6 +131,8 @@ impl SamplerCache {
             Strategy::Sis => {
                 Sampling::Sis(ctx.strata.expect("the strata are built when a material is shaded with SIS"))
             }
+            // Points on a plane sample its pyramid (`pixel::sample_light`); the rest, MIS pairs.
+            Strategy::PlaneProduct => Sampling::Mis { env_share: 0.5, sampler: env.compensated() },
             Strategy::Lightcuts => {
                 unreachable!("Lightcuts shades through shade_cuts, never the environment's estimators")
             }

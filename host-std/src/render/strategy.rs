@@ -49,6 +49,10 @@ pub enum Strategy {
     /// Structured importance sampling: every stratum of the map a directional light
     /// ([`Context::strata`](crate::render::Context::strata)).
     Sis,
+    /// On planes (`render::plane_products`), env-only sampling ∝ the map × the plane's cosine,
+    /// from a pyramid per plane built once: the product a diffuse plane integrates, exactly.
+    /// Shading points off the scene's planes sample as MIS pairs.
+    PlaneProduct,
     /// Lightcuts: a cut through the light tree per shading point
     /// ([`Context::lightcuts`](crate::render::Context::lightcuts)), covering the map and the
     /// point lights.

@@ -19,7 +19,8 @@
 //! `lanes_avx2.rs`); with a
 //! texel table (`texel_cdf.rs`) attached, env-only sampling skips the descent. MIS with BRDF
 //! samples draws from a compensated pyramid (`compensation.rs`) where one is attached, and weighs
-//! its samples by the view's heuristic (`mis_heuristic.rs`).
+//! its samples by the view's heuristic (`mis_heuristic.rs`). A Lambertian plane samples the map
+//! times its cosine through a pyramid of its own (`plane.rs`).
 
 mod compensation;
 mod density;
@@ -34,6 +35,7 @@ mod lanes_avx2;
 #[cfg(target_arch = "x86_64")]
 mod lanes_avx2_ops;
 mod mis_heuristic;
+mod plane;
 mod pyramid;
 mod sample;
 mod texel_cdf;

@@ -131,6 +131,15 @@ pub fn cell_cone(cell: Cell) -> Cone {
     Cone::new(axis, widest + 0.5 * STRETCH * step + SLACK)
 }
 
+/// A half-angle within which every direction of a cell of `level` lies around its centre's
+/// direction: [`STRETCH`] times half the cell's diagonal, plus the rounding slack. Coarser than
+/// [`cell_cone`]'s measured angle, and free to compute.
+#[must_use]
+pub fn cell_radius_bound(level: u32) -> f32 {
+    let size = 1.0 / (1u32 << level) as f32;
+    0.5 * STRETCH * core::f32::consts::SQRT_2 * size + SLACK
+}
+
 /// Fills `out` (length `4^level`, Morton order like the pyramid's levels) with every cell's
 /// [`cell_cone`]. Returns false, writing nothing, when the length is not a power of four.
 pub fn build_cell_cones(out: &mut [Cone]) -> bool {
@@ -190,6 +199,24 @@ mod tests {
                         assert!(angle <= cone.angle - 0.5 * SLACK, "level {level} cell ({x}, {y}): {angle} > {cone:?}");
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn the_radius_bound_holds_every_direction_of_a_cell_around_its_centre() {
+        let mut rng = Pcg32::new(5, 6);
+        for level in [2u32, 5, 8, 10, 12] {
+            let (n, bound) = (1u32 << level, cell_radius_bound(level));
+            for _ in 0..20_000 {
+                let (x, y) = (rng.next_u32() % n, rng.next_u32() % n);
+                let corner = Vec2::new(x as f32, y as f32);
+                let centre = square_to_sphere((corner + Vec2::splat(0.5)) / n as f32);
+                // Corners and edges too, where the angle is largest.
+                let xi = Vec2::new(rng.next_f32(), rng.next_f32()).map(|v| if v < 0.2 { 0.0 } else { v });
+                let d = square_to_sphere((corner + xi) / n as f32);
+                let angle = libm::atan2f(centre.cross(d).length(), centre.dot(d));
+                assert!(angle <= bound - 0.5 * SLACK, "level {level} cell ({x}, {y}): {angle} > {bound}");
             }
         }
     }

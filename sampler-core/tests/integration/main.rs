@@ -21,6 +21,7 @@ mod light_tree;
 mod lights;
 mod mapping;
 mod pdf_integral;
+mod plane_product;
 mod stability_matrix;
 mod two_level;
 mod two_stage;
