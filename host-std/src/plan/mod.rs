@@ -148,7 +148,7 @@ fn material_plans(scene: &Scene, env: Option<&EnvHierarchy<'_>>, settings: &Sett
         .enumerate()
         .map(|(i, m)| {
             let strategy = match settings.method {
-                Method::Auto if rules::samples_plane_product(&m.bsdf, on_planes_only(scene, i)) => {
+                Method::Auto if rules::samples_plane_product(&m.bsdf, on_planes_only(scene, i), env_peak) => {
                     Strategy::PlaneProduct
                 }
                 method => method.strategy(&m.bsdf, env_peak),

@@ -68,13 +68,15 @@ pub fn auto_strategy(bsdf: &Bsdf, env_peak: f32) -> Strategy {
 }
 
 /// Whether `auto` samples a material of `bsdf` whose objects are all flat (`on_planes`) by the
-/// plane product (`render::plane_products`): where the BRDF is diffuse, whatever the map. There
-/// the product of the map and the plane's cosine is exact, so env-only sampling of it leaves
-/// only visibility to vary the estimate, at env sampling's cost; it has no candidate in the
-/// pilot (docs/perf.md, "Plane products").
+/// plane product (`render::plane_products`), under a map of peak `env_peak`: where the BRDF is
+/// diffuse and the light extended (`env_peak` below [`SUN_PEAK`]). There the product of the
+/// map and the plane's cosine is exact, so env-only sampling of it leaves only visibility to
+/// vary the estimate, at env sampling's cost, and such a material has no pilot. Under a sun
+/// nearly every sample goes to the sun, and in a shadow the sky's light is left to rare
+/// samples, which BRDF samples find more often (docs/perf.md, "Plane products").
 #[must_use]
-pub fn samples_plane_product(bsdf: &Bsdf, on_planes: bool) -> bool {
-    on_planes && bsdf.as_brdf().is_diffuse()
+pub fn samples_plane_product(bsdf: &Bsdf, on_planes: bool, env_peak: f32) -> bool {
+    on_planes && env_peak < SUN_PEAK && bsdf.as_brdf().is_diffuse()
 }
 
 /// The share of a material's product-MIS budget spent on product samples (the rest are BRDF
@@ -163,6 +165,16 @@ mod tests {
         assert_eq!(auto_env_share(&diffuse, 713.0), 0.5, "sun");
         assert_eq!(auto_env_share(&conductor(0.01), 21.0), 0.5, "sharp lobe");
         assert_eq!(Method::Mis.strategy(&diffuse, 21.0), Strategy::Mis { env_share: 0.5 }, "--method mis: pairs");
+    }
+
+    #[test]
+    fn auto_samples_the_plane_product_on_diffuse_planes_under_extended_light() {
+        let diffuse = Bsdf::Diffuse(Lambert::new(Vec3::ONE));
+        assert!(samples_plane_product(&diffuse, true, 21.0));
+        assert!(samples_plane_product(&diffuse, true, 1.6), "smooth light too");
+        assert!(!samples_plane_product(&diffuse, false, 21.0), "not only on planes");
+        assert!(!samples_plane_product(&diffuse, true, 713.0), "a sun");
+        assert!(!samples_plane_product(&conductor(0.1), true, 21.0), "glossy");
     }
 
     #[test]

@@ -238,20 +238,35 @@ fn the_environment_lights_and_brdf_samples_together_shade_their_closed_form() {
 #[test]
 fn a_diffuse_plane_samples_the_map_times_its_cosine_with_no_noise_but_the_texels() {
     // Nothing shadows the plane: the plane product's estimate varies only by the cosine's
-    // spread within the sampled texels, MIS's by how the map and the cosine differ.
-    let env = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
+    // spread within the sampled texels, MIS's by how the map and the cosine differ. A soft box
+    // 40× the sky above the plane (+z) on one side: extended light, which `auto` samples by the
+    // plane product; under the built-in sky's sun it samples MIS.
+    let tmp = tempfile::Builder::new().prefix("ppis-plane-").tempdir().unwrap();
+    let path = tmp.path().join("softbox.exr");
+    exr::prelude::write_rgb_file(&path, 512, 256, |x, y| {
+        let v = if (80..144).contains(&x) && (48..88).contains(&y) { 40.0 } else { 1.0 };
+        (v, v, v)
+    })
+    .unwrap();
     let scene = plane_under(Vec::new());
     let bvh = Bvh::build(&scene);
-    let stats = |method: Method| {
+    let stats = |env: &Environment, method: Method| {
         let pixels = render(&scene, &bvh, Some(&env.hierarchy()), &settings(method, 16)).pixels;
         let n = pixels.len() as f64;
         let mean = pixels.iter().map(|p| p[1] as f64).sum::<f64>() / n;
         (mean, pixels.iter().map(|p| (p[1] as f64 - mean).powi(2)).sum::<f64>() / (n - 1.0))
     };
-    let (plane, mis, auto) = (stats(Method::PlaneProduct), stats(Method::Mis), stats(Method::Auto));
-    assert!((plane.0 - mis.0).abs() < 4.0 * ((plane.1 + mis.1) / 256.0).sqrt(), "{plane:?} against {mis:?}");
-    // A tenth of MIS's here (the sky's sun is a few texels, and the cosine spreads across
-    // them); the bound leaves room for the seed.
-    assert!(plane.1 < 0.25 * mis.1, "plane product's variance {} against MIS's {}", plane.1, mis.1);
-    assert_eq!(auto, plane, "auto samples a diffuse plane's product");
+    let softbox = Environment::build(&EnvSource::File(path), Placement::default()).unwrap();
+    let sky = Environment::build(&EnvSource::Sky { level: 8 }, Placement::default()).unwrap();
+    assert!(softbox.hierarchy().peak(5) < 100.0 && sky.hierarchy().peak(5) > 100.0, "extended light and a sun");
+    for (name, env) in [("soft box", &softbox), ("sky", &sky)] {
+        let (plane, mis) = (stats(env, Method::PlaneProduct), stats(env, Method::Mis));
+        let se = ((plane.1 + mis.1) / 256.0).sqrt();
+        assert!((plane.0 - mis.0).abs() < 4.0 * se, "{name}: {plane:?} against {mis:?}");
+        // The bound leaves room for the seed: a few per cent of MIS's under the soft box, a
+        // tenth under the sky, whose sun is a few texels that the cosine spreads across.
+        assert!(plane.1 < 0.25 * mis.1, "{name}: plane product's variance {} against MIS's {}", plane.1, mis.1);
+        let auto = stats(env, Method::Auto);
+        assert_eq!(auto, if name == "sky" { mis } else { plane }, "{name}: auto");
+    }
 }

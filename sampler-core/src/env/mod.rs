@@ -44,6 +44,7 @@ pub use compensation::compensate_pyramid;
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::{IN_FLIGHT, LANES, WarpLane};
 pub use mis_heuristic::MisHeuristic;
+pub use plane::COSINE_LEVEL;
 pub use pyramid::{
     EnvError, MAX_LEVEL, build_pyramid, build_pyramid_from_importance, level_offset, luminance, pyramid_index,
     pyramid_len, sanitize_rgb,

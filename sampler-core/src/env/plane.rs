@@ -10,13 +10,23 @@ use crate::cone::cell_radius_bound;
 use crate::mapping::square_to_sphere;
 use glam::{Vec2, Vec3};
 
+/// The level whose cell centres the cosine is evaluated at: texels of a coarser map average
+/// the cosine over their share of these points, texels of a finer one share their cell's. A
+/// 1024² grid holds the cosine to a few thousandths of its value away from the horizon, and
+/// bounds the work at a million directions whatever the map's size.
+pub const COSINE_LEVEL: u32 = 10;
+
 impl<'a> EnvHierarchy<'a> {
     /// Writes the plane importance of the finest level's rows `first_row ..` into `out` (whole
     /// rows, row-major) for Lambertian surfaces whose normal lies within `tolerance` radians of
-    /// the unit world direction `normal`. Each texel's luminance is weighted by
-    /// - its centre's cosine to `normal` where the texel lies wholly above the plane,
-    /// - the largest cosine within it where it straddles the horizon, so that every direction
-    ///   above the plane keeps a density > 0,
+    /// the unit world direction `normal`. Each texel's luminance is weighted by the cosine to
+    /// `normal` of the cell it is read at (the texel, or its cell of [`COSINE_LEVEL`] in a finer
+    /// map):
+    /// - where the cell lies wholly above the plane, the cosine's mean over the cell's points of
+    ///   [`COSINE_LEVEL`] (its centre's, in a map that fine or finer);
+    /// - where it straddles the horizon, the mean of the cosine's positive part over points of
+    ///   it, but at least a sixteenth of the largest cosine within it, so that every direction
+    ///   above the plane keeps a density > 0;
     /// - 0 where it lies wholly below.
     ///
     /// Errors when `out` is not whole rows within the map.
@@ -32,23 +42,21 @@ impl<'a> EnvHierarchy<'a> {
         if !out.len().is_multiple_of(n) || first_row as usize + rows > n {
             return Err(EnvError::WrongLength { buffer: "plane importance rows", expected: n, found: out.len() });
         }
-        let normal = self.world_to_map * normal;
-        let reach = (cell_radius_bound(self.finest) + tolerance.max(0.0)).min(core::f32::consts::FRAC_PI_2);
-        let (sin_r, cos_r) = (libm::sinf(reach), libm::cosf(reach));
+        let cells = CosineCells::new(self.finest, self.world_to_map * normal, tolerance);
+        // A finer map's texels share their cell's weight: one row of cells at a time.
+        let mut row = [0.0f32; 1 << COSINE_LEVEL];
+        let mut row_of: Option<usize> = None;
         let first = first_row as usize * n;
         for (i, w) in out.iter_mut().enumerate() {
             let (x, y) = (i % n, first_row as usize + i / n);
-            let centre = square_to_sphere(Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32));
-            let c = normal.dot(centre).clamp(-1.0, 1.0);
-            let weight = if c >= sin_r {
-                c
-            } else if c <= -sin_r {
-                0.0
-            } else {
-                // cos(θ − reach): the nearest the texel comes to the normal.
-                c * cos_r + libm::sqrtf(1.0 - c * c) * sin_r
-            };
-            *w = luminance(Vec3::from_array(self.radiance[first + i])) * weight;
+            let (cx, cy) = (x >> cells.shift, y >> cells.shift);
+            if row_of != Some(cy) {
+                for (k, v) in row[..cells.side].iter_mut().enumerate() {
+                    *v = cells.weight(k, cy);
+                }
+                row_of = Some(cy);
+            }
+            *w = luminance(Vec3::from_array(self.radiance[first + i])) * row[cx];
         }
         Ok(())
     }
@@ -61,6 +69,74 @@ impl<'a> EnvHierarchy<'a> {
         let mut view = *self;
         (view.pyramid, view.inv_mean, view.cdf, view.compensated) = (pyramid, fresh.inv_mean, None, None);
         Ok(view)
+    }
+}
+
+/// Points per side at which a cell across the horizon averages the cosine's positive part.
+const HORIZON_POINTS: usize = 8;
+
+/// The least weight of a cell across the horizon, as a share of the largest cosine within it:
+/// a sliver above the horizon that the points miss keeps a density, at most this many times
+/// below its share of the product.
+const HORIZON_FLOOR: f32 = 1.0 / 16.0;
+
+/// The cells the cosine is weighed over: the finest level's texels, or [`COSINE_LEVEL`]'s
+/// cells in a finer map.
+struct CosineCells {
+    /// Cells per side.
+    side: usize,
+    /// Levels between the map's texels and the cells (0 for a map no finer than the cells).
+    shift: u32,
+    /// Points per cell side at which the cosine is averaged.
+    points: usize,
+    /// The plane's normal in the map's frame.
+    normal: Vec3,
+    /// sin and cos of a cell's reach: the angle within which its directions lie around its
+    /// centre's, widened by the normals' tolerance.
+    sin_reach: f32,
+    cos_reach: f32,
+}
+
+impl CosineCells {
+    fn new(finest: u32, normal: Vec3, tolerance: f32) -> Self {
+        let level = finest.min(COSINE_LEVEL);
+        let reach = (cell_radius_bound(level) + tolerance.max(0.0)).min(core::f32::consts::FRAC_PI_2);
+        Self {
+            side: 1 << level,
+            shift: finest - level,
+            points: 1 << (COSINE_LEVEL - level),
+            normal,
+            sin_reach: libm::sinf(reach),
+            cos_reach: libm::cosf(reach),
+        }
+    }
+
+    /// The weight of cell (x, y) (see [`EnvHierarchy::plane_importance_rows`]).
+    fn weight(&self, x: usize, y: usize) -> f32 {
+        let at = |px: f32, py: f32| self.normal.dot(square_to_sphere(Vec2::new(px, py) / self.side as f32));
+        let c = at(x as f32 + 0.5, y as f32 + 0.5).clamp(-1.0, 1.0);
+        let mean = |points: usize| {
+            let step = 1.0 / points as f32;
+            let mut sum = 0.0f32;
+            for j in 0..points {
+                for i in 0..points {
+                    sum += at(x as f32 + (i as f32 + 0.5) * step, y as f32 + (j as f32 + 0.5) * step).max(0.0);
+                }
+            }
+            sum * step * step
+        };
+        if c <= -self.sin_reach {
+            0.0
+        } else if c < self.sin_reach {
+            // The mean over the part above the horizon, but at least a share of the largest
+            // cosine within the cell, cos(θ − reach), where the points miss a sliver above it.
+            let largest = c * self.cos_reach + libm::sqrtf(1.0 - c * c) * self.sin_reach;
+            mean(self.points.max(HORIZON_POINTS)).max(largest * HORIZON_FLOOR)
+        } else if self.points == 1 {
+            c
+        } else {
+            mean(self.points)
+        }
     }
 }
 

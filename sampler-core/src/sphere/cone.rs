@@ -132,8 +132,8 @@ pub fn cell_cone(cell: Cell) -> Cone {
 }
 
 /// A half-angle within which every direction of a cell of `level` lies around its centre's
-/// direction: [`STRETCH`] times half the cell's diagonal, plus the rounding slack. Coarser than
-/// [`cell_cone`]'s measured angle, and free to compute.
+/// direction: the equal-area map's stretch bound times half the cell's diagonal, plus the
+/// rounding slack. Coarser than [`cell_cone`]'s measured angle, and free to compute.
 #[must_use]
 pub fn cell_radius_bound(level: u32) -> f32 {
     let size = 1.0 / (1u32 << level) as f32;

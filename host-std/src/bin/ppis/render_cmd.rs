@@ -24,10 +24,12 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
     /// product, wavelet, env, brdf, mis, product-mis, ris, two-stage, two-level, two-level-mis,
-    /// sis, lightcuts or auto. sis (structured importance sampling) and lightcuts are the
-    /// seed's deterministic, biased baselines: each shading point shades every stratum or a
-    /// whole cut: P = spp/64 shading points per pixel (docs/renderer.md). The default, auto, picks per material the plan with the least error at equal
-    /// time, from rules checked by a pilot render (docs/perf.md#auto-and-its-pilot).
+    /// sis, lightcuts, plane-product or auto. plane-product samples diffuse planes by the map ×
+    /// the plane's cosine, a pyramid per plane, and everything else as mis. sis (structured
+    /// importance sampling) and lightcuts are the seed's deterministic, biased baselines: each
+    /// shading point shades every stratum or a whole cut: P = spp/64 shading points per pixel
+    /// (docs/renderer.md). The default, auto, picks per material the plan with the least error
+    /// at equal time, from rules checked by a pilot render (docs/perf.md#auto-and-its-pilot).
     #[arg(long, default_value = "auto", value_parser = parse_method)]
     pub(crate) method: Method,
     /// Visibility samples (shadow rays) per pixel.
