@@ -97,9 +97,19 @@ pub struct Rendered {
     pub pilot: Vec<PilotResult>,
     /// `auto`: seconds of the pilot, included in `render_seconds`.
     pub pilot_seconds: f64,
+    /// `auto`: every material's plan by name, in material order, whether the rules or the
+    /// pilot chose it (empty for the other methods).
+    pub auto_plans: Vec<String>,
 }
 
 impl Rendered {
+    /// `auto`: per material, in material order, its index, its plan's name and what the pilot
+    /// measured where one ran for it (`None`: the rules chose alone).
+    pub fn auto_choices(&self) -> impl Iterator<Item = (usize, &str, Option<&PilotResult>)> {
+        let pilot = |m: usize| self.pilot.iter().find(|r| r.material == m);
+        self.auto_plans.iter().enumerate().map(move |(m, plan)| (m, plan.as_str(), pilot(m)))
+    }
+
     /// Adds a pilot's time, run before the render and part of its cost, to the render's.
     pub fn add_pilot(&mut self, seconds: f64, cpu_seconds: Option<f64>) {
         self.render_seconds += seconds;
@@ -240,6 +250,10 @@ pub fn render_crop(
         _ => None,
     };
     let pilot_seconds = start.elapsed().as_secs_f64();
+    let auto_plans = match settings.method {
+        Method::Auto => plans.iter().map(|p| method::strategy_name(p.strategy)).collect(),
+        _ => Vec::new(),
+    };
     let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_ref()), ..ctx }, crop, start);
     // The baselines' lights are built per render: their build is part of their cost.
     let render_seconds = start.elapsed().as_secs_f64() + baselines.seconds;
@@ -258,5 +272,6 @@ pub fn render_crop(
         non_finite: c.non_finite,
         pilot,
         pilot_seconds,
+        auto_plans,
     }
 }

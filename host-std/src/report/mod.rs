@@ -21,7 +21,7 @@ pub use tables::{csv, markdown, relmse_at};
 
 use crate::plan::method::Lighting;
 use crate::plan::prepass::render_planned;
-use crate::plan::{self, Method, Settings, ShadingPoints};
+use crate::plan::{self, Method, Rendered, Settings, ShadingPoints};
 use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::scene::Scene;
@@ -142,17 +142,7 @@ pub fn sweep(
         let (rmse, relmse) = errors(&image.pixels, reference);
         let bias = errors::relative_bias(&image.pixels, reference);
         let regions = regions.errors(&image.pixels, reference);
-        let plans = image
-            .pilot
-            .iter()
-            .map(|r| {
-                let changed = if Some(r.chosen) == r.rule { "" } else { " (pilot)" };
-                (
-                    scene.materials[r.material].bsdf.label(),
-                    format!("{}{changed}", crate::plan::pilot::plan_name(r.chosen)),
-                )
-            })
-            .collect();
+        let plans = auto_plans(scene, &image);
         let (method, k) = (series.method, series.brdf_samples);
         let seconds = timing.clock.seconds(&image);
         let m = Measurement { method, brdf_samples: k, spp, seconds, rmse, relmse, bias, regions, plans };
@@ -236,6 +226,20 @@ pub const BRACKET_DOUBLINGS: usize = 3;
 
 /// No bracketing render goes beyond this many visibility samples per pixel.
 const MAX_BRACKET_SPP: usize = 1 << 20;
+
+/// `auto`'s plan per material as the report lists it, `(material, plan)`: " (pilot)" where the
+/// pilot overrode the rules; materials with the same label and plan listed once.
+fn auto_plans(scene: &Scene, image: &Rendered) -> Vec<(String, String)> {
+    let mut plans: Vec<(String, String)> = Vec::new();
+    for (m, plan, pilot) in image.auto_choices() {
+        let changed = if pilot.is_some_and(|r| Some(r.chosen) != r.rule) { " (pilot)" } else { "" };
+        let entry = (scene.materials[m].bsdf.label(), format!("{plan}{changed}"));
+        if !plans.contains(&entry) {
+            plans.push(entry);
+        }
+    }
+    plans
+}
 
 #[cfg(test)]
 mod tests {

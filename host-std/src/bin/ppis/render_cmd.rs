@@ -11,7 +11,7 @@ use host_std::light::environment::Environment;
 use host_std::output;
 use host_std::plan::carrier::{self, Carrier, CarrierChoice};
 use host_std::plan::prepass::Prepass;
-use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints, pilot};
+use host_std::plan::{self, Method, Rendered, Settings, ShadingPoints};
 use host_std::render::crop::Crop;
 use host_std::scene::Scene;
 use host_std::trace::bvh::Bvh;
@@ -259,16 +259,49 @@ fn carry_distant_lights(
 
 /// One line per material `auto`'s pilot measured.
 fn report_pilot(scene: &Scene, image: &Rendered) {
-    for r in &image.pilot {
+    // Materials the rules planned alone, by plan, in the order the plans first appear.
+    let mut by_rules: Vec<(&str, Vec<String>)> = Vec::new();
+    for (m, plan, pilot) in image.auto_choices() {
+        let label = scene.materials[m].bsdf.label();
+        let Some(r) = pilot else {
+            match by_rules.iter_mut().find(|(p, _)| *p == plan) {
+                Some((_, labels)) => labels.push(label),
+                None => by_rules.push((plan, vec![label])),
+            }
+            continue;
+        };
         eprintln!(
-            "ppis: auto: {} → {}{} (pilot: {} pixels, {:.2} s in all)",
-            scene.materials[r.material].bsdf.label(),
-            pilot::plan_name(r.chosen),
+            "ppis: auto: {label} → {plan}{} (pilot: {} pixels, {:.2} s in all)",
             if Some(r.chosen) == r.rule { "" } else { ", measured ahead of the rule's plan" },
             r.pixels,
             image.pilot_seconds
         );
     }
+    for (plan, labels) in by_rules {
+        eprintln!("ppis: auto: {} → {plan} (by the rules)", counted(&labels));
+    }
+}
+
+/// `labels` with repeats counted, in first-seen order: `diffuse ×2, carpaint`; past
+/// `MAX_LISTED` distinct labels, how many more.
+fn counted(labels: &[String]) -> String {
+    const MAX_LISTED: usize = 6;
+    let mut distinct: Vec<(&str, usize)> = Vec::new();
+    for l in labels {
+        match distinct.iter_mut().find(|(d, _)| *d == l.as_str()) {
+            Some((_, n)) => *n += 1,
+            None => distinct.push((l, 1)),
+        }
+    }
+    let mut parts: Vec<String> = distinct
+        .iter()
+        .take(MAX_LISTED)
+        .map(|&(l, n)| if n > 1 { format!("{l} ×{n}") } else { l.to_string() })
+        .collect();
+    if distinct.len() > MAX_LISTED {
+        parts.push(format!("{} more", distinct.len() - MAX_LISTED));
+    }
+    parts.join(", ")
 }
 
 /// Fails early (before any work) when the output folder does not exist.

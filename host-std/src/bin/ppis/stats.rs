@@ -3,8 +3,10 @@
 //! host-usd/bench/) read them by name.
 
 use crate::render_cmd::{Prepared, RenderArgs};
+use host_std::plan::pilot::PilotResult;
 use host_std::plan::split::SplitChoice;
 use host_std::plan::{Rendered, pilot};
+use host_std::scene::Scene;
 use sampler_core::env::EnvHierarchy;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -12,7 +14,7 @@ use std::collections::BTreeMap;
 /// One render's stats.
 #[derive(Serialize)]
 pub(crate) struct Stats {
-    /// `auto`: per material its pilot's plan and scores (empty otherwise).
+    /// `auto`: per material, in material order, its plan and its pilot's scores (empty otherwise).
     auto_plans: Vec<AutoPlan>,
     /// `--brdf-samples`: every material's K (`null`: each material's from its lobes).
     brdf_samples: Option<u32>,
@@ -86,15 +88,37 @@ struct SplitPilot {
     power_score: Option<f64>,
 }
 
-/// What `auto`'s pilot measured for one material.
+/// One material's plan under `auto`, and what its pilot measured.
 #[derive(Serialize)]
 struct AutoPlan {
     material: String,
+    /// 0 where no pilot ran for the material (the rules chose alone).
     pilot_pixels: usize,
     plan: String,
     rule_plan: Option<String>,
     /// Per candidate plan by name, its score (`null`: not measured or not trusted).
     scores: BTreeMap<String, Option<f64>>,
+}
+
+impl AutoPlan {
+    /// Material `m`'s entry: its plan, and the pilot's measurement where one ran (otherwise no
+    /// pilot pixels, no scores, and the rules' plan is the plan).
+    fn new(scene: &Scene, m: usize, plan: &str, pilot: Option<&PilotResult>) -> Self {
+        let material = scene.materials[m].bsdf.label();
+        let plan = plan.to_string();
+        match pilot {
+            Some(r) => AutoPlan {
+                material,
+                pilot_pixels: r.pixels,
+                plan,
+                rule_plan: r.rule.map(pilot::plan_name),
+                scores: (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), r.scores[c])).collect(),
+            },
+            None => {
+                AutoPlan { material, pilot_pixels: 0, rule_plan: Some(plan.clone()), plan, scores: BTreeMap::new() }
+            }
+        }
+    }
 }
 
 impl Stats {
@@ -113,17 +137,7 @@ impl Stats {
         let env_build = env.map_or(0.0, |e| e.stats.build_seconds);
         let scene = &prepared.scene;
         Stats {
-            auto_plans: image
-                .pilot
-                .iter()
-                .map(|r| AutoPlan {
-                    material: scene.materials[r.material].bsdf.label(),
-                    pilot_pixels: r.pixels,
-                    plan: pilot::plan_name(r.chosen),
-                    rule_plan: r.rule.map(pilot::plan_name),
-                    scores: (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), r.scores[c])).collect(),
-                })
-                .collect(),
+            auto_plans: image.auto_choices().map(|(m, plan, pilot)| AutoPlan::new(scene, m, plan, pilot)).collect(),
             brdf_samples: args.brdf_samples,
             bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
             bvh_seconds: prepared.bvh_seconds,
