@@ -6,6 +6,7 @@
 
 use crate::light::map_buffer::{MapBuffer, PYRAMID_LINE_START};
 use crate::scene::{Scene, Shape};
+use rayon::prelude::*;
 use sampler_core::env::{EnvHierarchy, build_pyramid_from_importance, pyramid_len};
 use sampler_core::glam::Vec3;
 use std::sync::OnceLock;
@@ -84,11 +85,21 @@ fn same_normal(a: Vec3, b: Vec3) -> bool {
     a.dot(b) > 0.0 && a.cross(b).length() <= NORMAL_TOLERANCE
 }
 
-/// The pyramid of `env`'s radiance × the cosine to `normal`.
+/// Rows of the map per task of a plane's build: a whole number of `COSINE_LEVEL`'s cells in
+/// every map up to [`MAX_PLANE_LEVEL`], so that no task weighs a row of cells another does.
+const BUILD_ROWS: usize = 64;
+
+/// The pyramid of `env`'s radiance × the cosine to `normal`. The importance is written in bands
+/// of rows on rayon's threads (each band depends on its rows alone): the render's threads that
+/// wait for the plane meanwhile leave their cores to it.
 fn build(env: &EnvHierarchy<'_>, normal: Vec3) -> MapBuffer<f32> {
     let level = env.finest_level();
-    let mut importance = vec![0.0f32; 1usize << (2 * level)];
-    env.plane_importance_rows(normal, NORMAL_TOLERANCE, 0, &mut importance).expect("whole rows of the map");
+    let n = 1usize << level;
+    let mut importance = vec![0.0f32; n * n];
+    importance.par_chunks_mut(n * BUILD_ROWS.min(n)).enumerate().for_each(|(k, band)| {
+        let first_row = (k * BUILD_ROWS) as u32;
+        env.plane_importance_rows(normal, NORMAL_TOLERANCE, first_row, band).expect("whole rows of the map");
+    });
     let mut pyramid = MapBuffer::new(pyramid_len(level), PYRAMID_LINE_START);
     build_pyramid_from_importance(level, &importance, &mut pyramid).expect("sized for the map's level");
     pyramid

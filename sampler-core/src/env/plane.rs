@@ -7,8 +7,8 @@
 use super::EnvHierarchy;
 use super::pyramid::{EnvError, luminance};
 use crate::cone::cell_radius_bound;
-use crate::mapping::square_to_sphere;
-use glam::{Vec2, Vec3};
+use crate::mapping::{square_to_sphere, square_to_sphere_x4};
+use glam::{Vec2, Vec3, Vec4};
 
 /// The level whose cell centres the cosine is evaluated at: texels of a coarser map average
 /// the cosine over their share of these points, texels of a finer one share their cell's. A
@@ -46,17 +46,17 @@ impl<'a> EnvHierarchy<'a> {
         // A finer map's texels share their cell's weight: one row of cells at a time.
         let mut row = [0.0f32; 1 << COSINE_LEVEL];
         let mut row_of: Option<usize> = None;
-        let first = first_row as usize * n;
-        for (i, w) in out.iter_mut().enumerate() {
-            let (x, y) = (i % n, first_row as usize + i / n);
-            let (cx, cy) = (x >> cells.shift, y >> cells.shift);
+        for (r, out_row) in out.chunks_exact_mut(n).enumerate() {
+            let y = first_row as usize + r;
+            let cy = y >> cells.shift;
             if row_of != Some(cy) {
-                for (k, v) in row[..cells.side].iter_mut().enumerate() {
-                    *v = cells.weight(k, cy);
-                }
+                cells.row(cy, &mut row[..cells.side]);
                 row_of = Some(cy);
             }
-            *w = luminance(Vec3::from_array(self.radiance[first + i])) * row[cx];
+            let radiance = &self.radiance[y * n..(y + 1) * n];
+            for (x, (w, rgb)) in out_row.iter_mut().zip(radiance).enumerate() {
+                *w = luminance(Vec3::from_array(*rgb)) * row[x >> cells.shift];
+            }
         }
         Ok(())
     }
@@ -111,10 +111,28 @@ impl CosineCells {
         }
     }
 
-    /// The weight of cell (x, y) (see [`EnvHierarchy::plane_importance_rows`]).
-    fn weight(&self, x: usize, y: usize) -> f32 {
+    /// The weights of row `y`'s cells into `out` (one per cell): the centres' cosines four at
+    /// a time, the same bits as one at a time.
+    fn row(&self, y: usize, out: &mut [f32]) {
+        let side = self.side as f32;
+        let v = Vec4::splat((y as f32 + 0.5) / side);
+        let [nx, ny, nz] = self.normal.to_array().map(Vec4::splat);
+        for (k, chunk) in out.chunks_mut(4).enumerate() {
+            let x0 = 4 * k;
+            let u = Vec4::from_array(core::array::from_fn(|i| ((x0 + i) as f32 + 0.5) / side));
+            let [dx, dy, dz] = square_to_sphere_x4(u, v);
+            // `Vec3::dot`'s order of operations, lane by lane.
+            let c = (nx * dx + ny * dy + nz * dz).to_array();
+            for (i, w) in chunk.iter_mut().enumerate() {
+                *w = self.weight(x0 + i, y, c[i].clamp(-1.0, 1.0));
+            }
+        }
+    }
+
+    /// The weight of cell (x, y), whose centre has cosine `c` to the normal (see
+    /// [`EnvHierarchy::plane_importance_rows`]).
+    fn weight(&self, x: usize, y: usize, c: f32) -> f32 {
         let at = |px: f32, py: f32| self.normal.dot(square_to_sphere(Vec2::new(px, py) / self.side as f32));
-        let c = at(x as f32 + 0.5, y as f32 + 0.5).clamp(-1.0, 1.0);
         let mean = |points: usize| {
             let step = 1.0 / points as f32;
             let mut sum = 0.0f32;
@@ -172,6 +190,24 @@ mod tests {
                 }
                 if above {
                     assert!(weight > 0.0, "texel {i} reaches above the plane but has no weight");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_row_of_cells_weighs_as_each_cell_alone() {
+        let mut rng = Pcg32::new(3, 5);
+        let mut row = [0.0f32; 1 << COSINE_LEVEL];
+        for finest in [0, 1, 3, 6, 10, 11] {
+            let normal = square_to_sphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+            let cells = CosineCells::new(finest, normal, 1e-3);
+            for y in [0, cells.side / 3, cells.side - 1] {
+                cells.row(y, &mut row[..cells.side]);
+                for (x, w) in row[..cells.side].iter().enumerate() {
+                    let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) / cells.side as f32;
+                    let c = normal.dot(square_to_sphere(centre)).clamp(-1.0, 1.0);
+                    assert_eq!(w.to_bits(), cells.weight(x, y, c).to_bits(), "level {finest}, cell ({x}, {y})");
                 }
             }
         }
