@@ -63,14 +63,16 @@ fn the_plane_view_matches_its_pdf() {
         );
         assert!(r.p_value >= alpha && r.impossible == 0, "{name}: {r:?}");
         // The direction-level pdf agrees with the one returned, but where the direction's round
-        // trip through the mapping lands in the next texel.
+        // trip through the mapping lands in the next texel: never in maps of 128² or coarser,
+        // rarely in the 2048² one, whose texels are a sixteenth of the size.
+        let allowed = if env.level <= 7 { 0 } else { 10 };
         let (mut rng, mut mismatch) = (Pcg32::new(1, 1), 0);
         for _ in 0..10_000 {
             let s = plane.sample(DVec2::new(rng.next_f64(), rng.next_f64())).unwrap();
             mismatch += usize::from((plane.pdf(s.dir) - s.pdf).abs() > 1e-4 * s.pdf);
             assert!(s.dir.dot(*normal) > -(2.0 * reach).sin(), "{name}: drawn {:?} beyond the texels' reach", s.dir);
         }
-        assert!(mismatch <= 10, "{name}: {mismatch} of 10000 pdfs differ");
+        assert!(mismatch <= allowed, "{name}: {mismatch} of 10000 pdfs differ");
     }
 }
 
