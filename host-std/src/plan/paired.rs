@@ -6,11 +6,12 @@
 //! sun's carrier (`plan::carrier`) and the light samples per shading point (`plan::split`) are
 //! chosen by them.
 
-use crate::plan::{Method, Settings, render_crop};
+use crate::plan::{Method, Rendered, Settings, render_crop};
 use crate::render::crop::Crop;
 use crate::render::tiles::TILE;
 use crate::scene::Scene;
 use crate::trace::bvh::Bvh;
+use rayon::prelude::*;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::luminance64;
 use sampler_core::glam::Vec3;
@@ -48,28 +49,41 @@ pub fn paired_scores_at(
     tiles: &[Crop],
     salt: u64,
 ) -> Vec<f64> {
-    let renders: Vec<[(Vec<[f32; 3]>, f64); 2]> = candidates
+    // Every (candidate, repetition, tile) is a job of its own, so that the threads share the
+    // pilot as they share the render; the results are gathered in a fixed order, so the scores
+    // do not depend on the thread count.
+    let settings: Vec<[Settings; 2]> = candidates
         .iter()
         .zip(indices)
         .map(|(c, &k)| {
-            std::array::from_fn(|rep| {
-                let s = Settings {
-                    // `auto`'s own pilot would run again in every tile's render: its MIS plans
-                    // stand in for it.
-                    method: if c.settings.method == Method::Auto { Method::Mis } else { c.settings.method },
-                    seed: hash_combine(hash_combine(c.settings.seed, salt), 2 * k as u64 + rep as u64),
-                    progress: false,
-                    ..c.settings
-                };
+            std::array::from_fn(|rep| Settings {
+                // `auto`'s own pilot would run again in every tile's render: its MIS plans
+                // stand in for it.
+                method: if c.settings.method == Method::Auto { Method::Mis } else { c.settings.method },
+                seed: hash_combine(hash_combine(c.settings.seed, salt), 2 * k as u64 + rep as u64),
+                progress: false,
+                ..c.settings
+            })
+        })
+        .collect();
+    let jobs: Vec<(usize, usize, Crop)> = (0..candidates.len())
+        .flat_map(|i| (0..2).flat_map(move |rep| tiles.iter().map(move |&t| (i, rep, t))))
+        .collect();
+    let images: Vec<Rendered> = jobs
+        .par_iter()
+        .map(|&(i, rep, t)| render_crop(candidates[i].scene, bvh, candidates[i].env, &settings[i][rep], t))
+        .collect();
+    let mut images = images.into_iter();
+    let renders: Vec<[(Vec<[f32; 3]>, f64); 2]> = candidates
+        .iter()
+        .map(|c| {
+            std::array::from_fn(|_| {
                 let mut cost = 0.0;
-                let pixels = tiles
-                    .iter()
-                    .flat_map(|&t| {
-                        let image = render_crop(c.scene, bvh, c.env, &s, t);
-                        cost += image.shadow_rays as f64 + c.point_cost * image.shading_points as f64;
-                        image.pixels
-                    })
-                    .collect();
+                let mut pixels = Vec::new();
+                for image in images.by_ref().take(tiles.len()) {
+                    cost += image.shadow_rays as f64 + c.point_cost * image.shading_points as f64;
+                    pixels.extend(image.pixels);
+                }
                 (pixels, cost)
             })
         })

@@ -159,7 +159,7 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
     }
     if let Some(c) = &prepass.split {
         eprintln!(
-            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}{}; {:.2} s)",
+            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}{}; {:.2} s, {})",
             c.samples_per_point,
             c.pixels,
             c.pilot_spp,
@@ -169,7 +169,8 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
             c.candidates[1],
             c.power_score
                 .map_or(String::new(), |p| format!(", {p:.3e} at {} by the power heuristic", c.samples_per_point)),
-            c.seconds
+            c.seconds,
+            c.cpu_seconds.map_or(String::from("CPU time unknown"), |s| format!("{s:.2} CPU s"))
         );
         if c.power_score.is_some() {
             eprintln!("ppis: MIS heuristic: {}", heuristic_name(c.heuristic));
