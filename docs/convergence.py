@@ -5,7 +5,7 @@ mean over seeds estimates the expected error, which falls 4× per 4× spp when t
 footprint is integrated too — docs/tuning.md, "Shading points per pixel").
 
   python3 docs/convergence.py --out DIR [--methods mis,product-mis] [--spp 16,64,256,1024]
-                              [--seeds 4] [--ref-spp 16384] [--width 160 --height 90] [SCENE]
+                              [--seeds 8] [--ref-spp 16384] [--width 160 --height 90] [SCENE]
 
 Without SCENE: the embedded default scene. The reference is rendered once (method mis, seed
 4242) and cached in DIR. Needs numpy and the `exr`-reading `mitsuba` package, or OpenEXR."""
@@ -35,7 +35,7 @@ def main():
     ap.add_argument('--out', required=True)
     ap.add_argument('--methods', default='mis,product-mis', type=lambda s: s.split(','))
     ap.add_argument('--spp', default='16,64,256,1024', type=lambda s: [int(v) for v in s.split(',')])
-    ap.add_argument('--seeds', type=int, default=4)
+    ap.add_argument('--seeds', type=int, default=8)
     ap.add_argument('--ref-spp', type=int, default=16384)
     ap.add_argument('--width', type=int, default=160)
     ap.add_argument('--height', type=int, default=90)
