@@ -4,8 +4,11 @@
 //! every sample); a shading point costs about two shadow rays. Where the light's noise dominates
 //! — glossy lobes under extended light — four pairs per point spend the time on what pays; where
 //! the footprint's does — a sun's glints and hard shadows — they starve it (docs/tuning.md,
-//! "Shading points per pixel"). Neither wins on every scene, so a pilot measures the scene:
-//! paired renders of a few tiles with each split (`plan::paired`), scored by variance × cost.
+//! "Shading points per pixel"). Under a sun neither wins on every scene, so a pilot measures
+//! the scene: paired renders of a few tiles with each split (`plan::paired`), scored by
+//! variance × cost. Under extended light (the map's peak below [`SUN_PEAK`]) four pairs won or
+//! tied on every scene measured, and the pilot that chose them there cost a few per cent of
+//! the render for nothing: there the split is four pairs without a pilot.
 //!
 //! At the split it chooses, the pilot also renders the MIS methods (not `auto`, whose pilot
 //! renders its materials as MIS) with the power heuristic instead of the balance heuristic, and
@@ -13,7 +16,8 @@
 //! It does so where most of the map's light stands above its mean ([`POWER_EXCESS_SHARE`]),
 //! the maps where the power heuristic can win by more than the pilot costs.
 //!
-//! The pilot renders at an eighth of the render's samples per pixel (at least 32): the
+//! The pilot (of the split, or of the heuristic alone under extended light) renders at an
+//! eighth of the render's samples per pixel (at least 32): the
 //! footprint's share of the error falls with spp faster than the light's (stratified shading
 //! points), so a split that wins there wins at the render's spp too, and the pilot's four
 //! renders of 5% of the pixels cost a few per cent of the render.
@@ -22,6 +26,7 @@ use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::plan::carrier::point_cost;
 use crate::plan::method::Lighting;
 use crate::plan::paired::{PilotCandidate, paired_scores, paired_scores_at, pilot_tiles};
+use crate::plan::rules::SUN_PEAK;
 use crate::plan::{Method, Settings, ShadingPoints};
 use crate::render::crop::Crop;
 use crate::scene::Scene;
@@ -65,8 +70,10 @@ pub struct SplitChoice {
     pub samples_per_point: usize,
     /// The candidates: the rule's samples per point and twice as many.
     pub candidates: [usize; 2],
-    /// Their variance × cost at the pilot's spp (lower is better).
-    pub scores: [f64; 2],
+    /// Their variance × cost at the pilot's spp (lower is better), where measured: both under
+    /// a sun; under extended light only the chosen split's, and only where the power heuristic
+    /// is measured beside it.
+    pub scores: [Option<f64>; 2],
     /// The heuristic MIS weighs by in the render.
     pub heuristic: MisHeuristic,
     /// The variance × cost of the chosen split under the power heuristic, where the pilot
@@ -75,7 +82,7 @@ pub struct SplitChoice {
     pub power_score: Option<f64>,
     /// Samples per pixel of the pilot's renders.
     pub pilot_spp: usize,
-    /// Pixels of each of the pilot's renders.
+    /// Pixels of each of the pilot's renders (0 where none ran).
     pub pixels: usize,
     /// Wall-clock seconds of the pilot.
     pub seconds: f64,
@@ -126,21 +133,38 @@ pub fn choose(
         },
         point_cost: point_cost(settings.method),
     };
-    let scored = paired_scores(bvh, &candidates.map(|v| candidate(v, 0)), &tiles, SALT);
-    let scores: [f64; 2] = scored.try_into().expect("two splits");
-    let best = usize::from(scores[1] < scores[0]);
+    let extended = env.is_some_and(|e| e.peak(5) < SUN_PEAK);
+    let (mut scores, best) = if extended {
+        ([None, None], 1)
+    } else {
+        let scored = paired_scores(bvh, &candidates.map(|v| candidate(v, 0)), &tiles, SALT);
+        (std::array::from_fn(|k| Some(scored[k])), usize::from(scored[1] < scored[0]))
+    };
     let samples_per_point = candidates[best];
     // The power heuristic at the chosen split, with its renders' seeds: the same samples,
-    // weighed otherwise.
+    // weighed otherwise. Under extended light both heuristics are scored together (one
+    // normalisation), as the two splits are under a sun.
     let concentrated = env.and_then(EnvHierarchy::excess_share).is_some_and(|s| s >= POWER_EXCESS_SHARE);
-    let power_score = (heuristic.is_none() && settings.method != Method::Auto && concentrated)
-        .then(|| paired_scores_at(bvh, &[candidate(samples_per_point, 1)], &[best], &tiles, SALT)[0]);
-    let heuristic = match power_score {
-        Some(p) if p < scores[best] => MisHeuristic::Power,
+    let mut power_score = None;
+    if heuristic.is_none() && settings.method != Method::Auto && concentrated {
+        let at_best = |views: &[usize]| {
+            let weighed: Vec<PilotCandidate<'_>> = views.iter().map(|&v| candidate(samples_per_point, v)).collect();
+            paired_scores_at(bvh, &weighed, &vec![best; views.len()], &tiles, SALT)
+        };
+        if scores[best].is_some() {
+            power_score = Some(at_best(&[1])[0]);
+        } else {
+            let both = at_best(&[0, 1]);
+            (scores[best], power_score) = (Some(both[0]), Some(both[1]));
+        }
+    }
+    let heuristic = match (power_score, scores[best]) {
+        (Some(p), Some(b)) if p < b => MisHeuristic::Power,
         _ => heuristic.unwrap_or_default(),
     };
+    let measured = scores.iter().any(Option::is_some);
     let cpu_seconds = cpu_seconds_since(cpu_start);
-    let pixels = tiles.iter().map(Crop::area).sum();
+    let pixels = if measured { tiles.iter().map(Crop::area).sum() } else { 0 };
     Some(SplitChoice {
         samples_per_point,
         candidates,
@@ -186,11 +210,22 @@ mod tests {
         }
     }
 
+    /// A map of level 5 (32², one texel per block `EnvHierarchy::peak(5)` reads): 1 everywhere
+    /// but `bright` at one texel, and its plain view.
+    fn map_with_one_texel(bright: f32) -> (Vec<[f32; 3]>, Vec<f32>) {
+        let level = 5;
+        let mut rgb = vec![[1.0f32; 3]; 1 << (2 * level)];
+        rgb[300] = [bright; 3];
+        let mut pyramid = vec![0.0f32; sampler_core::env::pyramid_len(level)];
+        sampler_core::env::build_pyramid(level, &rgb, &mut pyramid).unwrap();
+        (rgb, pyramid)
+    }
+
     #[test]
-    fn the_pilot_runs_only_where_the_rule_leaves_a_choice_and_repeats_it() {
-        let source = EnvSource::Constant { level: 5 };
-        let env = Environment::build(&source, Placement::default()).unwrap();
-        let hierarchy = env.hierarchy();
+    fn under_a_sun_the_pilot_runs_only_where_the_rule_leaves_a_choice_and_repeats_it() {
+        let (rgb, pyramid) = map_with_one_texel(1e4);
+        let hierarchy = EnvHierarchy::new(5, &pyramid, &rgb).unwrap();
+        assert!(hierarchy.peak(5) >= SUN_PEAK, "a sun");
         let mut scene = crate::scene::builtin::scene();
         (scene.camera.width, scene.camera.height) = (224, 192);
         let bvh = Bvh::build(&scene);
@@ -209,14 +244,38 @@ mod tests {
             run(Method::Mis, 128, ShadingPoints::Rule, some).unwrap(),
         );
         assert_eq!((a.samples_per_point, a.scores, a.pixels), (b.samples_per_point, b.scores, b.pixels));
-        assert_eq!((a.heuristic, a.power_score), (MisHeuristic::Balance, None), "a constant map: nothing to try");
+        assert_eq!((a.heuristic, a.power_score), (MisHeuristic::Balance, None), "no excess to weigh");
         assert_eq!((a.candidates, a.pilot_spp, a.pixels), ([4, 8], 32, 8 * 16 * 16));
-        assert!(a.scores.iter().all(|s| s.is_finite() && *s > 0.0), "{:?}", a.scores);
-        let best = if a.scores[1] < a.scores[0] { 8 } else { 4 };
+        let scores = a.scores.map(|s| s.expect("both splits scored"));
+        assert!(scores.iter().all(|s| s.is_finite() && *s > 0.0), "{scores:?}");
+        let best = if scores[1] < scores[0] { 8 } else { 4 };
         assert_eq!(a.samples_per_point, best);
         let s = settings(Method::Mis, 128);
         assert_eq!(shading_points(Some(&a), ShadingPoints::Rule, &s, Lighting::OneKind), 128 / best);
         assert_eq!(shading_points(None, ShadingPoints::Rule, &s, Lighting::OneKind), 32);
+    }
+
+    #[test]
+    fn under_extended_light_four_pairs_stand_without_a_pilot() {
+        let source = EnvSource::Constant { level: 5 };
+        let env = Environment::build(&source, Placement::default()).unwrap();
+        let hierarchy = env.hierarchy();
+        let (rgb, pyramid) = map_with_one_texel(20.0);
+        let patchy = EnvHierarchy::new(5, &pyramid, &rgb).unwrap();
+        let mut scene = crate::scene::builtin::scene();
+        (scene.camera.width, scene.camera.height) = (224, 192);
+        let bvh = Bvh::build(&scene);
+        for (view, method) in [(&hierarchy, Method::Mis), (&patchy, Method::Auto), (&patchy, Method::ProductMis)] {
+            assert!(view.peak(5) < SUN_PEAK);
+            let c = choose(&scene, &bvh, Some(view), &settings(method, 256), ShadingPoints::Rule, None).unwrap();
+            assert_eq!(
+                (c.samples_per_point, c.scores, c.power_score, c.pixels),
+                (8, [None, None], None, 0),
+                "{method}"
+            );
+            let s = settings(method, 256);
+            assert_eq!(shading_points(Some(&c), ShadingPoints::Rule, &s, Lighting::OneKind), 32);
+        }
     }
 
     /// A map whose light sits in one bright patch: the pilot measures the power heuristic for
@@ -244,7 +303,8 @@ mod tests {
         let a = run(Method::Mis, None);
         let power = a.power_score.expect("MIS measures the power heuristic");
         assert!(power.is_finite() && power > 0.0);
-        let chosen = a.scores[usize::from(a.samples_per_point == a.candidates[1])];
+        assert_eq!((a.samples_per_point, a.scores[0]), (8, None), "extended light: four pairs, unscored");
+        let chosen = a.scores[1].expect("the balance heuristic scored beside the power heuristic");
         let expected = if power < chosen { MisHeuristic::Power } else { MisHeuristic::Balance };
         assert_eq!(a.heuristic, expected);
         assert_eq!((a.heuristic, a.power_score), (run(Method::Mis, None).heuristic, Some(power)), "repeatable");

@@ -158,20 +158,35 @@ pub(crate) fn render_command(args: RenderArgs) -> Result<()> {
         );
     }
     if let Some(c) = &prepass.split {
-        eprintln!(
-            "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {:.3e} at {}, {:.3e} at {}{}; {:.2} s, {})",
-            c.samples_per_point,
-            c.pixels,
-            c.pilot_spp,
-            c.scores[0],
-            c.candidates[0],
-            c.scores[1],
-            c.candidates[1],
-            c.power_score
-                .map_or(String::new(), |p| format!(", {p:.3e} at {} by the power heuristic", c.samples_per_point)),
-            c.seconds,
-            c.cpu_seconds.map_or(String::from("CPU time unknown"), |s| format!("{s:.2} CPU s"))
-        );
+        let score = |k: usize| c.scores[k].map_or(String::from("—"), |s| format!("{s:.3e}"));
+        let cpu = c.cpu_seconds.map_or(String::from("CPU time unknown"), |s| format!("{s:.2} CPU s"));
+        let power = c.power_score.map_or(String::new(), |p| {
+            format!(
+                ", {p:.3e} at {} by the power heuristic against {}",
+                c.samples_per_point,
+                score(usize::from(c.samples_per_point == c.candidates[1]))
+            )
+        });
+        if c.scores[0].is_some() {
+            eprintln!(
+                "ppis: light samples per shading point: {} (pilot of {} pixels at {} spp: variance × cost {} at {}, {} at {}{power}; {:.2} s, {cpu})",
+                c.samples_per_point,
+                c.pixels,
+                c.pilot_spp,
+                score(0),
+                c.candidates[0],
+                score(1),
+                c.candidates[1],
+                c.seconds,
+            );
+        } else if c.pixels > 0 {
+            eprintln!(
+                "ppis: light samples per shading point: {} (extended light; pilot of {} pixels at {} spp{power}; {:.2} s, {cpu})",
+                c.samples_per_point, c.pixels, c.pilot_spp, c.seconds,
+            );
+        } else {
+            eprintln!("ppis: light samples per shading point: {} (extended light)", c.samples_per_point);
+        }
         if c.power_score.is_some() {
             eprintln!("ppis: MIS heuristic: {}", heuristic_name(c.heuristic));
         }

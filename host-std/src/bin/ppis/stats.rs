@@ -80,8 +80,9 @@ struct SplitPilot {
     chosen: usize,
     pilot_pixels: usize,
     pilot_spp: usize,
-    /// Per candidate samples per shading point, its variance × cost.
-    scores: BTreeMap<usize, f64>,
+    /// Per candidate samples per shading point, its variance × cost (`null`: not measured —
+    /// under extended light the split is the rule's, docs/tuning.md, "Shading points per pixel").
+    scores: BTreeMap<usize, Option<f64>>,
     /// The MIS heuristic the render weighed by (`balance` or `power`).
     mis_heuristic: &'static str,
     /// The chosen split's variance × cost under the power heuristic (`null`: not measured).
