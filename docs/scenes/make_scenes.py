@@ -78,31 +78,40 @@ def write(name, img):
     write_exr(os.path.join(HERE, name), img.astype(np.float32))
 
 
-write("furnace_env.exr", np.ones((32, 64, 3)))
+def latlong_directions(w, h):
+    """The unit direction of each pixel centre of a w × h lat-long map (the project's
+    convention), shape (h, w, 3)."""
+    v, u = np.meshgrid((np.arange(h) + 0.5) / h, (np.arange(w) + 0.5) / w, indexing="ij")
+    theta, phi = v * np.pi, u * 2 * np.pi
+    return np.stack([np.sin(theta) * np.sin(phi), np.cos(theta), -np.sin(theta) * np.cos(phi)], axis=-1)
 
-w, h = 1024, 512
-v, u = np.meshgrid((np.arange(h) + 0.5) / h, (np.arange(w) + 0.5) / w, indexing="ij")
-theta, phi = v * np.pi, u * 2 * np.pi
-d = np.stack([np.sin(theta) * np.sin(phi), np.cos(theta), -np.sin(theta) * np.cos(phi)], axis=-1)
-sun = np.array([0.35, 0.55, 0.76])
-sun /= np.linalg.norm(sun)
-inside = d @ sun > np.cos(np.radians(0.5))
-img = np.full((h, w, 3), 0.05)
-img[inside] = 2.0e4
-write("sharp_sun_env.exr", img)
-print(f"sun texels: {inside.sum()}")
 
-rng = np.random.default_rng(7)
-img = np.full((h, w, 3), 0.02)
-for _ in range(24):
-    # Above the horizon: y = cos θ uniform in [0, 0.95].
-    y = rng.uniform(0.0, 0.95)
-    a = rng.uniform(0, 2 * np.pi)
-    c = np.array([np.sqrt(1 - y * y) * np.sin(a), y, -np.sqrt(1 - y * y) * np.cos(a)])
-    radius = np.radians(rng.uniform(3.0, 6.0))
-    colour = rng.uniform(20.0, 200.0) * rng.uniform(0.8, 1.0, 3)
-    img[d @ c > np.cos(radius)] = colour
-write("studio_env.exr", img)
+def sharp_sun_map(w=1024, h=512):
+    """A sun of 0.5° radius, 4e5× a constant sky."""
+    d = latlong_directions(w, h)
+    sun = np.array([0.35, 0.55, 0.76])
+    sun /= np.linalg.norm(sun)
+    inside = d @ sun > np.cos(np.radians(0.5))
+    img = np.full((h, w, 3), 0.05)
+    img[inside] = 2.0e4
+    return img, int(inside.sum())
+
+
+def studio_map(seed=7, w=1024, h=512):
+    """studio.json's map: 24 discs of 3–6° radius and radiance 20–200 above the horizon over a
+    dark studio (0.02); other seeds place other discs the same way."""
+    d = latlong_directions(w, h)
+    rng = np.random.default_rng(seed)
+    img = np.full((h, w, 3), 0.02)
+    for _ in range(24):
+        # Above the horizon: y = cos θ uniform in [0, 0.95].
+        y = rng.uniform(0.0, 0.95)
+        a = rng.uniform(0, 2 * np.pi)
+        c = np.array([np.sqrt(1 - y * y) * np.sin(a), y, -np.sqrt(1 - y * y) * np.cos(a)])
+        radius = np.radians(rng.uniform(3.0, 6.0))
+        colour = rng.uniform(20.0, 200.0) * rng.uniform(0.8, 1.0, 3)
+        img[d @ c > np.cos(radius)] = colour
+    return img
 
 
 def default_sky(w=4096, h=2048, ss=8):
@@ -130,8 +139,6 @@ def default_sky(w=4096, h=2048, ss=8):
             img[r, c] += 1.0e5 * np.array([1.0, 0.92, 0.82]) * cover
     return img
 
-
-write("default_sky.exr", default_sky())
 
 
 def torus_knot(p=2, q=3, segments=1250, sides=40, tube=0.16):
@@ -171,8 +178,19 @@ def write_ply(name, verts, faces):
         f.write(rows.tobytes())
 
 
-verts, faces = torus_knot()
-# Lift it so that it rests above the floor at y = 0.
-verts[:, 1] += 0.6
-write_ply("knot.ply", verts, faces)
-print(f"knot: {len(faces)} triangles")
+def main():
+    write("furnace_env.exr", np.ones((32, 64, 3)))
+    img, texels = sharp_sun_map()
+    write("sharp_sun_env.exr", img)
+    print(f"sun texels: {texels}")
+    write("studio_env.exr", studio_map())
+    write("default_sky.exr", default_sky())
+    verts, faces = torus_knot()
+    # Lift it so that it rests above the floor at y = 0.
+    verts[:, 1] += 0.6
+    write_ply("knot.ply", verts, faces)
+    print(f"knot: {len(faces)} triangles")
+
+
+if __name__ == "__main__":
+    main()
