@@ -3,8 +3,8 @@
 "Equal time against Mitsuba 3").
 
   python3 docs/equal_time.py --out DIR [--spp 256] [--ref-spp 8192] [--methods mis,product-mis,auto]
-                             [--seeds 7] [--threads 2] [--clock wall|cpu] [--ppis target/release/ppis]
-                             SCENE.json...
+                             [--seeds 7] [--threads 2] [--clock wall|cpu] [--repeat 1]
+                             [--ppis target/release/ppis] SCENE.json...
 
 Per scene: Mitsuba's converged image (`ldsampler`, --ref-spp) and ours (`mis`, --ref-spp, another
 seed), each renderer measured against its own (the two differ on uncovered pixels by the map's
@@ -14,9 +14,15 @@ with `ldsampler` and `independent` at --spp, timed; each of our methods at --spp
 that its first time predicts for Mitsuba-ldsampler's time, its relMSE interpolated log-log at
 that time. Prints one Markdown table of times, relMSE and ratios at equal time, and the
 throughput per core: our shading points and shadow rays per second beside Mitsuba's (one primary
-ray and two shadow rays per sample: `direct` samples the emitter and the BSDF once each). With
+ray and two shadow rays per sample: `direct` samples the emitter and the BSDF once each), and
+the time per visibility sample (a light sample, whether or not its contribution needs a ray:
+ours skip the rays of samples that contribute nothing, so per traced ray is not the same
+measure) over Mitsuba's. A second table times our MIS in Mitsuba's structure, one camera ray and
+one pair of samples per sample, against Mitsuba's time and error at the same count. With
 several --seeds, every timed render (both renderers) is repeated per seed, a row per seed, and
-a last table gives each method's range of ratios over the seeds.
+a last table gives each method's range of ratios over the seeds. With --repeat N every timed
+render is run N times and its median time kept (the images are the same each time): on a
+machine whose speed drifts, one timing moves a ratio by tens of per cent.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
@@ -25,6 +31,7 @@ import argparse, json, math, os, re, subprocess, sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 MITSUBA_REF = os.path.join(HERE, 'reference', 'mitsuba_ref.py')
 CLOCK = 'wall'
+REPEAT = 1
 
 
 def run(cmd):
@@ -47,11 +54,20 @@ def relmse(image, reference, covered):
     return float(np.mean((o - r) ** 2 / (r ** 2 + 0.01)))
 
 
-def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=()):
-    text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
-                '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
+def median(values):
+    v = sorted(values)
+    return v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
+
+
+def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=(), repeat=None):
+    """Mitsuba's render time (the median of REPEAT timed renders, the same image each time)."""
     key = 'render_cpu_seconds' if CLOCK == 'cpu' else 'render_seconds'
-    return float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1))
+    times = []
+    for _ in range(repeat or REPEAT):
+        text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
+                    '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
+        times.append(float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1)))
+    return median(times)
 
 
 def seconds(stats):
@@ -59,12 +75,18 @@ def seconds(stats):
     return stats['render_cpu_seconds'] if CLOCK == 'cpu' else stats['render_seconds']
 
 
-def ours(args, scene, method, spp, seed, out):
+def ours(args, scene, method, spp, seed, out, extra=(), repeat=None):
+    """Our render's statistics, its time the median of REPEAT timed renders (the same image each
+    time)."""
     stats = out + '.json'
-    run([args.ppis, 'render', scene, '--method', method, '--spp', str(spp), '--seed', str(seed),
-         '--threads', str(args.threads), '-o', out, '--stats-json', stats])
-    with open(stats) as f:
-        return json.load(f)
+    runs = []
+    for _ in range(repeat or REPEAT):
+        run([args.ppis, 'render', scene, '--method', method, '--spp', str(spp), '--seed', str(seed),
+             '--threads', str(args.threads), '-o', out, '--stats-json', stats, *extra])
+        with open(stats) as f:
+            runs.append(json.load(f))
+    runs.sort(key=seconds)
+    return runs[len(runs) // 2]
 
 
 def at_time(points, t):
@@ -81,9 +103,10 @@ def scene_rows(args, scene, seed):
     name = os.path.splitext(os.path.basename(scene))[0]
     d = lambda f: os.path.join(args.out, f'{name}_{f}')
     if not os.path.exists(d('mref.exr')):
-        mitsuba(scene, args.ref_spp, 4242, d('mref.exr'), 'ldsampler', passes=4, extra=['--coverage-out', d('cov.exr')])
+        mitsuba(scene, args.ref_spp, 4242, d('mref.exr'), 'ldsampler', passes=4, extra=['--coverage-out', d('cov.exr')],
+                repeat=1)
     if not os.path.exists(d('pref.exr')):
-        ours(args, scene, 'mis', args.ref_spp, 4242, d('pref.exr'))
+        ours(args, scene, 'mis', args.ref_spp, 4242, d('pref.exr'), repeat=1)
     covered = load(d('cov.exr'))[..., 0] >= 0.999
     mref, pref = load(d('mref.exr')), load(d('pref.exr'))
     rows = {}
@@ -91,6 +114,11 @@ def scene_rows(args, scene, seed):
         t = mitsuba(scene, args.spp, seed, d(f'mts_{sampler}_{seed}.exr'), sampler)
         rows[sampler] = (t, relmse(load(d(f'mts_{sampler}_{seed}.exr')), mref, covered))
     target = rows['ldsampler'][0]
+    # Mitsuba's structure: one camera ray and one MIS pair (an emitter and a BSDF sample, the
+    # power heuristic) per sample, so 2·spp visibility samples over spp camera rays.
+    pairs = ours(args, scene, 'mis', 2 * args.spp, seed, d(f'mis_pairs_{seed}.exr'),
+                 ['--shading-points', str(args.spp), '--mis-heuristic', 'power'])
+    rows['pairs'] = (seconds(pairs), relmse(load(d(f'mis_pairs_{seed}.exr')), pref, covered))
     h, w = covered.shape
     results = []
     for method in args.methods:
@@ -121,17 +149,19 @@ def main():
                     help='time both renderers by wall clock (an idle machine) or by the CPU seconds of '
                          'all their threads (a machine shared with other work)')
     ap.add_argument('--ppis', default=os.path.join(HERE, '..', 'target', 'release', 'ppis'))
+    ap.add_argument('--repeat', type=int, default=1,
+                    help='time every render (both renderers) this many times and keep the median time')
     args = ap.parse_args()
-    global CLOCK
-    CLOCK = args.clock
+    global CLOCK, REPEAT
+    CLOCK, REPEAT = args.clock, max(1, args.repeat)
     os.makedirs(args.out, exist_ok=True)
     print(f'{args.spp} spp, {args.threads} threads; relMSE on covered pixels, each renderer against its own '
           f'converged image ({args.ref_spp} spp); "at Mitsuba-ld time": ours interpolated log-log at its time.\n')
     print('| scene | seed | Mitsuba ldsampler | Mitsuba independent | method | ours | ours at Mitsuba-ld time '
           '| / ldsampler | / independent | our shading points/s/core | our shadow rays/s/core '
-          '| Mitsuba-ld samples/s/core |')
-    print('|---|---:|---|---|---|---|---|---:|---:|---:|---:|---:|')
-    ratios = {}
+          '| Mitsuba-ld samples/s/core | time per visibility sample, ours / Mitsuba\'s |')
+    print('|---|---:|---|---|---|---|---|---:|---:|---:|---:|---:|---:|')
+    ratios, pair_rows = {}, []
     for scene in args.scenes:
         for seed in args.seeds:
             name, rows, results, samples = scene_rows(args, scene, seed)
@@ -140,15 +170,30 @@ def main():
                 # Mitsuba's independent sampler's error at ldsampler's time: error ∝ 1/time.
                 e_in_at = e_in * t_in / t_ld
                 ratios.setdefault((name, method), []).append(e_at / e_ld)
+                # Both at --spp: ours `spp` visibility samples per pixel, Mitsuba's two per sample.
+                per_sample = t / (t_ld / 2)
+                ratios.setdefault((name, method, 'sample'), []).append(per_sample)
                 print(f'| {name} | {seed} | {t_ld:.2f} s, {e_ld:.2e} | {t_in:.2f} s, {e_in:.2e} | {method} | {t:.2f} s, {e:.2e} '
                       f'| {e_at:.2e} | {e_at / e_ld:.2f} | {e_at / e_in_at:.2f} | {sp / 1e6:.2f} M | {sr / 1e6:.2f} M '
-                      f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M |', flush=True)
+                      f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M | {per_sample:.2f} |', flush=True)
+            t_p, e_p = rows['pairs']
+            ratios.setdefault((name, 'one pair per camera ray', 'time'), []).append(t_p / t_ld)
+            ratios.setdefault((name, 'one pair per camera ray', 'error'), []).append(e_p / e_ld)
+            pair_rows.append(f'| {name} | {seed} | {t_p:.2f} s, {e_p:.2e} | {t_p / t_ld:.2f} | {e_p / e_ld:.2f} |')
+    print('\nOur MIS in Mitsuba\'s structure (`--spp 2N --shading-points N --mis-heuristic power`: one camera '
+          'ray, one env and one BRDF sample per sample, as `direct` at N spp):\n')
+    print('| scene | seed | ours: CPU s, relMSE | time / Mitsuba-ld\'s (per camera ray) | relMSE / Mitsuba-ld\'s (equal samples) |')
+    print('|---|---:|---|---:|---:|')
+    print('\n'.join(pair_rows))
     if len(args.seeds) > 1:
-        print('\n| scene | method | / ldsampler over the seeds: min – max (median) |')
-        print('|---|---|---|')
-        for (name, method), r in ratios.items():
+        print('\n| scene | method | measure | over the seeds: min – max (median) |')
+        print('|---|---|---|---|')
+        measure = {'ratio': 'relMSE at equal time / ldsampler', 'sample': 'time per visibility sample / Mitsuba\'s',
+                   'time': 'time / Mitsuba-ld\'s', 'error': 'relMSE / Mitsuba-ld\'s'}
+        for key, r in ratios.items():
+            name, method, what = key if len(key) == 3 else (*key, 'ratio')
             r = sorted(r)
-            print(f'| {name} | {method} | {r[0]:.2f} – {r[-1]:.2f} ({r[len(r) // 2]:.2f}) |')
+            print(f'| {name} | {method} | {measure[what]} | {r[0]:.2f} – {r[-1]:.2f} ({r[len(r) // 2]:.2f}) |')
 
 
 if __name__ == '__main__':
