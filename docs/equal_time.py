@@ -21,7 +21,7 @@ measure) over Mitsuba's. A second table times our MIS in Mitsuba's structure, on
 one pair of samples per sample, against Mitsuba's time and error at the same count. With
 several --seeds, every timed render (both renderers) is repeated per seed, a row per seed, and
 a last table gives each method's range of ratios over the seeds. With --repeat N every timed
-render is run N times and its median time kept (the images are the same each time): on a
+render is run N times and its median time kept (the upper middle for an even N; the images are the same each time): on a
 machine whose speed drifts, one timing moves a ratio by tens of per cent.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
@@ -54,20 +54,21 @@ def relmse(image, reference, covered):
     return float(np.mean((o - r) ** 2 / (r ** 2 + 0.01)))
 
 
-def median(values):
-    v = sorted(values)
-    return v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
+def middle(values, key=None):
+    """The middle of `values` by `key` (the median for an odd count, the upper middle else): one
+    measured value, so that a render's statistics stay those of one run."""
+    return sorted(values, key=key)[len(values) // 2]
 
 
 def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=(), repeat=None):
-    """Mitsuba's render time (the median of REPEAT timed renders, the same image each time)."""
+    """Mitsuba's render time (the middle of REPEAT timed renders, the same image each time)."""
     key = 'render_cpu_seconds' if CLOCK == 'cpu' else 'render_seconds'
     times = []
     for _ in range(repeat or REPEAT):
         text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
                     '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
         times.append(float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1)))
-    return median(times)
+    return middle(times)
 
 
 def seconds(stats):
@@ -76,8 +77,8 @@ def seconds(stats):
 
 
 def ours(args, scene, method, spp, seed, out, extra=(), repeat=None):
-    """Our render's statistics, its time the median of REPEAT timed renders (the same image each
-    time)."""
+    """Our render's statistics, those of the middle by time of REPEAT timed renders (the same
+    image each time)."""
     stats = out + '.json'
     runs = []
     for _ in range(repeat or REPEAT):
@@ -85,8 +86,7 @@ def ours(args, scene, method, spp, seed, out, extra=(), repeat=None):
              '--threads', str(args.threads), '-o', out, '--stats-json', stats, *extra])
         with open(stats) as f:
             runs.append(json.load(f))
-    runs.sort(key=seconds)
-    return runs[len(runs) // 2]
+    return middle(runs, key=seconds)
 
 
 def at_time(points, t):
