@@ -21,8 +21,9 @@ measure) over Mitsuba's. A second table times our MIS in Mitsuba's structure, on
 one pair of samples per sample, against Mitsuba's time and error at the same count. With
 several --seeds, every timed render (both renderers) is repeated per seed, a row per seed, and
 a last table gives each method's range of ratios over the seeds. With --repeat N every timed
-render is run N times and its median time kept (the upper middle for an even N; the images are the same each time): on a
-machine whose speed drifts, one timing moves a ratio by tens of per cent.
+render is run N times and its median time kept (the upper middle for an even N; the images are
+the same each time): on a machine whose speed drifts, one timing moves a ratio by tens of per
+cent.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
