@@ -2,9 +2,9 @@
 //! level, so that one descent's loads and arithmetic overlap the others' instead of each
 //! waiting on its own mispredicted branches.
 //!
-//! * [`ProductSampler::sample_many`]: product samples — the tree first, then the environment's
-//!   levels below the leaves with the environment's own lanes (and the defensive env samples
-//!   from the root).
+//! * [`ProductSampler::sample_many`]: product samples — the tree first (four descents to an
+//!   AVX2 register where the CPU has it, `lanes_avx2.rs`), then the environment's levels below
+//!   the leaves with the environment's own lanes (and the defensive env samples from the root).
 //! * [`ProductSampler::pdf_square_many`]: product densities, descents side by side by the points' bits.
 
 use super::quadtree::{COORD_BITS, Node, quantize};
@@ -21,22 +21,22 @@ use glam::{DVec2, Vec2, Vec3};
 const WARPS: usize = 2 * LANES;
 
 /// One descent through the product tree.
-#[derive(Clone, Copy, Default)]
-struct TreeLane {
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct TreeLane {
     /// The node the descent is at (a copy: its leaf test needs no load) and its index.
-    node: Node,
-    index: usize,
+    pub(super) node: Node,
+    pub(super) index: usize,
     /// The node's cell.
-    cell: Cell,
+    pub(super) cell: Cell,
     /// Probability of the path so far (the leaf's, once there).
-    path: f64,
-    xi: DVec2,
+    pub(super) path: f64,
+    pub(super) xi: DVec2,
     /// Drawn by the defensive environment part of the mixture: no tree descent.
-    defensive: bool,
+    pub(super) defensive: bool,
     /// Still descending the tree.
-    in_tree: bool,
+    pub(super) in_tree: bool,
     /// False once the descent met a node without mass.
-    alive: bool,
+    pub(super) alive: bool,
 }
 
 impl ProductSampler<'_, '_> {
@@ -103,8 +103,18 @@ impl ProductSampler<'_, '_> {
         }
     }
 
-    /// Advances every lane still in the tree one level per round until all reach a leaf.
+    /// Advances every lane still in the tree one level per round until all reach a leaf: four
+    /// lanes to a register where the CPU has AVX2 (the same bits), else one at a time.
     fn descend_tree(&self, lanes: &mut [TreeLane]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.descend_tree_avx2(lanes) {
+            return;
+        }
+        self.descend_tree_scalar(lanes);
+    }
+
+    /// [`descend_tree`](Self::descend_tree) in scalar arithmetic, the lanes side by side.
+    pub(super) fn descend_tree_scalar(&self, lanes: &mut [TreeLane]) {
         loop {
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.in_tree) {

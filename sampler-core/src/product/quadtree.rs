@@ -48,8 +48,10 @@ const SUBNORMAL_SLACK: f32 = 1e-36;
 const SEARCH_FROM: usize = 32;
 const _: () = assert!(SEARCH_FROM <= 255, "split packs its counts in bytes");
 
-/// One node of the product tree.
+/// One node of the product tree. In C's layout: the AVX2 descent (`lanes_avx2.rs`) reads a
+/// node's four children as one row of eight 32-bit words.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Node {
     /// Index of the first of four consecutive children; 0 marks a leaf (the root is never a
     /// child).
