@@ -18,7 +18,7 @@ use glam::{DVec2, Vec2, Vec3};
 /// Product samples drawn side by side: a renderer's batch (`estimator::BATCH`) in one go, so
 /// that the environment's descents below the leaves, whose loads miss the caches at large maps,
 /// all have theirs in flight together (twice the environment's own [`LANES`]).
-const WARPS: usize = 2 * LANES;
+pub(super) const WARPS: usize = 2 * LANES;
 
 /// One descent through the product tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -7,7 +7,7 @@
 //!
 //! [`choose_child_branchless`]: crate::warp::choose_child_branchless
 
-use super::lanes::TreeLane;
+use super::lanes::{TreeLane, WARPS};
 use super::quadtree::Node;
 use super::sampler::ProductSampler;
 use crate::warp::ONE_MINUS_EPSILON;
@@ -20,8 +20,8 @@ static EMPTY: [Node; 4] = [Node { child: 0, product: 0.0 }; 4];
 const WIDTH: usize = 4;
 
 /// Groups of four lanes stepped together, level by level, so that one group's loads and
-/// divisions overlap the others' arithmetic.
-const GROUPS: usize = 4;
+/// divisions overlap the others' arithmetic: a batch of `sample_many`.
+const GROUPS: usize = WARPS / WIDTH;
 
 impl ProductSampler<'_, '_> {
     /// Descends `lanes` as [`descend_tree_scalar`](Self::descend_tree_scalar) does, bit for bit,
