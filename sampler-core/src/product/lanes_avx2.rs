@@ -19,6 +19,8 @@ static EMPTY: [Node; 4] = [Node { child: 0, product: 0.0 }; 4];
 /// Lanes per register.
 const WIDTH: usize = 4;
 
+const _: () = assert!(size_of::<Node>() == 8, "a row of four children is read as 32 bytes");
+
 /// Groups of four lanes stepped together, level by level, so that one group's loads and
 /// divisions overlap the others' arithmetic: a batch of `sample_many`.
 const GROUPS: usize = WARPS / WIDTH;
