@@ -1,6 +1,7 @@
 //! The AVX2 register operations of the env-only descents (`lanes_avx2.rs`): lane masks, a
 //! side picked for four lanes at once, and the blocks of sixteen grandchildren transposed into
-//! registers — each the scalar step's operations in its order.
+//! registers — each the scalar step's operations in its order. The masks, the clamp and the
+//! read-back serve the product tree's descents too (`product/lanes_avx2.rs`).
 
 use crate::warp::ONE_MINUS_EPSILON;
 use core::arch::x86_64::*;
@@ -8,7 +9,7 @@ use core::arch::x86_64::*;
 /// Lane bits as a mask register (all ones where set).
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) fn lane_mask(bits: i32) -> __m256d {
+pub(crate) fn lane_mask(bits: i32) -> __m256d {
     let m = |k: i32| if bits & (1 << k) != 0 { -1 } else { 0 };
     _mm256_castsi256_pd(_mm256_setr_epi64x(m(0), m(1), m(2), m(3)))
 }
@@ -16,7 +17,7 @@ pub(super) fn lane_mask(bits: i32) -> __m256d {
 /// The four f64 of a register.
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) fn floats(v: __m256d) -> [f64; 4] {
+pub(crate) fn floats(v: __m256d) -> [f64; 4] {
     let mut out = [0.0; 4];
     // SAFETY: `out` holds four f64.
     unsafe { _mm256_storeu_pd(out.as_mut_ptr(), v) };
@@ -94,7 +95,7 @@ pub(super) fn select(at_least: [__m256d; 3], v: [__m256d; 4]) -> __m256d {
 /// `f64::clamp(v, 0, ONE_MINUS_EPSILON)` per lane.
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) fn clamp_unit(v: __m256d) -> __m256d {
+pub(crate) fn clamp_unit(v: __m256d) -> __m256d {
     let (lo, hi) = (_mm256_setzero_pd(), _mm256_set1_pd(ONE_MINUS_EPSILON));
     let v = _mm256_blendv_pd(v, lo, _mm256_cmp_pd::<_CMP_LT_OQ>(v, lo));
     _mm256_blendv_pd(v, hi, _mm256_cmp_pd::<_CMP_GT_OQ>(v, hi))

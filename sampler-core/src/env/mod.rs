@@ -43,6 +43,8 @@ mod texel_cdf;
 pub use compensation::compensate_pyramid;
 pub use hierarchy::EnvHierarchy;
 pub(crate) use lanes::{IN_FLIGHT, LANES, WarpLane};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use lanes_avx2_ops::{clamp_unit, floats, lane_mask};
 pub use mis_heuristic::MisHeuristic;
 pub use plane::COSINE_LEVEL;
 pub use pyramid::{

@@ -21,7 +21,7 @@ use glam::{DVec2, Vec2, Vec3};
 pub(super) const WARPS: usize = 2 * LANES;
 
 /// One descent through the product tree.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Default)]
 pub(super) struct TreeLane {
     /// The node the descent is at (a copy: its leaf test needs no load) and its index.
     pub(super) node: Node,

@@ -10,7 +10,7 @@
 use super::lanes::{TreeLane, WARPS};
 use super::quadtree::Node;
 use super::sampler::ProductSampler;
-use crate::warp::ONE_MINUS_EPSILON;
+use crate::env::{clamp_unit, floats, lane_mask};
 use core::arch::x86_64::*;
 
 /// Children of a lane that takes no part in a step: no mass.
@@ -168,23 +168,6 @@ fn masses(rows: [&[Node; 4]; WIDTH]) -> [__m256d; 4] {
     [f64s(low(mass02)), f64s(low(mass13)), f64s(high(mass02)), f64s(high(mass13))]
 }
 
-/// `f64::clamp(v, 0, ONE_MINUS_EPSILON)` per lane.
-#[inline]
-#[target_feature(enable = "avx2")]
-fn clamp_unit(v: __m256d) -> __m256d {
-    let (lo, hi) = (_mm256_setzero_pd(), _mm256_set1_pd(ONE_MINUS_EPSILON));
-    let v = _mm256_blendv_pd(v, lo, _mm256_cmp_pd::<_CMP_LT_OQ>(v, lo));
-    _mm256_blendv_pd(v, hi, _mm256_cmp_pd::<_CMP_GT_OQ>(v, hi))
-}
-
-/// Lane bits as a mask register (all ones where set).
-#[inline]
-#[target_feature(enable = "avx2")]
-fn lane_mask(bits: i32) -> __m256d {
-    let m = |k: i32| -i64::from((bits >> k) & 1);
-    _mm256_castsi256_pd(_mm256_setr_epi64x(m(0), m(1), m(2), m(3)))
-}
-
 /// The ξ of up to four lanes, x and y each in a register (missing lanes 0).
 #[inline]
 #[target_feature(enable = "avx2")]
@@ -198,12 +181,7 @@ fn load_xi(four: &[TreeLane]) -> [__m256d; 2] {
 #[inline]
 #[target_feature(enable = "avx2")]
 fn store_xi(xi: &[__m256d; 2], four: &mut [TreeLane]) {
-    let (mut xs, mut ys) = ([0.0f64; 4], [0.0f64; 4]);
-    // SAFETY: each array holds four f64.
-    unsafe {
-        _mm256_storeu_pd(xs.as_mut_ptr(), xi[0]);
-        _mm256_storeu_pd(ys.as_mut_ptr(), xi[1]);
-    }
+    let (xs, ys) = (floats(xi[0]), floats(xi[1]));
     for (k, lane) in four.iter_mut().enumerate() {
         lane.xi = glam::DVec2::new(xs[k], ys[k]);
     }
@@ -217,6 +195,7 @@ mod tests {
     use crate::env::{EnvHierarchy, build_pyramid, pyramid_len};
     use crate::frame::Frame;
     use crate::sampler::{ProductArena, ProductParams};
+    use crate::warp::ONE_MINUS_EPSILON;
     use glam::{DVec2, Vec3};
     use std::boxed::Box;
     use std::vec;
