@@ -9,7 +9,7 @@ use crate::render::shade::{self, CountingVisibility, Run, Sampling};
 use crate::render::shade_cuts::shade_cuts;
 use crate::render::shade_lights::{budgets, shade_lights};
 use crate::render::strategy::Strategy;
-use crate::render::wavefront::{self, WaveBuffers};
+use crate::render::wavefront::{self, Shadows, WaveBuffers};
 use crate::render::{Context, Counters};
 use crate::scene::{Bsdf, Scene};
 use crate::trace::bvh::{self, Surface};
@@ -333,10 +333,8 @@ fn shade_members(
         let _ = points.push(shading_point(ctx.scene, h));
         (runs[i], origins[i]) = (run_of(h), h.origin);
     }
-    let shadows = ctx.options.shadows;
-    let origins = &origins[..m];
-    let occluded = |i: usize, dir: Vec3| shadows && ctx.bvh.occluded(origins[i], dir, 0.0, f32::INFINITY);
-    wavefront::shade_wavefront(sampling, env, &points, &runs[..m], budget, waves, occluded, &mut out[..m])
+    let shadows = Shadows { origins: &origins[..m], bvh: ctx.options.shadows.then_some(ctx.bvh) };
+    wavefront::shade_wavefront(sampling, env, &points, &runs[..m], budget, waves, shadows, &mut out[..m])
         .map_or(0, |r| r as u64)
 }
 

@@ -3,9 +3,10 @@
 //! point — the environment (env, BRDF and MIS sampling) or the pixel's shared product-MIS or
 //! two-level-MIS sampler — and each point takes few samples: then each point's estimate is the
 //! per-point estimator's ([`shade::shade`]) bit for bit, but the samples of all points are
-//! drawn together, and each shadow ray is traced as its point's estimate sums its sample.
+//! drawn together, and their shadow rays are traced together.
 
 use crate::render::shade::{Run, Sampling};
+use crate::trace::bvh::{Bvh, RaysAhead};
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::wavefront::{Candidate, Technique, WaveSample, Weighting, wavefront};
@@ -90,14 +91,25 @@ pub(crate) fn split_shares(first: usize, brdf: usize) -> (f32, f32) {
 pub(crate) struct WaveBuffers {
     samples: Vec<WaveSample>,
     candidates: Vec<Candidate>,
+    rays: RaysAhead,
+    blocked: Vec<bool>,
+}
+
+/// What a wavefront's shadow rays need: where each shading point's rays start, and the scene
+/// that blocks them (`None` where nothing casts shadows).
+pub(crate) struct Shadows<'a> {
+    /// Each shading point's ray origin, offset from its surface.
+    pub origins: &'a [Vec3],
+    /// The scene's hierarchy, or `None` for unshadowed light.
+    pub bvh: Option<&'a Bvh>,
 }
 
 /// Each shading point's estimate of its direct light into `out`, from `budget` samples drawn
 /// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
-/// through one sampler for all of them and the budget is small ([`fits`]). Each sample that
-/// needs a shadow ray asks `occluded(k, dir)` whether direction `dir` is blocked at point k,
-/// in the order the estimates sum them; returns how many rays it asked for. `None` (nothing
-/// done) where the wavefront does not fit.
+/// through one sampler for all of them and the budget is small ([`fits`]). The shadow rays of
+/// the samples that need one are traced together ([`Bvh::occluded_ahead_many`]) where the scene
+/// answers them in batches, else one by one; returns how many rays it asked for. `None` (nothing done) where the wavefront
+/// does not fit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_wavefront(
     sampling: &Sampling<'_, '_>,
@@ -106,7 +118,7 @@ pub(crate) fn shade_wavefront(
     runs: &[Run],
     budget: usize,
     buffers: &mut WaveBuffers,
-    mut occluded: impl FnMut(usize, Vec3) -> bool,
+    shadows: Shadows<'_>,
     out: &mut [DVec3],
 ) -> Option<usize> {
     let layout = layout(sampling, budget)?;
@@ -137,20 +149,57 @@ pub(crate) fn shade_wavefront(
         Sampling::TwoLevelMis { sampler, .. } => wavefront(sampler, points, samples, weighting, candidates),
         _ => wavefront(env, points, samples, weighting, candidates),
     }
-    // Each shadow ray as its sample is summed: a ray's answer is used where it is found, and
-    // no list of rays and answers is written and read back.
-    let mut rays = 0;
-    for (k, (candidates, o)) in candidates.chunks(per_point).zip(out.iter_mut()).enumerate() {
+    // Where the scene answers rays in batches, the rays in the order the estimates sum their
+    // samples, so that the answers are read back in turn; written without a branch on which
+    // samples need one (about one in three does not, with no pattern a branch predictor
+    // finds). Elsewhere each ray is traced as its estimate sums its sample.
+    let batch = shadows.bvh.filter(|b| b.batches_rays_ahead());
+    let blocked = match batch {
+        Some(bvh) => {
+            trace_batch(bvh, shadows.origins, candidates, per_point, (&mut buffers.rays, &mut buffers.blocked))
+        }
+        None => &mut [],
+    };
+    let (mut traced, mut next) = (0, 0);
+    for (origin, (candidates, o)) in shadows.origins.iter().zip(candidates.chunks(per_point).zip(out.iter_mut())) {
         let mut value = |c: &Candidate| {
             if !c.needs_ray {
                 return DVec3::ZERO;
             }
-            rays += 1;
-            if occluded(k, c.dir) { DVec3::ZERO } else { c.value }
+            traced += 1;
+            let occluded = match (batch, shadows.bvh) {
+                (Some(_), _) => {
+                    next += 1;
+                    blocked[next - 1]
+                }
+                (None, Some(bvh)) => bvh.occluded(*origin, c.dir, 0.0, f32::INFINITY),
+                (None, None) => false,
+            };
+            if occluded { DVec3::ZERO } else { c.value }
         };
         *o = reduce(layout, candidates, &mut value);
     }
-    Some(rays)
+    Some(traced)
+}
+
+/// Whether each candidate's shadow ray that `needs_ray` is blocked, in the candidates' order
+/// (`per_point` of them per origin), traced as one batch (`rays` and `blocked` reused).
+fn trace_batch<'b>(
+    bvh: &Bvh,
+    origins: &[Vec3],
+    candidates: &[Candidate],
+    per_point: usize,
+    (rays, blocked): (&mut RaysAhead, &'b mut Vec<bool>),
+) -> &'b mut [bool] {
+    rays.clear_for(candidates.len());
+    for (origin, candidates) in origins.iter().zip(candidates.chunks(per_point)) {
+        for c in candidates {
+            rays.push_if(*origin, c.dir, c.needs_ray);
+        }
+    }
+    let blocked = at_least(blocked, rays.len(), false);
+    bvh.occluded_ahead_many(rays, blocked);
+    blocked
 }
 
 /// The first `n` entries of `buffer`, grown to hold them (with `fill`) if it is shorter.

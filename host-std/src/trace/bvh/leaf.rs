@@ -8,7 +8,7 @@ use super::lanes::F4;
 use sampler_core::glam::Vec3;
 
 /// A lane with no primitive.
-const NONE: u32 = u32::MAX;
+pub(super) const NONE: u32 = u32::MAX;
 
 /// Up to four primitives of one leaf.
 #[derive(Clone, Copy, Debug)]
