@@ -67,6 +67,10 @@ pub struct Scratch {
 struct GroupBuffers {
     /// The film positions of the group's camera rays.
     film: [DVec2; GROUP],
+    /// The camera rays' directions.
+    dirs: [Vec3; GROUP],
+    /// Where each camera ray hits.
+    found: [Option<bvh::Hit>; GROUP],
     /// Each hit's estimate, by hit.
     values: [DVec3; GROUP],
     /// Whether a hit is shaded yet, by hit.
@@ -85,6 +89,8 @@ impl Default for GroupBuffers {
     fn default() -> Self {
         Self {
             film: [DVec2::ZERO; GROUP],
+            dirs: [Vec3::ZERO; GROUP],
+            found: [None; GROUP],
             values: [DVec3::ZERO; GROUP],
             done: [false; GROUP],
             members: [0; GROUP],
@@ -134,10 +140,15 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
         let m = (p - done).min(GROUP);
         let film = &mut scratch.group.film[..m];
         sobol02(seeds.pixel, done as u32, film);
+        let dirs = &mut scratch.group.dirs[..m];
+        for (d, f) in dirs.iter_mut().zip(film.iter()) {
+            *d = camera_ray(ctx.camera, x, y, *f, &mut scratch.counters);
+        }
+        let found = &mut scratch.group.found[..m];
+        ctx.bvh.intersect_from(ctx.camera.origin, dirs, ctx.camera.near_clip, found);
         scratch.hits.clear();
-        for (k, f) in film.iter().enumerate() {
-            let dir = camera_ray(ctx.camera, x, y, *f, &mut scratch.counters);
-            let Some(hit) = ctx.bvh.intersect(ctx.camera.origin, dir, ctx.camera.near_clip, f32::INFINITY) else {
+        for (k, (&dir, hit)) in dirs.iter().zip(found.iter()).enumerate() {
+            let Some(hit) = hit else {
                 if let Some(radiance) = background(ctx, dir) {
                     sum += radiance;
                 }
@@ -145,7 +156,7 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
             };
             match hit.surface {
                 Surface::Material(material) => {
-                    if let Some(h) = surface(ctx, dir, &hit, material, done + k) {
+                    if let Some(h) = surface(ctx, dir, hit, material, done + k) {
                         scratch.hits.push(h);
                     }
                 }

@@ -87,10 +87,10 @@ pub struct Bvh {
     disks: Vec<disk::Disk>,
     /// The blocks (first, count) of a tree that is one leaf, which rays test directly.
     lone_leaf: Option<(u32, u32)>,
-    /// The lone leaf's primitives for shadow rays eight at a time, where the tree is one leaf,
-    /// no disk is beside it and the CPU has AVX2.
+    /// The lone leaf's primitives for rays eight at a time, where the tree is one leaf, no
+    /// disk is beside it and the CPU has AVX2.
     #[cfg(target_arch = "x86_64")]
-    lane_prims: Option<Vec<ray_lanes::LanePrim>>,
+    lanes: Option<ray_lanes::LoneLeaf>,
 }
 
 impl Bvh {
@@ -102,12 +102,9 @@ impl Bvh {
         let (nodes, blocks) = wide::collapse(&binary, &prims);
         let lone_leaf = wide::lone_leaf(&nodes);
         #[cfg(target_arch = "x86_64")]
-        let lane_prims =
-            lone_leaf.filter(|_| disks.is_empty() && std::is_x86_feature_detected!("avx2")).map(|(first, count)| {
-                let leaf = &blocks[first as usize..(first + count) as usize];
-                let ids = leaf.iter().flat_map(|b| b.prim).filter(|&id| id != leaf::NONE);
-                ids.map(|id| ray_lanes::LanePrim::of(&prims[id as usize])).collect()
-            });
+        let lanes = lone_leaf
+            .filter(|_| disks.is_empty() && std::is_x86_feature_detected!("avx2"))
+            .map(|(first, count)| ray_lanes::LoneLeaf::new(&blocks[first as usize..(first + count) as usize], &prims));
         Bvh {
             prims,
             nodes,
@@ -116,7 +113,7 @@ impl Bvh {
             disks,
             lone_leaf,
             #[cfg(target_arch = "x86_64")]
-            lane_prims,
+            lanes,
         }
     }
 
@@ -164,8 +161,12 @@ impl Bvh {
             let surface = Surface::from_id(disk.surface);
             return Some(Hit { t, point, normal, shading_normal: normal, uv: None, surface });
         }
-        let prim = best?;
-        let point = o + t_max * d;
+        best.map(|prim| self.hit_at(prim, o, d, t_max))
+    }
+
+    /// The hit of the ray o + t·d on primitive `prim` at distance `t`.
+    fn hit_at(&self, prim: usize, o: Vec3, d: Vec3, t: f32) -> Hit {
+        let point = o + t * d;
         let mut uv = None;
         let (normal, shading, surface) = match self.prims[prim] {
             Primitive::Sphere { center, radius, surface } => {
@@ -195,7 +196,35 @@ impl Bvh {
                 }
             }
         };
-        Some(Hit { t: t_max, point, normal, shading_normal: shading, uv, surface: Surface::from_id(surface) })
+        Hit { t, point, normal, shading_normal: shading, uv, surface: Surface::from_id(surface) }
+    }
+
+    /// [`Bvh::intersect`] of rays from one point `o` (a pinhole camera's) along each of `dirs`,
+    /// t ∈ (t_min, ∞): `out[k]` is ray k's hit, bit for bit the one-at-a-time call's. In a scene
+    /// that is one leaf, with no disk beside it, rays go eight to a register where the CPU has
+    /// AVX2 (`ray_lanes.rs`). Panics unless `out` has one entry per direction.
+    pub fn intersect_from(&self, o: Vec3, dirs: &[Vec3], t_min: f32, out: &mut [Option<Hit>]) {
+        assert_eq!(dirs.len(), out.len(), "intersect_from: one hit per ray");
+        #[cfg(target_arch = "x86_64")]
+        if let Some(leaf) = &self.lanes {
+            const LANES: usize = ray_lanes::LANES;
+            for (dirs, out) in dirs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                let mut rows = [[0.0f32; LANES]; 3];
+                for (k, d) in dirs.iter().enumerate() {
+                    (rows[0][k], rows[1][k], rows[2][k]) = (d.x, d.y, d.z);
+                }
+                // SAFETY: `lanes` exists only where the CPU has AVX2.
+                let (t, found) = unsafe { ray_lanes::closest(&leaf.prims, o, rows.each_ref(), t_min) };
+                for (k, (d, h)) in dirs.iter().zip(out.iter_mut()).enumerate() {
+                    let prim = leaf.ids.get(found[k] as usize);
+                    *h = prim.map(|&p| self.hit_at(p as usize, o, *d, t[k]));
+                }
+            }
+            return;
+        }
+        for (d, h) in dirs.iter().zip(out.iter_mut()) {
+            *h = self.intersect(o, *d, t_min, f32::INFINITY);
+        }
     }
 
     /// True if anything blocks o + t·d for t ∈ (t_min, t_max).
@@ -272,7 +301,7 @@ impl Bvh {
     #[must_use]
     pub fn batches_rays_ahead(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
-        return self.lane_prims.is_some();
+        return self.lanes.is_some();
         #[cfg(not(target_arch = "x86_64"))]
         return false;
     }
@@ -284,10 +313,10 @@ impl Bvh {
     pub fn occluded_ahead_many(&self, rays: &RaysAhead, out: &mut [bool]) {
         assert_eq!(rays.len(), out.len(), "occluded_ahead_many: one answer per ray");
         #[cfg(target_arch = "x86_64")]
-        if let Some(prims) = &self.lane_prims {
+        if let Some(leaf) = &self.lanes {
             for (first, out) in (0..).step_by(ray_lanes::LANES).zip(out.chunks_mut(ray_lanes::LANES)) {
-                // SAFETY: `lane_prims` exists only where the CPU has AVX2.
-                let blocked = unsafe { ray_lanes::blocked_ahead(prims, rays, first) };
+                // SAFETY: `lanes` exists only where the CPU has AVX2.
+                let blocked = unsafe { ray_lanes::blocked_ahead(&leaf.prims, rays, first) };
                 for (k, o) in out.iter_mut().enumerate() {
                     *o = blocked & (1 << k) != 0;
                 }
