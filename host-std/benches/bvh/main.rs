@@ -11,7 +11,8 @@ mod theirs_obvhs;
 
 use cpu_time::ThreadCpu;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use host_std::trace::bvh::ShadowRay;
+use host_std::trace::bvh::{RaysAhead, ShadowRay};
+use sampler_core::glam::Vec3;
 use scenes::{Case, Ray};
 use std::hint::black_box;
 use std::time::Duration;
@@ -84,7 +85,7 @@ fn measure(c: &mut Criterion<ThreadCpu>, case: &Case, name: &str, t: &impl Trace
     g.finish();
 }
 
-/// Our shadow rays through the batched call, in batches of 256 as a wavefront would hand them.
+/// Our rays through the batched calls, in batches as the renderer hands them.
 fn many(c: &mut Criterion<ThreadCpu>, case: &Case) {
     let rays: Vec<ShadowRay> =
         case.shadow.iter().map(|r| ShadowRay { origin: r.o, dir: r.d, t_min: r.t_min, t_max: f32::INFINITY }).collect();
@@ -98,6 +99,43 @@ fn many(c: &mut Criterion<ThreadCpu>, case: &Case) {
                 let out = &mut out[..batch.len()];
                 case.bvh.occluded_many(black_box(batch), out);
                 n += out.iter().filter(|&&o| o).count();
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+    // The batches the renderer hands over: a wavefront's shadow rays over (0, ∞) as structure
+    // of arrays, and a pixel group's camera rays from the camera's origin.
+    let mut ahead = RaysAhead::default();
+    let mut blocked = vec![false; 256];
+    let mut g = c.benchmark_group(format!("shadow/{}", case.name));
+    g.throughput(Throughput::Elements(case.shadow.len() as u64));
+    g.bench_function("ours-ahead", |b| {
+        b.iter(|| {
+            let mut n = 0;
+            for batch in case.shadow.chunks(256) {
+                ahead.clear_for(batch.len());
+                batch.iter().for_each(|r| ahead.push_if(r.o, r.d, true));
+                let out = &mut blocked[..batch.len()];
+                case.bvh.occluded_ahead_many(black_box(&ahead), out);
+                n += out.iter().filter(|&&o| o).count();
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+    let (origin, t_min) = (case.camera[0].o, case.camera[0].t_min);
+    let dirs: Vec<Vec3> = case.camera.iter().map(|r| r.d).collect();
+    let mut found = vec![None; 64];
+    let mut g = c.benchmark_group(format!("closest/{}", case.name));
+    g.throughput(Throughput::Elements(dirs.len() as u64));
+    g.bench_function("ours-from", |b| {
+        b.iter(|| {
+            let mut n = 0;
+            for batch in dirs.chunks(64) {
+                let out = &mut found[..batch.len()];
+                case.bvh.intersect_from(origin, black_box(batch), t_min, out);
+                n += out.iter().filter(|h| h.is_some()).count();
             }
             black_box(n)
         })

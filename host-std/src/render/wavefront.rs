@@ -149,32 +149,35 @@ pub(crate) fn shade_wavefront(
         Sampling::TwoLevelMis { sampler, .. } => wavefront(sampler, points, samples, weighting, candidates),
         _ => wavefront(env, points, samples, weighting, candidates),
     }
-    // Where the scene answers rays in batches, the rays in the order the estimates sum their
-    // samples, so that the answers are read back in turn; written without a branch on which
-    // samples need one (about one in three does not, with no pattern a branch predictor
-    // finds). Elsewhere each ray is traced as its estimate sums its sample.
-    let batch = shadows.bvh.filter(|b| b.batches_rays_ahead());
-    let blocked = match batch {
-        Some(bvh) => {
-            trace_batch(bvh, shadows.origins, candidates, per_point, (&mut buffers.rays, &mut buffers.blocked))
+    // Where the scene answers rays in batches, its rays are traced first and their answers read
+    // back in the order the estimates sum their samples; elsewhere each ray is traced as its
+    // estimate sums its sample.
+    if let Some(bvh) = shadows.bvh.filter(|b| b.batches_rays_ahead()) {
+        let bufs = (&mut buffers.rays, &mut buffers.blocked);
+        let blocked = trace_batch(bvh, shadows.origins, candidates, per_point, bufs);
+        let mut next = 0;
+        for (candidates, o) in candidates.chunks(per_point).zip(out.iter_mut()) {
+            // Without a branch on the sample (about one in three needs no ray, and which ones
+            // follows no pattern a predictor finds): a sample without a ray has the value +0,
+            // which the next ray's answer leaves +0 (the answers end in one that is not
+            // blocked), and a blocked ray's value is cleared to +0 by its bits.
+            let mut value = |c: &Candidate| {
+                let keep = u64::from(!blocked[next]).wrapping_neg();
+                next += usize::from(c.needs_ray);
+                c.value.to_array().map(|v| f64::from_bits(v.to_bits() & keep)).into()
+            };
+            *o = reduce(layout, candidates, &mut value);
         }
-        None => &mut [],
-    };
-    let (mut traced, mut next) = (0, 0);
+        return Some(next);
+    }
+    let mut traced = 0;
     for (origin, (candidates, o)) in shadows.origins.iter().zip(candidates.chunks(per_point).zip(out.iter_mut())) {
         let mut value = |c: &Candidate| {
             if !c.needs_ray {
                 return DVec3::ZERO;
             }
             traced += 1;
-            let occluded = match (batch, shadows.bvh) {
-                (Some(_), _) => {
-                    next += 1;
-                    blocked[next - 1]
-                }
-                (None, Some(bvh)) => bvh.occluded(*origin, c.dir, 0.0, f32::INFINITY),
-                (None, None) => false,
-            };
+            let occluded = shadows.bvh.is_some_and(|bvh| bvh.occluded(*origin, c.dir, 0.0, f32::INFINITY));
             if occluded { DVec3::ZERO } else { c.value }
         };
         *o = reduce(layout, candidates, &mut value);
@@ -183,7 +186,8 @@ pub(crate) fn shade_wavefront(
 }
 
 /// Whether each candidate's shadow ray that `needs_ray` is blocked, in the candidates' order
-/// (`per_point` of them per origin), traced as one batch (`rays` and `blocked` reused).
+/// (`per_point` of them per origin), traced as one batch (`rays` and `blocked` reused), and one
+/// answer more, not blocked, after the last.
 fn trace_batch<'b>(
     bvh: &Bvh,
     origins: &[Vec3],
@@ -197,8 +201,10 @@ fn trace_batch<'b>(
             rays.push_if(*origin, c.dir, c.needs_ray);
         }
     }
-    let blocked = at_least(blocked, rays.len(), false);
-    bvh.occluded_ahead_many(rays, blocked);
+    let blocked = at_least(blocked, rays.len() + 1, false);
+    let (answers, last) = blocked.split_at_mut(rays.len());
+    bvh.occluded_ahead_many(rays, answers);
+    last[0] = false;
     blocked
 }
 
