@@ -108,8 +108,8 @@ pub(crate) struct Shadows<'a> {
 /// as `sampling` says (`runs[k]`: point k's run of its pixel's sequences), if `sampling` draws
 /// through one sampler for all of them and the budget is small ([`fits`]). The shadow rays of
 /// the samples that need one are traced together ([`Bvh::occluded_ahead_many`]) where the scene
-/// answers them in batches, else one by one; returns how many rays it asked for. `None` (nothing done) where the wavefront
-/// does not fit.
+/// answers them in batches, else one by one; returns how many rays it asked for. `None`
+/// (nothing done) where the wavefront does not fit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_wavefront(
     sampling: &Sampling<'_, '_>,
@@ -152,22 +152,25 @@ pub(crate) fn shade_wavefront(
     // Where the scene answers rays in batches, its rays are traced first and their answers read
     // back in the order the estimates sum their samples; elsewhere each ray is traced as its
     // estimate sums its sample.
+    debug_assert_eq!(shadows.origins.len(), runs.len(), "one ray origin per shading point");
     if let Some(bvh) = shadows.bvh.filter(|b| b.batches_rays_ahead()) {
         let bufs = (&mut buffers.rays, &mut buffers.blocked);
         let blocked = trace_batch(bvh, shadows.origins, candidates, per_point, bufs);
         let mut next = 0;
         for (candidates, o) in candidates.chunks(per_point).zip(out.iter_mut()) {
-            // Without a branch on the sample (about one in three needs no ray, and which ones
-            // follows no pattern a predictor finds): a sample without a ray has the value +0,
-            // which the next ray's answer leaves +0 (the answers end in one that is not
-            // blocked), and a blocked ray's value is cleared to +0 by its bits.
+            // Without a branch on the sample (which samples need no ray follows no pattern a
+            // predictor finds): a sample without a ray has the value +0, which the next ray's
+            // answer leaves +0 (the answers end in one that is not blocked), and a blocked
+            // ray's value is cleared to +0 by its bits.
             let mut value = |c: &Candidate| {
+                debug_assert!(c.needs_ray || c.value.to_array().iter().all(|v| v.to_bits() == 0));
                 let keep = u64::from(!blocked[next]).wrapping_neg();
                 next += usize::from(c.needs_ray);
                 c.value.to_array().map(|v| f64::from_bits(v.to_bits() & keep)).into()
             };
             *o = reduce(layout, candidates, &mut value);
         }
+        debug_assert_eq!(next, blocked.len() - 1, "every answer read");
         return Some(next);
     }
     let mut traced = 0;

@@ -20,13 +20,18 @@ impl RaysAhead {
     /// Empties the list and makes room for `n` rays: [`RaysAhead::push_if`] of up to `n` rays
     /// then allocates nothing (the rows only grow).
     pub fn clear_for(&mut self, n: usize) {
-        let room = (n + 1).div_ceil(BLOCK) * BLOCK;
+        self.grow_rows(n);
+        self.len = 0;
+    }
+
+    /// Rows long enough for `n` rays, in whole blocks.
+    fn grow_rows(&mut self, n: usize) {
+        let room = n.div_ceil(BLOCK).max(1) * BLOCK;
         for row in self.origin.iter_mut().chain(&mut self.dir) {
             if row.len() < room {
                 row.resize(room, 0.0);
             }
         }
-        self.len = 0;
     }
 
     /// Writes the ray from `o` along `d` after the last and keeps it where `keep`: a list
@@ -43,10 +48,8 @@ impl RaysAhead {
 
     /// Appends the ray from `o` along `d`, making room for it.
     pub fn push(&mut self, o: Vec3, d: Vec3) {
-        if self.origin[0].len() <= self.len + 1 {
-            let len = self.len;
-            self.clear_for(2 * len + BLOCK);
-            self.len = len;
+        if self.origin[0].len() <= self.len {
+            self.grow_rows(2 * self.len + BLOCK);
         }
         self.push_if(o, d, true);
     }
@@ -66,6 +69,7 @@ impl RaysAhead {
     /// Ray `k`: its origin and direction.
     #[must_use]
     pub fn ray(&self, k: usize) -> (Vec3, Vec3) {
+        assert!(k < self.len, "ray {k} of {}", self.len);
         let at = |rows: &[Vec<f32>; 3]| Vec3::new(rows[0][k], rows[1][k], rows[2][k]);
         (at(&self.origin), at(&self.dir))
     }
@@ -74,14 +78,15 @@ impl RaysAhead {
     /// and directions, a row per coordinate.
     #[cfg(target_arch = "x86_64")]
     pub(super) fn block(&self, first: usize) -> ([&[f32; BLOCK]; 3], [&[f32; BLOCK]; 3]) {
-        (rows(&self.origin, first), rows(&self.dir, first))
+        debug_assert!(first.is_multiple_of(BLOCK) && first < self.len, "block from {first} of {}", self.len);
+        (block_of(&self.origin, first), block_of(&self.dir, first))
     }
 }
 
-/// The block of `rows` from entry `first`.
+/// The block of three rows from entry `first` (the rows are whole blocks long).
 #[cfg(target_arch = "x86_64")]
-fn rows(rows: &[Vec<f32>; 3], first: usize) -> [&[f32; BLOCK]; 3] {
-    rows.each_ref().map(|r| r[first..first + BLOCK].try_into().expect("whole blocks"))
+fn block_of(rows: &[Vec<f32>; 3], first: usize) -> [&[f32; BLOCK]; 3] {
+    rows.each_ref().map(|r| r[first..first + BLOCK].try_into().expect("a slice of BLOCK entries"))
 }
 
 #[cfg(test)]

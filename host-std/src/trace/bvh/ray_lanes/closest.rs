@@ -1,7 +1,7 @@
 //! Camera rays' nearest hits, eight rays from one point to a register, among the lone leaf's
 //! primitives.
 
-use super::{LANES, LanePrim, and3, cross, dot, splat3};
+use super::{LANES, LanePrim, and3, cross, dot, load8, sphere_quadratic, splat3, sub3};
 use core::arch::x86_64::*;
 use sampler_core::glam::Vec3;
 
@@ -9,8 +9,7 @@ use sampler_core::glam::Vec3;
 /// (`t_min`, ∞): per lane the distance and the index into `prims` of the primitive hit (`u32::MAX`
 /// where none is). The primitives are met in order and a nearer hit replaces an earlier only
 /// where strictly nearer, as the blocks' lanes are met in `Bvh::intersect`, with the blocks'
-/// exact tests ([`Block::triangles`](super::leaf::Block), [`Block::spheres`](super::leaf::Block)):
-/// the same hit, bit for bit.
+/// exact tests (`Block::triangles`, `Block::spheres`): the same hit, bit for bit.
 #[target_feature(enable = "avx2")]
 pub(in crate::trace::bvh) fn closest(
     prims: &[LanePrim],
@@ -18,11 +17,7 @@ pub(in crate::trace::bvh) fn closest(
     dirs: [&[f32; LANES]; 3],
     t_min: f32,
 ) -> ([f32; LANES], [u32; LANES]) {
-    let row = |r: &[f32; LANES]| {
-        // SAFETY: `r` is eight readable f32s; the load has no alignment requirement.
-        unsafe { _mm256_loadu_ps(r.as_ptr()) }
-    };
-    let (o, d) = (splat3(origin), dirs.map(row));
+    let (o, d) = (splat3(origin), dirs.map(|r| load8(r)));
     let t_min = _mm256_set1_ps(t_min);
     let mut t_best = _mm256_set1_ps(f32::INFINITY);
     let mut best = _mm256_set1_epi32(-1);
@@ -66,7 +61,7 @@ fn triangle_nearest(
     let abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0), det);
     let mut ok = _mm256_cmp_ps::<_CMP_NLT_US>(abs, _mm256_set1_ps(1e-20));
     let inv = _mm256_div_ps(one, det);
-    let s = [_mm256_sub_ps(o[0], v0[0]), _mm256_sub_ps(o[1], v0[1]), _mm256_sub_ps(o[2], v0[2])];
+    let s = sub3(o, v0);
     let u = _mm256_mul_ps(dot(s, p), inv);
     ok = and3(ok, _mm256_cmp_ps::<_CMP_LE_OS>(zero, u), _mm256_cmp_ps::<_CMP_LE_OS>(u, one));
     let q = cross(s, e1);
@@ -92,15 +87,7 @@ fn sphere_nearest(
     t_max: __m256,
 ) -> (__m256, __m256) {
     let sign_bit = _mm256_set1_ps(-0.0);
-    let f = [_mm256_sub_ps(o[0], center[0]), _mm256_sub_ps(o[1], center[1]), _mm256_sub_ps(o[2], center[2])];
-    let b = _mm256_xor_ps(dot(f, d), sign_bit);
-    let perp = [
-        _mm256_add_ps(f[0], _mm256_mul_ps(b, d[0])),
-        _mm256_add_ps(f[1], _mm256_mul_ps(b, d[1])),
-        _mm256_add_ps(f[2], _mm256_mul_ps(b, d[2])),
-    ];
-    let disc = _mm256_sub_ps(r2, dot(perp, perp));
-    let c = _mm256_sub_ps(dot(f, f), r2);
+    let [b, disc, c] = sphere_quadratic(center, r2, o, d);
     let root = _mm256_or_ps(_mm256_andnot_ps(sign_bit, _mm256_sqrt_ps(disc)), _mm256_and_ps(sign_bit, b));
     let q = _mm256_add_ps(b, root);
     let cq = _mm256_div_ps(c, q);
@@ -119,19 +106,34 @@ fn sphere_nearest(
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_scenes::small_scene;
-    use crate::trace::bvh::Bvh;
+    use super::super::test_scenes::{numbers, scene_of, small_scene};
+    use crate::scene::Shape;
+    use crate::trace::bvh::{Bvh, Hit};
     use sampler_core::glam::Vec3;
+
+    /// Asserts that the batch finds every ray's (from `o` along `dirs`, t ∈ (t_min, ∞)) hit as
+    /// `Bvh::intersect` does, bit for bit; returns how many hit.
+    fn assert_batch_hits(bvh: &Bvh, o: Vec3, dirs: &[Vec3], t_min: f32, what: &str) -> usize {
+        if std::is_x86_feature_detected!("avx2") {
+            assert!(bvh.lanes.is_some(), "{what}: the lanes serve a lone leaf");
+        }
+        let key = |h: &Option<Hit>| {
+            h.map(|h| {
+                (h.t.to_bits(), h.point.to_array().map(f32::to_bits), h.normal.to_array().map(f32::to_bits), h.surface)
+            })
+        };
+        let mut found = vec![None; dirs.len()];
+        bvh.intersect_from(o, dirs, t_min, &mut found);
+        for (k, (d, got)) in dirs.iter().zip(&found).enumerate() {
+            let want = bvh.intersect(o, *d, t_min, f32::INFINITY);
+            assert_eq!(key(got), key(&want), "{what}, origin {o}, ray {k} along {d}");
+        }
+        found.iter().filter(|h| h.is_some()).count()
+    }
 
     #[test]
     fn eight_rays_to_a_register_find_the_nearest_hits_as_one_ray_at_a_time() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut next = numbers(0x9e37_79b9_7f4a_7c15);
         let mut hits = 0;
         for (seed, spheres, rectangles) in [(1, 3, 1), (2, 0, 4), (3, 8, 0), (4, 1, 0), (5, 4, 2), (7, 2, 3)] {
             let bvh = Bvh::build(&small_scene(seed, spheres, rectangles));
@@ -143,25 +145,22 @@ mod tests {
             {
                 let dirs: Vec<Vec3> =
                     (0..1003).map(|_| Vec3::new(next(), next(), next()).normalize_or(Vec3::Z)).collect();
-                let mut found = vec![None; dirs.len()];
-                bvh.intersect_from(o, &dirs, t_min, &mut found);
-                for (k, (d, got)) in dirs.iter().zip(&found).enumerate() {
-                    let want = bvh.intersect(o, *d, t_min, f32::INFINITY);
-                    let key = |h: &Option<crate::trace::bvh::Hit>| {
-                        h.map(|h| {
-                            (
-                                h.t.to_bits(),
-                                h.point.to_array().map(f32::to_bits),
-                                h.normal.to_array().map(f32::to_bits),
-                                h.surface,
-                            )
-                        })
-                    };
-                    assert_eq!(key(got), key(&want), "scene {seed}, origin {o}, ray {k} along {d}");
-                    hits += usize::from(want.is_some());
-                }
+                hits += assert_batch_hits(&bvh, o, &dirs, t_min, &format!("scene {seed}"));
             }
         }
         assert!(hits > 3000, "{hits} hits: too few to test the lanes");
+    }
+
+    #[test]
+    fn of_equal_distances_the_first_primitive_wins_as_one_ray_at_a_time() {
+        // Each shape twice, the copy of another material: the same distances, and the hit must
+        // be the surface met first in the leaf, as `Bvh::intersect` meets it.
+        let sphere = Shape::Sphere { center: Vec3::new(0.0, 0.0, 2.0), radius: 1.0 };
+        let square = Shape::Rectangle { p0: Vec3::new(-2.0, -2.0, 4.0), e1: Vec3::X * 4.0, e2: Vec3::Y * 4.0 };
+        let bvh = Bvh::build(&scene_of(vec![(sphere.clone(), 0), (square.clone(), 1), (sphere, 1), (square, 0)]));
+        let mut next = numbers(7);
+        let dirs: Vec<Vec3> = (0..801).map(|_| Vec3::new(next() * 0.6, next() * 0.6, 1.0).normalize()).collect();
+        let hits = assert_batch_hits(&bvh, Vec3::ZERO, &dirs, 0.0, "doubled shapes");
+        assert!(hits > 500, "{hits} of {} hit", dirs.len());
     }
 }

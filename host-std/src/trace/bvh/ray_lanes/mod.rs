@@ -6,8 +6,8 @@
 //! splat, so every lane does work, and the primitives' data stays in registers for eight rays.
 //! Each lane repeats the block's operations for its primitive in their order, so a ray's answer
 //! is the one the block test gives, bit for bit: `ahead.rs` answers shadow rays over t ∈ (0, ∞)
-//! as [`Block::occludes`](super::leaf::Block) does, `closest.rs` finds camera rays' nearest hits
-//! as `Bvh::intersect` does.
+//! as `Block::occludes` does, `closest.rs` finds camera rays' nearest hits as `Bvh::intersect`
+//! does.
 
 mod ahead;
 mod closest;
@@ -106,6 +106,40 @@ pub(super) fn dot(a: [__m256; 3], b: [__m256; 3]) -> __m256 {
     _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a[0], b[0]), _mm256_mul_ps(a[1], b[1])), _mm256_mul_ps(a[2], b[2]))
 }
 
+/// Eight f32 into a register.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn load8(r: &[f32; LANES]) -> __m256 {
+    // SAFETY: `r` is eight readable f32s; the load has no alignment requirement.
+    unsafe { _mm256_loadu_ps(r.as_ptr()) }
+}
+
+/// a − b per lane and coordinate.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn sub3(a: [__m256; 3], b: [__m256; 3]) -> [__m256; 3] {
+    [_mm256_sub_ps(a[0], b[0]), _mm256_sub_ps(a[1], b[1]), _mm256_sub_ps(a[2], b[2])]
+}
+
+/// A sphere's quadratic t² − 2bt + c = 0 along rays from `o` along `d`, as the leaf's blocks
+/// set it up (`Block::sphere_roots`): b (the closest approach's distance), the discriminant
+/// r² − |f + b·d|² (robust where the ray passes far from the centre) and c = |f|² − r², with f
+/// the origin less the centre.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn sphere_quadratic(center: [__m256; 3], r2: __m256, o: [__m256; 3], d: [__m256; 3]) -> [__m256; 3] {
+    let f = sub3(o, center);
+    let b = _mm256_xor_ps(dot(f, d), _mm256_set1_ps(-0.0));
+    let perp = [
+        _mm256_add_ps(f[0], _mm256_mul_ps(b, d[0])),
+        _mm256_add_ps(f[1], _mm256_mul_ps(b, d[1])),
+        _mm256_add_ps(f[2], _mm256_mul_ps(b, d[2])),
+    ];
+    let disc = _mm256_sub_ps(r2, dot(perp, perp));
+    let c = _mm256_sub_ps(dot(f, f), r2);
+    [b, disc, c]
+}
+
 /// Scenes for the lanes' tests.
 #[cfg(test)]
 mod test_scenes {
@@ -113,23 +147,34 @@ mod test_scenes {
     use sampler_core::brdf::Lambert;
     use sampler_core::glam::Vec3;
 
+    /// A fixed stream of numbers in [−1, 1) (xorshift64) from `state`.
+    pub(super) fn numbers(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        }
+    }
+
+    /// A scene of `shapes`, each with its material (two Lambertian materials, 0 and 1).
+    pub(super) fn scene_of(shapes: Vec<(Shape, usize)>) -> Scene {
+        let objects = shapes.into_iter().map(|(shape, material)| Object { shape, material }).collect();
+        let material = Material::new(Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
+        Scene { objects, materials: vec![material.clone(), material], ..crate::scene::builtin::scene() }
+    }
+
     /// A scene of one leaf: spheres and rectangles about the origin, some overlapping.
     pub(super) fn small_scene(seed: u64, spheres: usize, rectangles: usize) -> Scene {
-        let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = move || {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut next = numbers(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
         let mut v = || Vec3::new(next(), next(), next());
-        let mut objects = Vec::new();
+        let mut shapes = Vec::new();
         for _ in 0..spheres {
-            objects.push(Object { shape: Shape::Sphere { center: v(), radius: 0.2 + 0.3 * v().x.abs() }, material: 0 });
+            shapes.push((Shape::Sphere { center: v(), radius: 0.2 + 0.3 * v().x.abs() }, 0));
         }
         for _ in 0..rectangles {
-            objects
-                .push(Object { shape: Shape::Rectangle { p0: v() * 1.5, e1: v() * 2.0, e2: v() * 2.0 }, material: 0 });
+            shapes.push((Shape::Rectangle { p0: v() * 1.5, e1: v() * 2.0, e2: v() * 2.0 }, 0));
         }
-        let material = Material::new(Bsdf::Diffuse(Lambert::new(Vec3::ONE)), false);
-        Scene { objects, materials: vec![material], ..crate::scene::builtin::scene() }
+        scene_of(shapes)
     }
 }
