@@ -20,10 +20,13 @@ ours skip the rays of samples that contribute nothing, so per traced ray is not 
 measure) over Mitsuba's. A second table times our MIS in Mitsuba's structure, one camera ray and
 one pair of samples per sample, against Mitsuba's time and error at the same count. With
 several --seeds, every timed render (both renderers) is repeated per seed, a row per seed, and
-a last table gives each method's range of ratios over the seeds. With --repeat N every timed
-render is run N times and its median time kept (the upper middle for an even N; the images are
-the same each time): on a machine whose speed drifts, one timing moves a ratio by tens of per
-cent.
+a last table gives each method's range of ratios over the seeds. With --repeat N the timed renders
+run in N rounds, each round every render once, Mitsuba's and ours interleaved so that a drift of
+the machine's speed falls on both; Mitsuba's time is the median of its N, ours per sample the
+median of a method's 2N time / spp at its two spp (our time is proportional to spp at the default
+split), and our error at Mitsuba's time is read log-log in spp between the two renders' errors at
+the spp that cost predicts. The images are the same each round, so only that one cost carries our
+timings' noise: with the ratio of two renders' times (two medians) a run moved a ratio by ±10%.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
@@ -55,21 +58,12 @@ def relmse(image, reference, covered):
     return float(np.mean((o - r) ** 2 / (r ** 2 + 0.01)))
 
 
-def middle(values, key=None):
-    """The middle of `values` by `key` (the median for an odd count, the upper middle else): one
-    measured value, so that a render's statistics stay those of one run."""
-    return sorted(values, key=key)[len(values) // 2]
-
-
-def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=(), repeat=None):
-    """Mitsuba's render time (the middle of REPEAT timed renders, the same image each time)."""
+def mitsuba(scene, spp, seed, out, sampler, passes=1, extra=()):
+    """Mitsuba's render time, one timed render."""
     key = 'render_cpu_seconds' if CLOCK == 'cpu' else 'render_seconds'
-    times = []
-    for _ in range(repeat or REPEAT):
-        text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
-                    '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
-        times.append(float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1)))
-    return middle(times)
+    text = run([sys.executable, MITSUBA_REF, scene, '--spp', str(spp), '--seed', str(seed), '--out', out,
+                '--sampler', sampler, '--passes', str(passes), '--warmup', *extra])
+    return float(re.search(key + r':\s*([0-9.eE+-]+)', text).group(1))
 
 
 def seconds(stats):
@@ -77,62 +71,82 @@ def seconds(stats):
     return stats['render_cpu_seconds'] if CLOCK == 'cpu' else stats['render_seconds']
 
 
-def ours(args, scene, method, spp, seed, out, extra=(), repeat=None):
-    """Our render's statistics, those of the middle by time of REPEAT timed renders (the same
-    image each time)."""
+def ours(args, scene, method, spp, seed, out, extra=()):
+    """Our render's statistics, one timed render."""
     stats = out + '.json'
-    runs = []
-    for _ in range(repeat or REPEAT):
-        run([args.ppis, 'render', scene, '--method', method, '--spp', str(spp), '--seed', str(seed),
-             '--threads', str(args.threads), '-o', out, '--stats-json', stats, *extra])
-        with open(stats) as f:
-            runs.append(json.load(f))
-    return middle(runs, key=seconds)
+    run([args.ppis, 'render', scene, '--method', method, '--spp', str(spp), '--seed', str(seed),
+         '--threads', str(args.threads), '-o', out, '--stats-json', stats, *extra])
+    with open(stats) as f:
+        return json.load(f)
 
 
-def at_time(points, t):
-    """log-log interpolation (or extrapolation) of (time, error) points at time t; from a single
-    point, error ∝ 1/time."""
-    (t1, e1), (t2, e2) = sorted(points)[:1] + sorted(points)[-1:]
-    if t1 == t2:
-        return e1 * t1 / t
-    slope = (math.log(e2) - math.log(e1)) / (math.log(t2) - math.log(t1))
-    return math.exp(math.log(e1) + slope * (math.log(t) - math.log(t1)))
+def at_spp(points, spp):
+    """log-log interpolation (or extrapolation) of (spp, error) points at `spp`; from a single
+    point, error ∝ 1/spp."""
+    (s1, e1), (s2, e2) = sorted(points)[:1] + sorted(points)[-1:]
+    if s1 == s2:
+        return e1 * s1 / spp
+    slope = (math.log(e2) - math.log(e1)) / (math.log(s2) - math.log(s1))
+    return math.exp(math.log(e1) + slope * (math.log(spp) - math.log(s1)))
+
+
+def median(values):
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
 
 
 def scene_rows(args, scene, seed):
+    """One seed of one scene. The timed renders run in REPEAT rounds, each round every render once
+    (Mitsuba's, then ours), so that a drift of the machine's speed falls on both renderers alike.
+    Our time per sample is the median over all our timings of a method at both its spp, time / spp
+    (our render time is proportional to spp at the default split), and our error at Mitsuba's time
+    is read at the spp that cost predicts, log-log between the two renders' errors: the images do
+    not change between rounds, so only the one cost carries the timings' noise."""
     name = os.path.splitext(os.path.basename(scene))[0]
     d = lambda f: os.path.join(args.out, f'{name}_{f}')
     if not os.path.exists(d('mref.exr')):
-        mitsuba(scene, args.ref_spp, 4242, d('mref.exr'), 'ldsampler', passes=4, extra=['--coverage-out', d('cov.exr')],
-                repeat=1)
+        mitsuba(scene, args.ref_spp, 4242, d('mref.exr'), 'ldsampler', passes=4, extra=['--coverage-out', d('cov.exr')])
     if not os.path.exists(d('pref.exr')):
-        ours(args, scene, 'mis', args.ref_spp, 4242, d('pref.exr'), repeat=1)
+        ours(args, scene, 'mis', args.ref_spp, 4242, d('pref.exr'))
     covered = load(d('cov.exr'))[..., 0] >= 0.999
     mref, pref = load(d('mref.exr')), load(d('pref.exr'))
-    rows = {}
-    for sampler in ['ldsampler', 'independent']:
-        t = mitsuba(scene, args.spp, seed, d(f'mts_{sampler}_{seed}.exr'), sampler)
-        rows[sampler] = (t, relmse(load(d(f'mts_{sampler}_{seed}.exr')), mref, covered))
-    target = rows['ldsampler'][0]
     # Mitsuba's structure: one camera ray and one MIS pair (an emitter and a BSDF sample, the
     # power heuristic) per sample, so 2·spp visibility samples over spp camera rays.
-    pairs = ours(args, scene, 'mis', 2 * args.spp, seed, d(f'mis_pairs_{seed}.exr'),
-                 ['--shading-points', str(args.spp), '--mis-heuristic', 'power'])
-    rows['pairs'] = (seconds(pairs), relmse(load(d(f'mis_pairs_{seed}.exr')), pref, covered))
+    pairs_args = ['--shading-points', str(args.spp), '--mis-heuristic', 'power']
+    times, stats, spps = {}, {}, {}
+    for _ in range(REPEAT):
+        for sampler in ['ldsampler', 'independent']:
+            times.setdefault(sampler, []).append(
+                mitsuba(scene, args.spp, seed, d(f'mts_{sampler}_{seed}.exr'), sampler))
+        times.setdefault('pairs', []).append(seconds(
+            ours(args, scene, 'mis', 2 * args.spp, seed, d(f'mis_pairs_{seed}.exr'), pairs_args)))
+        for method in args.methods:
+            st = ours(args, scene, method, args.spp, seed, d(f'{method}_{seed}.exr'))
+            stats[method] = st
+            times.setdefault((method, args.spp), []).append(seconds(st))
+            if method not in spps:
+                spp = max(1, 2 ** round(math.log2(args.spp * times['ldsampler'][0] / seconds(st))))
+                spps[method] = sorted({args.spp, spp})
+            for spp in spps[method]:
+                if spp != args.spp:
+                    st2 = ours(args, scene, method, spp, seed, d(f'{method}_{spp}_{seed}.exr'))
+                    times.setdefault((method, spp), []).append(seconds(st2))
+    rows = {}
+    for sampler in ['ldsampler', 'independent']:
+        rows[sampler] = (median(times[sampler]), relmse(load(d(f'mts_{sampler}_{seed}.exr')), mref, covered))
+    rows['pairs'] = (median(times['pairs']), relmse(load(d(f'mis_pairs_{seed}.exr')), pref, covered))
+    target = rows['ldsampler'][0]
     h, w = covered.shape
     results = []
     for method in args.methods:
-        points = []
-        stats = ours(args, scene, method, args.spp, seed, d(f'{method}_{seed}.exr'))
-        points.append((seconds(stats), relmse(load(d(f'{method}_{seed}.exr')), pref, covered)))
-        spp = max(1, 2 ** round(math.log2(args.spp * target / seconds(stats))))
-        if spp != args.spp:
-            s2 = ours(args, scene, method, spp, seed, d(f'{method}_{spp}_{seed}.exr'))
-            points.append((seconds(s2), relmse(load(d(f'{method}_{spp}_{seed}.exr')), pref, covered)))
-        per_core = seconds(stats) if CLOCK == 'cpu' else args.threads * seconds(stats)
-        results.append((method, seconds(stats), points[0][1], at_time(points, target),
-                        stats['shading_points'] / per_core, stats['shadow_rays'] / per_core))
+        cost = median([t / spp for spp in spps[method] for t in times[(method, spp)]])
+        image = lambda spp: d(f'{method}_{seed}.exr' if spp == args.spp else f'{method}_{spp}_{seed}.exr')
+        points = [(spp, relmse(load(image(spp)), pref, covered)) for spp in spps[method]]
+        t = cost * args.spp
+        per_core = t if CLOCK == 'cpu' else args.threads * t
+        results.append((method, t, dict(points)[args.spp], at_spp(points, target / cost),
+                        stats[method]['shading_points'] / per_core, stats[method]['shadow_rays'] / per_core))
     samples = w * h * args.spp
     return name, rows, results, samples
 
