@@ -20,6 +20,8 @@ mod rays_ahead;
 mod surface;
 mod traverse;
 mod wide;
+#[cfg(target_arch = "x86_64")]
+mod wide_avx2;
 
 use primitive::Aabb;
 pub use primitive::Primitive;
@@ -94,6 +96,9 @@ pub struct Bvh {
     /// disk is beside it and the CPU has AVX2.
     #[cfg(target_arch = "x86_64")]
     lanes: Option<ray_lanes::LoneLeaf>,
+    /// Whether the CPU has AVX2: rays then test a node's eight boxes in one register.
+    #[cfg(target_arch = "x86_64")]
+    avx2: bool,
 }
 
 impl Bvh {
@@ -105,8 +110,10 @@ impl Bvh {
         let (nodes, blocks) = wide::collapse(&binary, &prims);
         let lone_leaf = wide::lone_leaf(&nodes);
         #[cfg(target_arch = "x86_64")]
+        let avx2 = std::is_x86_feature_detected!("avx2");
+        #[cfg(target_arch = "x86_64")]
         let lanes = lone_leaf
-            .filter(|_| disks.is_empty() && std::is_x86_feature_detected!("avx2"))
+            .filter(|_| disks.is_empty() && avx2)
             .map(|(first, count)| ray_lanes::LoneLeaf::new(&blocks[first as usize..(first + count) as usize], &prims));
         Bvh {
             prims,
@@ -117,6 +124,8 @@ impl Bvh {
             lone_leaf,
             #[cfg(target_arch = "x86_64")]
             lanes,
+            #[cfg(target_arch = "x86_64")]
+            avx2,
         }
     }
 
@@ -154,9 +163,7 @@ impl Bvh {
         let mut t_max = t_max;
         match self.lone_leaf {
             Some((first, count)) => self.closest_in(first, count, o, d, t_min, &mut t_max, &mut best),
-            None => traverse::closest(&self.nodes, o, d, &mut t_max, |first, count, t_max| {
-                self.closest_in(first, count, o, d, t_min, t_max, &mut best)
-            }),
+            None => self.closest_in_tree(o, d, t_min, &mut t_max, &mut best),
         }
         if let Some((k, t)) = disk::closest(&self.disks, o, d, t_min, t_max) {
             let disk = &self.disks[k];
@@ -209,10 +216,52 @@ impl Bvh {
         }
         match self.lone_leaf {
             Some((first, count)) => self.blocked_in(first, count, o, d, t_min, t_max),
-            None => traverse::any(&self.nodes, o, d, t_max, |first, count| {
-                self.blocked_in(first, count, o, d, t_min, t_max)
-            }),
+            None => self.blocked_in_tree(o, d, t_min, t_max),
         }
+    }
+
+    /// The nearest hit in the tree, as [`Bvh::closest_in`] for its leaves.
+    #[inline(always)]
+    fn closest_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU has AVX2.
+            return unsafe { self.closest_in_tree_avx2(o, d, t_min, t_max, best) };
+        }
+        let ray = wide::RayLanes::new(o, d);
+        traverse::closest(&self.nodes, &ray, t_max, |first, count, t_max| {
+            self.closest_in(first, count, o, d, t_min, t_max, best);
+        });
+    }
+
+    /// [`Bvh::closest_in_tree`] compiled for AVX2, a node's boxes tested in one register.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn closest_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
+        let ray = wide_avx2::RayLanes8::new(o, d);
+        traverse::closest(&self.nodes, &ray, t_max, |first, count, t_max| {
+            self.closest_in(first, count, o, d, t_min, t_max, best);
+        });
+    }
+
+    /// Whether a primitive of the tree blocks the ray, as [`Bvh::blocked_in`] for its leaves.
+    #[inline(always)]
+    fn blocked_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU has AVX2.
+            return unsafe { self.blocked_in_tree_avx2(o, d, t_min, t_max) };
+        }
+        let ray = wide::RayLanes::new(o, d);
+        traverse::any(&self.nodes, &ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
+    }
+
+    /// [`Bvh::blocked_in_tree`] compiled for AVX2, a node's boxes tested in one register.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn blocked_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        let ray = wide_avx2::RayLanes8::new(o, d);
+        traverse::any(&self.nodes, &ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
     }
 
     /// The nearest hit in the blocks `first..first + count` within (t_min, `t_max`), if nearer

@@ -2,8 +2,7 @@
 //! meets nearest first and skips those that start beyond the best hit so far; occlusion tests
 //! leaf children as soon as their box is met and stops at the first blocker.
 
-use super::wide::{LEAF, RayLanes, WIDTH, WideNode};
-use sampler_core::glam::Vec3;
+use super::wide::{LEAF, NodeRay, WIDTH, WideNode};
 use std::mem::MaybeUninit;
 
 /// Stack entries: a node descends at most one binary level per wide level, the binary build
@@ -11,20 +10,18 @@ use std::mem::MaybeUninit;
 /// entries behind.
 const STACK: usize = 512;
 
-/// Visits the primitives of every leaf whose box the ray meets within `t_max`, nearest box
+/// Visits the primitives of every leaf whose box `ray` meets within `t_max`, nearest box
 /// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`.
 #[inline(always)]
 pub(super) fn closest(
     nodes: &[WideNode],
-    o: Vec3,
-    d: Vec3,
+    ray: &impl NodeRay,
     t_max: &mut f32,
     mut visit: impl FnMut(u32, u32, &mut f32),
 ) {
     if nodes.is_empty() {
         return;
     }
-    let ray = RayLanes::new(o, d);
     // Left uninitialised: zeroing the stack per ray is a noticeable share of simple scenes.
     let mut stack = [const { MaybeUninit::<(u32, u32, f32)>::uninit() }; STACK];
     let mut sp = 0;
@@ -35,7 +32,7 @@ pub(super) fn closest(
             visit(child & !LEAF, count, t_max);
         } else {
             let node = &nodes[child as usize];
-            let (mut mask, near) = node.hit(&ray, *t_max);
+            let (mut mask, near) = ray.hit(node, *t_max);
             // Sorted farthest first: all but the nearest are pushed in that order, and the
             // nearest is visited next without a trip through the stack.
             let mut order = [(0u32, 0u32, 0.0f32); WIDTH];
@@ -78,20 +75,19 @@ pub(super) fn closest(
     }
 }
 
-/// True when `test(first, count)` finds a blocker in a leaf whose box the ray meets within
+/// True when `test(first, count)` finds a blocker in a leaf whose box `ray` meets within
 /// `t_max`.
 #[inline(always)]
-pub(super) fn any(nodes: &[WideNode], o: Vec3, d: Vec3, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
+pub(super) fn any(nodes: &[WideNode], ray: &impl NodeRay, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
     if nodes.is_empty() {
         return false;
     }
-    let ray = RayLanes::new(o, d);
     let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
     let mut sp = 0;
     let mut index = 0;
     loop {
         let node = &nodes[index as usize];
-        let (mut mask, _) = node.hit(&ray, t_max);
+        let (mut mask, _) = ray.hit(node, t_max);
         // The first inner child met is visited next without a trip through the stack.
         let mut next = None;
         while mask != 0 {

@@ -25,15 +25,23 @@ pub(super) const WIDTH: usize = 8;
 #[repr(C, align(64))]
 pub(super) struct WideNode {
     /// Rows min x, max x, min y, max y, min z, max z; lane k is child k.
-    planes: [[f32; WIDTH]; 6],
+    pub(super) planes: [[f32; WIDTH]; 6],
     /// An inner child's node index, or `LEAF | first block`, or `EMPTY`.
     pub(super) child: [u32; WIDTH],
     /// A leaf child's number of blocks (0 for the others).
     pub(super) count: [u32; WIDTH],
 }
 
-/// A ray prepared for box tests: origin and reciprocal direction in all lanes, and per axis
-/// which of a box's two planes it meets first.
+/// A ray prepared for a wide node's box tests.
+pub(super) trait NodeRay {
+    /// Which children's boxes of `node` the ray meets within [0, t_max] (bit k for child k)
+    /// and the entry distance of each. NaN slab distances (a ray in a box's plane) leave the
+    /// interval as it is, so such boxes count as met.
+    fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]);
+}
+
+/// A ray prepared for box tests in two halves of four lanes: origin and reciprocal direction
+/// in all lanes, and per axis which of a box's two planes it meets first.
 pub(super) struct RayLanes {
     o: [F4; 3],
     inv: [F4; 3],
@@ -44,28 +52,36 @@ pub(super) struct RayLanes {
 impl RayLanes {
     pub(super) fn new(o: Vec3, d: Vec3) -> RayLanes {
         let inv = d.recip();
-        // The sign bit, not a comparison: a direction of −0 has reciprocal −∞ and meets the
-        // max plane first, which keeps empty lanes (min +∞, max −∞) empty.
-        let near = [inv.x, inv.y, inv.z].map(|v| usize::from(v.is_sign_negative()));
-        RayLanes { o: [o.x, o.y, o.z].map(F4::splat), inv: [inv.x, inv.y, inv.z].map(F4::splat), near }
+        RayLanes {
+            o: [o.x, o.y, o.z].map(F4::splat),
+            inv: [inv.x, inv.y, inv.z].map(F4::splat),
+            near: near_planes(inv),
+        }
     }
 }
 
-impl WideNode {
-    /// Which children's boxes the ray meets within [0, t_max] (bit k for child k) and the
-    /// entry distance of each. NaN slab distances (a ray in a box's plane) leave the interval
-    /// as it is, so such boxes count as met.
+/// Per axis, the row offset (0 or 1) of the plane of a box that a ray of reciprocal direction
+/// `inv` meets first: the sign bit, not a comparison, so that a direction of −0 (reciprocal
+/// −∞) meets the max plane first, which keeps empty lanes (min +∞, max −∞) empty.
+#[inline(always)]
+pub(super) fn near_planes(inv: Vec3) -> [usize; 3] {
+    [inv.x, inv.y, inv.z].map(|v| usize::from(v.is_sign_negative()))
+}
+
+impl NodeRay for RayLanes {
     #[inline(always)]
-    pub(super) fn hit(&self, r: &RayLanes, t_max: f32) -> (u32, [f32; WIDTH]) {
-        let (low, near_low) = self.hit_half(r, t_max, 0);
-        let (high, near_high) = self.hit_half(r, t_max, 4);
+    fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]) {
+        let (low, near_low) = node.hit_half(self, t_max, 0);
+        let (high, near_high) = node.hit_half(self, t_max, 4);
         let mut near = [0.0; WIDTH];
         near[..4].copy_from_slice(&near_low);
         near[4..].copy_from_slice(&near_high);
         (low | high << 4, near)
     }
+}
 
-    /// [`WideNode::hit`] for the four children from `first`.
+impl WideNode {
+    /// [`NodeRay::hit`] for the four children from `first`.
     #[inline(always)]
     fn hit_half(&self, r: &RayLanes, t_max: f32, first: usize) -> (u32, [f32; 4]) {
         let row = |plane: usize| -> &[f32; 4] { self.planes[plane][first..first + 4].try_into().unwrap() };
