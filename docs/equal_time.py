@@ -23,10 +23,12 @@ several --seeds, every timed render (both renderers) is repeated per seed, a row
 a last table gives each method's range of ratios over the seeds. With --repeat N the timed renders
 run in N rounds, each round every render once, Mitsuba's and ours interleaved so that a drift of
 the machine's speed falls on both; Mitsuba's time is the median of its N, ours per sample the
-median of a method's 2N time / spp at its two spp (our time is proportional to spp at the default
-split), and our error at Mitsuba's time is read log-log in spp between the two renders' errors at
-the spp that cost predicts. The images are the same each round, so only that one cost carries our
-timings' noise: with the ratio of two renders' times (two medians) a run moved a ratio by ±10%.
+median of time / spp over all of a method's timings at its two spp (2N, or N where the predicted
+spp is --spp; our time is proportional to spp at the default split, up to the few per cent of a
+render that its pilots and light tables take), and our error at Mitsuba's time is read log-log in
+spp between the two renders' errors at the spp that cost predicts. The images are the same each
+round, so only that one cost carries our timings' noise: with the ratio of two renders' times (two
+medians) a run moved a ratio by ±10%. The "ours" time in the first table is that cost × --spp.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
@@ -165,13 +167,14 @@ def main():
                          'all their threads (a machine shared with other work)')
     ap.add_argument('--ppis', default=os.path.join(HERE, '..', 'target', 'release', 'ppis'))
     ap.add_argument('--repeat', type=int, default=1,
-                    help='time every render (both renderers) this many times and keep the median time')
+                    help='time every render (both renderers) in this many interleaved rounds (see above)')
     args = ap.parse_args()
     global CLOCK, REPEAT
     CLOCK, REPEAT = args.clock, max(1, args.repeat)
     os.makedirs(args.out, exist_ok=True)
     print(f'{args.spp} spp, {args.threads} threads; relMSE on covered pixels, each renderer against its own '
-          f'converged image ({args.ref_spp} spp); "at Mitsuba-ld time": ours interpolated log-log at its time.\n')
+          f'converged image ({args.ref_spp} spp); "at Mitsuba-ld time": ours read log-log in spp at the spp its cost per sample predicts for that time; '
+          f'"ours": that cost × {args.spp} spp.\n')
     print('| scene | seed | Mitsuba ldsampler | Mitsuba independent | method | ours | ours at Mitsuba-ld time '
           '| / ldsampler | / independent | our shading points/s/core | our shadow rays/s/core '
           '| Mitsuba-ld samples/s/core | time per visibility sample, ours / Mitsuba\'s |')

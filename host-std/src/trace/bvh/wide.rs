@@ -1,11 +1,11 @@
 //! The eight-wide hierarchy that rays traverse: each node holds its eight children's boxes as
-//! structure of arrays (one eight-lane row per box plane), so one ray tests all eight in two
-//! halves of four SIMD lanes ([`super::lanes::F4`]). It is collapsed from the binary SAH tree
-//! (`build.rs`): a node takes its binary children and keeps opening the largest inner one
+//! structure of arrays (one eight-lane row per box plane), so one ray tests all eight at once:
+//! in one AVX2 register where the CPU has it (`wide_avx2.rs`), else in two halves of four SIMD
+//! lanes ([`super::lanes::F4`], here), with the same bits. It is collapsed from the binary SAH
+//! tree (`build.rs`): a node takes its binary children and keeps opening the largest inner one
 //! until it has eight, so the boxes are the binary tree's boxes and only the levels between
 //! them go. Eight children make the tree half as deep as four do, so a ray pops, loads and
-//! branches over fewer nodes, and the box tests of a node's two halves run back to back
-//! without a dependency between them.
+//! branches over fewer nodes.
 
 use super::lanes::F4;
 use super::leaf::Block;
