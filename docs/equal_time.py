@@ -28,7 +28,8 @@ spp is --spp; our time is proportional to spp at the default split, up to the fe
 render that its pilots and light tables take), and our error at Mitsuba's time is read log-log in
 spp between the two renders' errors at the spp that cost predicts. The images are the same each
 round, so only that one cost carries our timings' noise: with the ratio of two renders' times (two
-medians) a run moved a ratio by ±10%. The "ours" time in the first table is that cost × --spp.
+medians) a run moved a ratio by ±10%. The "ours" time in the first table is that cost × --spp. Every timing is kept in
+DIR/SCENE_timings_SEED.json.
 
 Needs `pip install mitsuba numpy` and `apt-get install libllvm19` (docs/reference/README.md); Mitsuba
 renders through docs/reference/mitsuba_ref.py. References are cached in DIR."""
@@ -134,6 +135,10 @@ def scene_rows(args, scene, seed):
                 if spp != args.spp:
                     st2 = ours(args, scene, method, spp, seed, d(f'{method}_{spp}_{seed}.exr'))
                     times.setdefault((method, spp), []).append(seconds(st2))
+    # Every timing, for a reading other than this script's.
+    with open(d(f'timings_{seed}.json'), 'w') as f:
+        json.dump({'clock': CLOCK, 'times': {k if isinstance(k, str) else f'{k[0]}@{k[1]}': v for k, v in times.items()}},
+                  f, indent=1)
     rows = {}
     for sampler in ['ldsampler', 'independent']:
         rows[sampler] = (median(times[sampler]), relmse(load(d(f'mts_{sampler}_{seed}.exr')), mref, covered))

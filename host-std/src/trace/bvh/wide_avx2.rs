@@ -75,7 +75,7 @@ mod tests {
             eprintln!("no AVX2 on this CPU: the eight-lane box test is never used here");
             return;
         }
-        let mut met = 0;
+        let (mut met, mut nan_lanes) = (0, 0);
         for k in 0..4000u32 {
             let mut node = WideNode { planes: [[0.0; WIDTH]; 6], child: [0; WIDTH], count: [0; WIDTH] };
             for lane in 0..WIDTH {
@@ -99,6 +99,12 @@ mod tests {
                 d.y = -0.0;
             }
             let t_max = [f32::INFINITY, 2.0, 0.5][(k % 3) as usize];
+            for lane in 0..WIDTH {
+                for axis in 0..3 {
+                    let lo = node.planes[2 * axis][lane];
+                    nan_lanes += u32::from(((lo - o[axis]) * d[axis].recip()).is_nan());
+                }
+            }
             let (mask4, near4) = RayLanes::new(o, d).hit(&node, t_max);
             // SAFETY: the CPU has AVX2 (checked above).
             let (mask8, near8) = unsafe { RayLanes8::new(o, d) }.hit(&node, t_max);
@@ -107,5 +113,6 @@ mod tests {
             met += mask4.count_ones();
         }
         assert!(met > 2000, "{met} boxes met: too few to test the lanes");
+        assert!(nan_lanes > 500, "{nan_lanes} NaN slab distances: too few to test their rule");
     }
 }
