@@ -220,50 +220,6 @@ impl Bvh {
         }
     }
 
-    /// The nearest hit in the tree, as [`Bvh::closest_in`] for its leaves.
-    #[inline(always)]
-    fn closest_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only where the CPU has AVX2.
-            return unsafe { self.closest_in_tree_avx2(o, d, t_min, t_max, best) };
-        }
-        let ray = wide::RayLanes::new(o, d);
-        traverse::closest(&self.nodes, &ray, t_max, |first, count, t_max| {
-            self.closest_in(first, count, o, d, t_min, t_max, best);
-        });
-    }
-
-    /// [`Bvh::closest_in_tree`] compiled for AVX2, a node's boxes tested in one register.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn closest_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
-        let ray = wide_avx2::RayLanes8::new(o, d);
-        traverse::closest(&self.nodes, &ray, t_max, |first, count, t_max| {
-            self.closest_in(first, count, o, d, t_min, t_max, best);
-        });
-    }
-
-    /// Whether a primitive of the tree blocks the ray, as [`Bvh::blocked_in`] for its leaves.
-    #[inline(always)]
-    fn blocked_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only where the CPU has AVX2.
-            return unsafe { self.blocked_in_tree_avx2(o, d, t_min, t_max) };
-        }
-        let ray = wide::RayLanes::new(o, d);
-        traverse::any(&self.nodes, &ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
-    }
-
-    /// [`Bvh::blocked_in_tree`] compiled for AVX2, a node's boxes tested in one register.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn blocked_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        let ray = wide_avx2::RayLanes8::new(o, d);
-        traverse::any(&self.nodes, &ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
-    }
-
     /// The nearest hit in the blocks `first..first + count` within (t_min, `t_max`), if nearer
     /// than `t_max`: `t_max` becomes its distance and `best` its primitive.
     #[allow(clippy::too_many_arguments)]

@@ -1,14 +1,77 @@
 //! Traversal of the eight-wide nodes with a fixed stack: closest hit visits the children a ray
 //! meets nearest first and skips those that start beyond the best hit so far; occlusion tests
-//! leaf children as soon as their box is met and stops at the first blocker.
+//! leaf children as soon as their box is met and stops at the first blocker. `Bvh` runs either
+//! in a function compiled for AVX2 where the CPU has it, a node's boxes then tested in one
+//! register (`wide_avx2.rs`), else with the two SSE halves (`wide.rs`).
 
-use super::wide::{LEAF, NodeRay, WIDTH, WideNode};
+use super::Bvh;
+use super::wide::{LEAF, NodeRay, RayLanes, WIDTH, WideNode};
+use sampler_core::glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Stack entries: a node descends at most one binary level per wide level, the binary build
 /// bounds its depth (median splits past depth 40), and each level leaves at most seven
 /// entries behind.
 const STACK: usize = 512;
+
+impl Bvh {
+    /// The nearest hit in the tree, as [`Bvh::closest_in`] for its leaves.
+    #[inline(always)]
+    pub(super) fn closest_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU has AVX2.
+            return unsafe { self.closest_in_tree_avx2(o, d, t_min, t_max, best) };
+        }
+        self.closest_along(&RayLanes::new(o, d), o, d, t_min, t_max, best);
+    }
+
+    /// [`Bvh::closest_in_tree`] compiled for AVX2, a node's boxes tested in one register.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn closest_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: &mut f32, best: &mut Option<usize>) {
+        self.closest_along(&super::wide_avx2::RayLanes8::new(o, d), o, d, t_min, t_max, best);
+    }
+
+    /// The nearest hit in the tree, its boxes tested by `ray` (the ray o + t·d).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn closest_along(
+        &self,
+        ray: &impl NodeRay,
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: &mut f32,
+        best: &mut Option<usize>,
+    ) {
+        closest(&self.nodes, ray, t_max, |first, count, t_max| self.closest_in(first, count, o, d, t_min, t_max, best));
+    }
+
+    /// Whether a primitive of the tree blocks the ray, as [`Bvh::blocked_in`] for its leaves.
+    #[inline(always)]
+    pub(super) fn blocked_in_tree(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU has AVX2.
+            return unsafe { self.blocked_in_tree_avx2(o, d, t_min, t_max) };
+        }
+        self.blocked_along(&RayLanes::new(o, d), o, d, t_min, t_max)
+    }
+
+    /// [`Bvh::blocked_in_tree`] compiled for AVX2, a node's boxes tested in one register.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn blocked_in_tree_avx2(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        self.blocked_along(&super::wide_avx2::RayLanes8::new(o, d), o, d, t_min, t_max)
+    }
+
+    /// Whether a primitive of the tree blocks the ray o + t·d, its boxes tested by `ray`.
+    #[inline(always)]
+    fn blocked_along(&self, ray: &impl NodeRay, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+        any(&self.nodes, ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
+    }
+}
 
 /// Visits the primitives of every leaf whose box `ray` meets within `t_max`, nearest box
 /// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`.
