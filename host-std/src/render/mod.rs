@@ -14,6 +14,7 @@ pub mod brdf_samples;
 pub mod crop;
 pub mod pixel;
 pub mod plane_products;
+pub(crate) mod primary;
 pub mod product_arena;
 pub mod sampler_cache;
 pub mod shade;

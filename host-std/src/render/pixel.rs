@@ -1,9 +1,11 @@
 //! One pixel, in named steps: for each of its shading points a camera ray
-//! (`camera_ray`), its intersection with the scene, the shading point there
-//! (`surface`) or the light it sees (`background`, `emitted`); then the light sampled at every
+//! (`Camera::directions`), its intersection with the scene, the shading point there
+//! ([`primary::surface`]) or the light it sees ([`primary::background`], [`primary::emitted`]);
+//! then the light sampled at every
 //! shading point (`sample_light` for the environment, `shade_lights` for the other lights), and
 //! the pixel's mean (`accumulate`).
 
+use crate::render::primary::{Hit, background, emitted, shading_point, surface};
 use crate::render::sampler_cache::{Lead, SamplerCache};
 use crate::render::shade::{self, CountingVisibility, Run, Sampling};
 use crate::render::shade_cuts::shade_cuts;
@@ -11,40 +13,17 @@ use crate::render::shade_lights::{budgets, shade_lights};
 use crate::render::strategy::Strategy;
 use crate::render::wavefront::{self, Shadows, WaveBuffers};
 use crate::render::{Context, Counters};
-use crate::scene::{Bsdf, Scene};
 use crate::trace::bvh::{self, Surface};
-use crate::trace::camera::Camera;
 use sampler_core::brdf::Brdf;
 use sampler_core::env::EnvHierarchy;
 use sampler_core::estimator::ShadingPoint;
-use sampler_core::frame::Frame;
 use sampler_core::glam::{DVec2, DVec3, Vec3};
-use sampler_core::light::Light;
 use sampler_core::lightcuts::CutEntry;
 use sampler_core::points::{permutation_element, sobol02};
 use sampler_core::rng::hash_combine;
 
 /// Shading points traced together: their hits are grouped by material before shading.
-const GROUP: usize = 64;
-
-/// A primary ray's hit, ready to shade.
-pub(crate) struct Hit {
-    /// The shading frame.
-    pub frame: Frame,
-    /// Towards the viewer.
-    pub wo: Vec3,
-    /// The BRDF at this hit when its material is textured; otherwise the material's.
-    pub bsdf: Option<Bsdf>,
-    /// Where shadow rays start: the hit, offset along the geometric normal.
-    pub origin: Vec3,
-    /// The hit's material.
-    pub material: usize,
-    /// The plane whose product it samples (`Context::planes`), where its material samples
-    /// the plane product and it lies on one of the scene's planes.
-    pub plane: Option<usize>,
-    /// The shading point's index in the pixel.
-    pub index: usize,
-}
+pub(crate) const GROUP: usize = 64;
 
 /// A tile's scratch memory, reused from pixel to pixel.
 pub struct Scratch {
@@ -71,6 +50,8 @@ struct GroupBuffers {
     dirs: [Vec3; GROUP],
     /// Where each camera ray hits.
     found: [Option<bvh::Hit>; GROUP],
+    /// What each camera ray that misses the scene sees of the environment.
+    background: [Vec3; GROUP],
     /// Each hit's estimate, by hit.
     values: [DVec3; GROUP],
     /// Whether a hit is shaded yet, by hit.
@@ -91,6 +72,7 @@ impl Default for GroupBuffers {
             film: [DVec2::ZERO; GROUP],
             dirs: [Vec3::ZERO; GROUP],
             found: [None; GROUP],
+            background: [Vec3::ZERO; GROUP],
             values: [DVec3::ZERO; GROUP],
             done: [false; GROUP],
             members: [0; GROUP],
@@ -141,16 +123,16 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
         let film = &mut scratch.group.film[..m];
         sobol02(seeds.pixel, done as u32, film);
         let dirs = &mut scratch.group.dirs[..m];
-        for (d, f) in dirs.iter_mut().zip(film.iter()) {
-            *d = camera_ray(ctx.camera, x, y, *f, &mut scratch.counters);
-        }
+        ctx.camera.directions(x, y, film, dirs);
+        scratch.counters.camera_rays += m as u64;
         let found = &mut scratch.group.found[..m];
         ctx.bvh.intersect_from(ctx.camera.origin, dirs, ctx.camera.near_clip, found);
+        let seen = background(ctx, dirs, found, &mut scratch.group.background[..m]);
         scratch.hits.clear();
         for (k, (&dir, hit)) in dirs.iter().zip(found.iter()).enumerate() {
             let Some(hit) = hit else {
-                if let Some(radiance) = background(ctx, dir) {
-                    sum += radiance;
+                if seen {
+                    sum += scratch.group.background[k].as_dvec3();
                 }
                 continue;
             };
@@ -180,75 +162,10 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
     accumulate(sum, p, &mut scratch.counters)
 }
 
-/// The primary ray through film position `f` of pixel (x, y).
-fn camera_ray(camera: &Camera, x: usize, y: usize, f: DVec2, counters: &mut Counters) -> Vec3 {
-    counters.camera_rays += 1;
-    camera.direction(x as f32 + f.x as f32, y as f32 + f.y as f32)
-}
-
-/// What a primary ray that leaves the scene sees: the environment, unless the scene hides it.
-fn background(ctx: &Context<'_, '_>, dir: Vec3) -> Option<DVec3> {
-    match (ctx.env, ctx.scene.hide_emitters) {
-        (Some(e), false) => Some(e.radiance(dir).as_dvec3()),
-        _ => None,
-    }
-}
-
-/// What a primary ray sees of the surface of light `light`: its radiance from the front, none
-/// from the back or where the scene hides emitters.
-fn emitted(ctx: &Context<'_, '_>, light: usize, dir: Vec3) -> DVec3 {
-    if ctx.scene.hide_emitters {
-        return DVec3::ZERO;
-    }
-    let seen = ctx.scene.lights[light].eval(ctx.camera.origin, dir);
-    seen.map_or(DVec3::ZERO, |h| h.radiance.as_dvec3())
-}
-
 /// The run of the pixel's light sequences the shading point `h` takes (see [`shade::Run`]),
 /// of a pixel of `p` shading points.
 fn run(seeds: Seeds, h: &Hit, p: usize) -> Run {
     Run { seed: seeds.light, block: permutation_element(h.index as u32, p as u32, seeds.light as u32) as usize }
-}
-
-/// The shading point of a primary hit on a surface of material `material`, `None` where
-/// nothing is reflected to the viewer (the back of a one-sided surface, or no light to
-/// reflect).
-fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material: usize, index: usize) -> Option<Hit> {
-    let m = &ctx.scene.materials[material];
-    let wo = -dir;
-    let (mut n, mut ns) = (hit.normal, hit.shading_normal);
-    if n.dot(wo) < 0.0 {
-        // Seen from the back, a one-sided surface reflects nothing.
-        if !m.twosided {
-            return None;
-        }
-        (n, ns) = (-n, -ns);
-    }
-    // The shading frame follows the interpolated normal, kept on the viewer's side of the
-    // surface.
-    if ns.dot(n) <= 0.0 {
-        ns = n;
-    }
-    if ctx.env.is_none() && ctx.lights.is_none() {
-        return None;
-    }
-    let eps = 1e-4 * (1.0 + hit.point.abs().max_element());
-    let plane = match (ctx.planes, ctx.plans[material].strategy) {
-        (Some(planes), Strategy::PlaneProduct) => planes.find(ns),
-        _ => None,
-    };
-    Some(Hit {
-        frame: Frame::from_normal(ns),
-        wo,
-        bsdf: match (&m.texture, hit.uv) {
-            (Some(t), Some(uv)) => Some(t.0.bsdf_at(uv)),
-            _ => None,
-        },
-        origin: hit.point + n * eps,
-        material,
-        plane,
-        index,
-    })
 }
 
 /// Samples the environment's light with `budget` samples (or its material plan's own) at every
@@ -389,13 +306,4 @@ fn accumulate(sum: DVec3, shading_points: usize, counters: &mut Counters) -> [f3
         counters.non_finite += 1;
         [0.0; 3]
     }
-}
-
-/// The hit's shading point: its own BRDF if its material is textured, the material's otherwise.
-pub(crate) fn shading_point<'a>(scene: &'a Scene, h: &'a Hit) -> ShadingPoint<'a, dyn Brdf + 'a> {
-    let brdf = match &h.bsdf {
-        Some(b) => b.as_brdf(),
-        None => scene.materials[h.material].bsdf.as_brdf(),
-    };
-    ShadingPoint { frame: h.frame, wo: h.wo, brdf }
 }

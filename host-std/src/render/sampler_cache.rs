@@ -10,7 +10,7 @@
 //! not kept").
 
 use crate::render::Context;
-use crate::render::pixel::Hit;
+use crate::render::primary::Hit;
 use crate::render::product_arena::SizedArena;
 use crate::render::shade::Sampling;
 use crate::render::strategy::{MaterialPlan, Strategy};

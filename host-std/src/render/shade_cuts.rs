@@ -3,7 +3,7 @@
 //! BVH. The tree holds the environment as directional lights and the scene's point lights and
 //! delta distant lights; the scene's other lights are left to `shade_lights`.
 
-use crate::render::pixel::{Hit, shading_point};
+use crate::render::primary::{Hit, shading_point};
 use crate::render::{Context, Counters};
 use sampler_core::glam::{DVec3, Vec3};
 use sampler_core::lightcuts::{CutEntry, DEFAULT_MAX_CUT, LightcutTree, lightcut};

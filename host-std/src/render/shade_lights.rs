@@ -5,7 +5,7 @@
 //! as the environment's estimators do with theirs; rays go through the BVH, where area lights'
 //! surfaces are primitives.
 
-use crate::render::pixel::{Hit, shading_point};
+use crate::render::primary::{Hit, shading_point};
 use crate::render::shade::Run;
 use crate::render::{Context, Counters};
 use crate::trace::bvh::{Bvh, Surface};
