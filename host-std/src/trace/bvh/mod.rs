@@ -174,7 +174,10 @@ impl Bvh {
         best.map(|prim| self.hit_at(prim, o, d, t_max))
     }
 
-    /// The hit of the ray o + t·d on primitive `prim` at distance `t`.
+    /// The hit of the ray o + t·d on primitive `prim` at distance `t`. Inlined, so that the
+    /// hit is built where the caller keeps it: copied out of a callee's frame, its wide loads
+    /// wait on the callee's narrower stores.
+    #[inline(always)]
     fn hit_at(&self, prim: usize, o: Vec3, d: Vec3, t: f32) -> Hit {
         let point = o + t * d;
         let mut uv = None;
