@@ -1,6 +1,6 @@
 //! One pixel, in named steps: for each of its shading points a camera ray
 //! (`Camera::directions`), its intersection with the scene, the shading point there
-//! ([`primary::surface`]) or the light it sees ([`primary::background`], [`primary::emitted`]);
+//! (`primary::surface`) or the light it sees (`primary::background`, `primary::emitted`);
 //! then the light sampled at every
 //! shading point (`sample_light` for the environment, `shade_lights` for the other lights), and
 //! the pixel's mean (`accumulate`).
@@ -23,7 +23,7 @@ use sampler_core::points::{permutation_element, sobol02};
 use sampler_core::rng::hash_combine;
 
 /// Shading points traced together: their hits are grouped by material before shading.
-pub(crate) const GROUP: usize = 64;
+const GROUP: usize = 64;
 
 /// A tile's scratch memory, reused from pixel to pixel.
 pub struct Scratch {
@@ -50,7 +50,8 @@ struct GroupBuffers {
     dirs: [Vec3; GROUP],
     /// Where each camera ray hits.
     found: [Option<bvh::Hit>; GROUP],
-    /// What each camera ray that misses the scene sees of the environment.
+    /// What each camera ray that misses the scene sees of the environment (written for the
+    /// misses only; the other entries are left from earlier groups).
     background: [Vec3; GROUP],
     /// Each hit's estimate, by hit.
     values: [DVec3; GROUP],
@@ -127,11 +128,11 @@ pub fn pixel(ctx: &Context<'_, '_>, x: usize, y: usize, scratch: &mut Scratch) -
         scratch.counters.camera_rays += m as u64;
         let found = &mut scratch.group.found[..m];
         ctx.bvh.intersect_from(ctx.camera.origin, dirs, ctx.camera.near_clip, found);
-        let seen = background(ctx, dirs, found, &mut scratch.group.background[..m]);
+        let env_seen = background(ctx, dirs, found, &mut scratch.group.background[..m]);
         scratch.hits.clear();
         for (k, (&dir, hit)) in dirs.iter().zip(found.iter()).enumerate() {
             let Some(hit) = hit else {
-                if seen {
+                if env_seen {
                     sum += scratch.group.background[k].as_dvec3();
                 }
                 continue;

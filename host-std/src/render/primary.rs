@@ -3,7 +3,6 @@
 //! the misses of a group of rays together) or a light's surface ([`emitted`]).
 
 use crate::render::Context;
-use crate::render::pixel::GROUP;
 use crate::render::strategy::Strategy;
 use crate::scene::{Bsdf, Scene};
 use crate::trace::bvh;
@@ -74,23 +73,28 @@ pub(crate) fn surface(ctx: &Context<'_, '_>, dir: Vec3, hit: &bvh::Hit, material
 }
 
 /// What the primary rays in directions `dirs` that leave the scene (`found[k]` none) see, into
-/// `out[k]`: the environment's radiance, their directions mapped to its square together.
-/// Returns false, nothing written, where there is no environment or the scene hides it.
+/// `out[k]`: the environment's radiance, the misses of up to a pixel group's 64 rays mapped to
+/// its square together. Returns false, nothing written, where there is no environment or the scene hides
+/// it.
 pub(crate) fn background(ctx: &Context<'_, '_>, dirs: &[Vec3], found: &[Option<bvh::Hit>], out: &mut [Vec3]) -> bool {
+    const CHUNK: usize = 64;
+    debug_assert!(dirs.len() == found.len() && dirs.len() == out.len(), "one hit and one value per ray");
     let Some(env) = ctx.env.filter(|_| !ctx.scene.hide_emitters) else {
         return false;
     };
-    let (mut which, mut missed, mut n) = ([0usize; GROUP], [Vec3::ZERO; GROUP], 0);
-    for (k, (d, h)) in dirs.iter().zip(found).enumerate() {
-        if h.is_none() {
-            (which[n], missed[n]) = (k, *d);
-            n += 1;
+    for ((dirs, found), out) in dirs.chunks(CHUNK).zip(found.chunks(CHUNK)).zip(out.chunks_mut(CHUNK)) {
+        let (mut ray_of_miss, mut missed, mut n) = ([0usize; CHUNK], [Vec3::ZERO; CHUNK], 0);
+        for (k, (d, h)) in dirs.iter().zip(found).enumerate() {
+            if h.is_none() {
+                (ray_of_miss[n], missed[n]) = (k, *d);
+                n += 1;
+            }
         }
-    }
-    let mut squares = [Vec2::ZERO; GROUP];
-    env.squares_of(&missed[..n], &mut squares[..n]);
-    for (&k, uv) in which[..n].iter().zip(&squares[..n]) {
-        out[k] = env.radiance_at(*uv);
+        let mut squares = [Vec2::ZERO; CHUNK];
+        env.squares_of(&missed[..n], &mut squares[..n]);
+        for (&k, uv) in ray_of_miss[..n].iter().zip(&squares[..n]) {
+            out[k] = env.radiance_at(*uv);
+        }
     }
     true
 }

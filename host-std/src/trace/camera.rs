@@ -58,11 +58,13 @@ impl Camera {
     }
 
     /// [`direction`](Self::direction) through film position (x + f.x, y + f.y) for each `f` of
-    /// `film` (offsets within pixel (x, y)), into `out`: the same operations in the same order,
-    /// four rays to an SSE register where the CPU is x86-64 — the same bits.
+    /// `film` (offsets within pixel (x, y)), into `out` (one direction per position): the same
+    /// operations in the same order, four rays to an SSE register where the target is x86-64
+    /// with SSE2 — the same bits.
     pub fn directions(&self, x: usize, y: usize, film: &[DVec2], out: &mut [Vec3]) {
+        debug_assert_eq!(film.len(), out.len(), "one direction per film position");
         let (px, py) = (x as f32, y as f32);
-        #[cfg(target_arch = "x86_64")]
+        #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
         for (fs, os) in film.chunks(4).zip(out.chunks_mut(4)) {
             let (mut fx, mut fy) = ([0.5f32; 4], [0.5f32; 4]);
             for (k, f) in fs.iter().enumerate() {
@@ -73,7 +75,7 @@ impl Camera {
                 *o = Vec3::new(d[0][k], d[1][k], d[2][k]);
             }
         }
-        #[cfg(not(target_arch = "x86_64"))]
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
         for (f, o) in film.iter().zip(out.iter_mut()) {
             *o = self.direction(px + f.x as f32, py + f.y as f32);
         }
@@ -81,10 +83,10 @@ impl Camera {
 
     /// [`direction`](Self::direction) at four film positions (fx[k], fy[k]), as rows of x, y
     /// and z.
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     fn directions_x4(&self, fx: [f32; 4], fy: [f32; 4]) -> [[f32; 4]; 3] {
         use core::arch::x86_64::*;
-        // SAFETY: SSE and SSE2 are part of x86-64; the loads and stores read and write whole
+        // SAFETY: the target has SSE2 (the cfg above); the loads and stores read and write whole
         // arrays of four.
         unsafe {
             let (add, mul, div) = (|a, b| _mm_add_ps(a, b), |a, b| _mm_mul_ps(a, b), |a, b| _mm_div_ps(a, b));
@@ -131,8 +133,8 @@ mod tests {
         for (s, &(origin, target, up, fov_y_deg, width, height, pixel_aspect)) in specs.iter().enumerate() {
             let spec = CameraSpec { origin, target, up, fov_y_deg, width, height, pixel_aspect, near_clip: 0.0 };
             let camera = Camera::new(&spec);
-            // Lengths that fill no chunk, one, and several with a remainder.
-            for (p, n) in [1usize, 5, 8, 21, 64].into_iter().enumerate() {
+            // Lengths that fill no chunk, one, and several with every remainder.
+            for (p, n) in [1usize, 2, 3, 5, 6, 7, 8, 21, 64, 257].into_iter().enumerate() {
                 let h = |k: usize, axis: u64| hash_combine((s * 100 + p) as u64, (k as u64) << 1 | axis);
                 let (x, y) = ((h(999, 0) % u64::from(width)) as usize, (h(999, 1) % u64::from(height)) as usize);
                 let film: Vec<DVec2> = (0..n).map(|k| DVec2::new(unit(h(k, 0)), unit(h(k, 1)))).collect();
@@ -145,6 +147,6 @@ mod tests {
                 }
             }
         }
-        assert_eq!(seen, 3 * 99);
+        assert_eq!(seen, 3 * 374);
     }
 }
