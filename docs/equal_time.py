@@ -198,11 +198,11 @@ def main():
                 ratios.setdefault((name, method, 'sample'), []).append(per_sample)
                 # Per traced shadow ray: ours trace only the samples that contribute, Mitsuba's
                 # `direct` two rays per sample.
-                mts_rays = 2 * samples / (t_ld if CLOCK == 'cpu' else args.threads * t_ld)
-                ratios.setdefault((name, method, 'ray'), []).append(mts_rays / sr)
+                mts_rate = samples / (t_ld if CLOCK == 'cpu' else args.threads * t_ld)
+                ratios.setdefault((name, method, 'ray'), []).append(2 * mts_rate / sr)
                 print(f'| {name} | {seed} | {t_ld:.2f} s, {e_ld:.2e} | {t_in:.2f} s, {e_in:.2e} | {method} | {t:.2f} s, {e:.2e} '
                       f'| {e_at:.2e} | {e_at / e_ld:.2f} | {e_at / e_in_at:.2f} | {sp / 1e6:.2f} M | {sr / 1e6:.2f} M '
-                      f'| {samples / (t_ld if CLOCK == "cpu" else args.threads * t_ld) / 1e6:.2f} M | {per_sample:.2f} |', flush=True)
+                      f'| {mts_rate / 1e6:.2f} M | {per_sample:.2f} |', flush=True)
             t_p, e_p = rows['pairs']
             ratios.setdefault((name, 'one pair per camera ray', 'time'), []).append(t_p / t_ld)
             ratios.setdefault((name, 'one pair per camera ray', 'error'), []).append(e_p / e_ld)

@@ -4,6 +4,7 @@
 //! to the right, y ∈ [0, H] downwards, has direction normalize(f + (2x/W − 1)·t·a·r + (1 − 2y/H)·t·u).
 
 use crate::scene::CameraSpec;
+use crate::trace::bvh::F4;
 use sampler_core::glam::{DVec2, Vec3, Vec3A};
 
 /// A camera ready to make primary rays.
@@ -59,55 +60,27 @@ impl Camera {
 
     /// [`direction`](Self::direction) through film position (x + f.x, y + f.y) for each `f` of
     /// `film` (offsets within pixel (x, y)), into `out` (one direction per position): the same
-    /// operations in the same order, four rays to an SSE register where the target is x86-64
-    /// with SSE2 — the same bits.
+    /// operations in the same order, four rays at a time in `bvh::F4` lanes (SSE on x86-64) — the same bits.
     pub fn directions(&self, x: usize, y: usize, film: &[DVec2], out: &mut [Vec3]) {
         debug_assert_eq!(film.len(), out.len(), "one direction per film position");
         let (px, py) = (x as f32, y as f32);
-        #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+        let s = F4::splat;
         for (fs, os) in film.chunks(4).zip(out.chunks_mut(4)) {
             let (mut fx, mut fy) = ([0.5f32; 4], [0.5f32; 4]);
             for (k, f) in fs.iter().enumerate() {
                 (fx[k], fy[k]) = (px + f.x as f32, py + f.y as f32);
             }
-            let d = self.directions_x4(fx, fy);
-            for (k, o) in os.iter_mut().take(fs.len()).enumerate() {
-                *o = Vec3::new(d[0][k], d[1][k], d[2][k]);
+            let tan_half = s(self.tan_half);
+            let sx = s(2.0).mul(F4::load(&fx)).div(s(self.film.0)).sub(s(1.0)).mul(tan_half).mul(s(self.aspect));
+            let sy = s(1.0).sub(s(2.0).mul(F4::load(&fy)).div(s(self.film.1))).mul(tan_half);
+            let axis = |f: f32, r: f32, u: f32| s(f).add(sx.mul(s(r))).add(sy.mul(s(u)));
+            let (f, r, u) = (self.forward, self.right, self.up);
+            let d = [axis(f.x, r.x, u.x), axis(f.y, r.y, u.y), axis(f.z, r.z, u.z)];
+            let inv_length = s(1.0).div(d[0].mul(d[0]).add(d[1].mul(d[1])).add(d[2].mul(d[2])).sqrt());
+            let [dx, dy, dz] = d.map(|v| v.mul(inv_length).to_array());
+            for (k, o) in os.iter_mut().enumerate() {
+                *o = Vec3::new(dx[k], dy[k], dz[k]);
             }
-        }
-        #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
-        for (f, o) in film.iter().zip(out.iter_mut()) {
-            *o = self.direction(px + f.x as f32, py + f.y as f32);
-        }
-    }
-
-    /// [`direction`](Self::direction) at four film positions (fx[k], fy[k]), as rows of x, y
-    /// and z.
-    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
-    fn directions_x4(&self, fx: [f32; 4], fy: [f32; 4]) -> [[f32; 4]; 3] {
-        use core::arch::x86_64::*;
-        // SAFETY: the target has SSE2 (the cfg above); the loads and stores read and write whole
-        // arrays of four.
-        unsafe {
-            let (add, mul, div) = (|a, b| _mm_add_ps(a, b), |a, b| _mm_mul_ps(a, b), |a, b| _mm_div_ps(a, b));
-            let (one, two) = (_mm_set1_ps(1.0), _mm_set1_ps(2.0));
-            let (fx, fy) = (_mm_loadu_ps(fx.as_ptr()), _mm_loadu_ps(fy.as_ptr()));
-            let tan_half = _mm_set1_ps(self.tan_half);
-            let sx = div(mul(two, fx), _mm_set1_ps(self.film.0));
-            let sx = mul(mul(_mm_sub_ps(sx, one), tan_half), _mm_set1_ps(self.aspect));
-            let sy = mul(_mm_sub_ps(one, div(mul(two, fy), _mm_set1_ps(self.film.1))), tan_half);
-            let axis =
-                |f: f32, r: f32, u: f32| add(add(_mm_set1_ps(f), mul(sx, _mm_set1_ps(r))), mul(sy, _mm_set1_ps(u)));
-            let dx = axis(self.forward.x, self.right.x, self.up.x);
-            let dy = axis(self.forward.y, self.right.y, self.up.y);
-            let dz = axis(self.forward.z, self.right.z, self.up.z);
-            let length = _mm_sqrt_ps(add(add(mul(dx, dx), mul(dy, dy)), mul(dz, dz)));
-            let r = div(one, length);
-            let mut rows = [[0.0f32; 4]; 3];
-            for (row, v) in rows.iter_mut().zip([dx, dy, dz]) {
-                _mm_storeu_ps(row.as_mut_ptr(), mul(v, r));
-            }
-            rows
         }
     }
 }

@@ -1,5 +1,5 @@
-//! Four f32 lanes for the leaves' triangle tests and, on CPUs without AVX2, the wide nodes' box
-//! tests: SSE on x86-64 (part of its baseline, so no run-time detection is needed), plain
+//! Four f32 lanes for the leaves' triangle tests, on CPUs without AVX2 the wide nodes' box
+//! tests, and the camera's rays four at a time: SSE on x86-64 (part of its baseline, so no run-time detection is needed), plain
 //! arrays elsewhere. Both give the same bits: every
 //! operation is one IEEE single-precision operation per lane, and `max_or` / `min_or` keep the
 //! accumulator where the new value is NaN, as SSE's `maxps` / `minps` do with these operand

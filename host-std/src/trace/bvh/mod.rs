@@ -23,6 +23,7 @@ mod wide;
 #[cfg(target_arch = "x86_64")]
 mod wide_avx2;
 
+pub(crate) use lanes::F4;
 use primitive::Aabb;
 pub use primitive::Primitive;
 pub use rays_ahead::RaysAhead;
