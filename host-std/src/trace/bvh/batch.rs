@@ -1,6 +1,7 @@
 //! Rays in batches, as the renderer hands them over: a pixel group's camera rays from the
 //! camera's origin, and a wavefront's shadow rays over t ∈ (0, ∞) ([`RaysAhead`]). In a scene that
-//! is one leaf they go eight to a register (`ray_lanes/`); elsewhere one by one.
+//! is one leaf they go eight to a register (`ray_lanes/`); in a tree camera rays go through it
+//! eight at a time as a packet (`ray_lanes/packet.rs`), shadow rays one by one.
 
 #[cfg(target_arch = "x86_64")]
 use super::ray_lanes;
@@ -11,7 +12,8 @@ impl Bvh {
     /// [`Bvh::intersect`] of rays from one point `o` (a pinhole camera's) along each of `dirs`,
     /// t ∈ (t_min, ∞): `out[k]` is ray k's hit, bit for bit the one-at-a-time call's. In a scene
     /// that is one leaf, with no disk beside it, rays go eight to a register where the CPU has
-    /// AVX2 (`ray_lanes/`). Panics unless `out` has one entry per direction.
+    /// AVX2 (`ray_lanes/`); in a tree, eight at a time through it as a packet where their
+    /// directions keep one sign per axis. Panics unless `out` has one entry per direction.
     pub fn intersect_from(&self, o: Vec3, dirs: &[Vec3], t_min: f32, out: &mut [Option<Hit>]) {
         assert_eq!(dirs.len(), out.len(), "intersect_from: one hit per ray");
         #[cfg(target_arch = "x86_64")]
@@ -27,6 +29,30 @@ impl Bvh {
                 for (k, (d, h)) in dirs.iter().zip(out.iter_mut()).enumerate() {
                     let prim = leaf.ids.get(found[k] as usize);
                     *h = prim.map(|&p| self.hit_at(p as usize, o, *d, t[k]));
+                }
+            }
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 && self.lone_leaf.is_none() {
+            const LANES: usize = ray_lanes::LANES;
+            for (dirs, out) in dirs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                // A short last chunk repeats its last ray in the lanes past it.
+                let mut packet = [dirs[dirs.len() - 1]; LANES];
+                packet[..dirs.len()].copy_from_slice(dirs);
+                // SAFETY: `avx2` is set only where the CPU has AVX2.
+                let Some((t, best, ties)) = (unsafe { ray_lanes::closest_packet(self, o, &packet, t_min) }) else {
+                    for (d, h) in dirs.iter().zip(out.iter_mut()) {
+                        *h = self.intersect(o, *d, t_min, f32::INFINITY);
+                    }
+                    continue;
+                };
+                for (k, (d, h)) in dirs.iter().zip(out.iter_mut()).enumerate() {
+                    *h = if ties & (1 << k) != 0 {
+                        self.intersect(o, *d, t_min, f32::INFINITY)
+                    } else {
+                        self.nearest_of(best[k], o, *d, t_min, t[k])
+                    };
                 }
             }
             return;

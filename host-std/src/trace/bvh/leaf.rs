@@ -10,6 +10,25 @@ use sampler_core::glam::Vec3;
 /// A lane with no primitive.
 pub(super) const NONE: u32 = u32::MAX;
 
+/// A primitive as lane tests read it, one primitive splat over rays (`ray_lanes/`).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum LanePrim {
+    /// A vertex and the two edges from it.
+    Triangle { v0: Vec3, e1: Vec3, e2: Vec3 },
+    /// The centre and the squared radius (rounded as the blocks round it).
+    Sphere { center: Vec3, r2: f32 },
+}
+
+impl LanePrim {
+    /// The lane form of `p`.
+    pub(super) fn of(p: &Primitive) -> Self {
+        match *p {
+            Primitive::Triangle { v0, e1, e2, .. } => LanePrim::Triangle { v0, e1, e2 },
+            Primitive::Sphere { center, radius, .. } => LanePrim::Sphere { center, r2: radius * radius },
+        }
+    }
+}
+
 /// Up to four primitives of one leaf.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
@@ -71,6 +90,20 @@ impl Block {
                 }
             }
             out.push(b);
+        }
+    }
+
+    /// Lane k's primitive as the lane tests read it (the block's own rounding of a sphere's
+    /// squared radius), or `None` where the lane is empty.
+    #[inline(always)]
+    pub(super) fn lane(&self, k: usize) -> Option<LanePrim> {
+        let column = |r: &[[f32; 4]; 3]| Vec3::new(r[0][k], r[1][k], r[2][k]);
+        if self.tris & (1 << k) != 0 {
+            Some(LanePrim::Triangle { v0: column(&self.v0), e1: column(&self.e1), e2: column(&self.e2) })
+        } else if self.spheres & (1 << k) != 0 {
+            Some(LanePrim::Sphere { center: column(&self.v0), r2: self.e1[0][k] })
+        } else {
+            None
         }
     }
 

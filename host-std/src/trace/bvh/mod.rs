@@ -4,7 +4,7 @@
 //! Primitive tests (`primitive.rs`, four to a leaf block in `leaf.rs`) decide every hit, so the
 //! closest hit is the one a test of every primitive finds. Rays also come in batches
 //! (`batch.rs`, `rays_ahead.rs`), which a scene that is one leaf answers eight rays to an AVX2
-//! register (`ray_lanes/`). Area lights' surfaces are primitives too (`gather.rs`), each hit
+//! register and a tree answers for camera rays as packets of eight (`ray_lanes/`). Area lights' surfaces are primitives too (`gather.rs`), each hit
 //! saying what it is the surface of (`surface.rs`); disks are tested beside the tree (`disk.rs`).
 
 mod batch;
@@ -166,6 +166,13 @@ impl Bvh {
             Some((first, count)) => self.closest_in(first, count, o, d, t_min, &mut t_max, &mut best),
             None => self.closest_in_tree(o, d, t_min, &mut t_max, &mut best),
         }
+        self.nearest_of(best, o, d, t_min, t_max)
+    }
+
+    /// The hit of the ray o + t·d, t ∈ (t_min, t_max), whose nearest primitive hit is `best` at
+    /// `t_max` (or none, `t_max` then the interval's end): a disk's where one is nearer.
+    #[inline(always)]
+    fn nearest_of(&self, best: Option<usize>, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
         if let Some((k, t)) = disk::closest(&self.disks, o, d, t_min, t_max) {
             let disk = &self.disks[k];
             let (point, normal) = (o + t * d, disk.normal);

@@ -2,7 +2,10 @@
 //! meets nearest first and skips those that start beyond the best hit so far; occlusion tests
 //! leaf children as soon as their box is met and stops at the first blocker. `Bvh` runs either
 //! in a function compiled for AVX2 where the CPU has it, a node's boxes then tested in one
-//! register (`wide_avx2.rs`), else with the two SSE halves (`wide.rs`).
+//! register (`wide_avx2.rs`), else with the two SSE halves (`wide.rs`). As soon as a node's
+//! boxes are tested, the cache lines of every child met are asked for: in a tree larger than
+//! the core's caches, those children's misses then overlap instead of each visit waiting on its
+//! own.
 
 use super::Bvh;
 use super::wide::{LEAF, NodeRay, RayLanes, WIDTH, WideNode};
@@ -45,7 +48,10 @@ impl Bvh {
         t_max: &mut f32,
         best: &mut Option<usize>,
     ) {
-        closest(&self.nodes, ray, t_max, |first, count, t_max| self.closest_in(first, count, o, d, t_min, t_max, best));
+        let touch = |first, count| prefetch_blocks(&self.blocks, first, count);
+        closest(&self.nodes, ray, t_max, touch, |first, count, t_max| {
+            self.closest_in(first, count, o, d, t_min, t_max, best)
+        });
     }
 
     /// Whether a primitive of the tree blocks the ray, as [`Bvh::blocked_in`] for its leaves.
@@ -69,17 +75,25 @@ impl Bvh {
     /// Whether a primitive of the tree blocks the ray o + t·d, its boxes tested by `ray`.
     #[inline(always)]
     fn blocked_along(&self, ray: &impl NodeRay, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        any(&self.nodes, ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
+        any(
+            &self.nodes,
+            ray,
+            t_max,
+            |first, count| prefetch_blocks(&self.blocks, first, count),
+            |first, count| self.blocked_in(first, count, o, d, t_min, t_max),
+        )
     }
 }
 
 /// Visits the primitives of every leaf whose box `ray` meets within `t_max`, nearest box
-/// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`.
+/// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`, and
+/// `touch(first, count)` asks for a leaf's cache lines when its box is met.
 #[inline(always)]
-pub(super) fn closest(
+pub(in crate::trace::bvh) fn closest(
     nodes: &[WideNode],
     ray: &impl NodeRay,
     t_max: &mut f32,
+    touch: impl Fn(u32, u32),
     mut visit: impl FnMut(u32, u32, &mut f32),
 ) {
     if nodes.is_empty() {
@@ -104,6 +118,11 @@ pub(super) fn closest(
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let item = (node.child[k], node.count[k], near[k]);
+                if item.0 & LEAF != 0 {
+                    touch(item.0 & !LEAF, item.1);
+                } else {
+                    prefetch_node(nodes, item.0);
+                }
                 let mut j = n;
                 while j > 0 && order[j - 1].2 < item.2 {
                     order[j] = order[j - 1];
@@ -139,9 +158,15 @@ pub(super) fn closest(
 }
 
 /// True when `test(first, count)` finds a blocker in a leaf whose box `ray` meets within
-/// `t_max`.
+/// `t_max`; `touch(first, count)` asks for a leaf's cache lines when its box is met.
 #[inline(always)]
-pub(super) fn any(nodes: &[WideNode], ray: &impl NodeRay, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
+pub(super) fn any(
+    nodes: &[WideNode],
+    ray: &impl NodeRay,
+    t_max: f32,
+    touch: impl Fn(u32, u32),
+    mut test: impl FnMut(u32, u32) -> bool,
+) -> bool {
     if nodes.is_empty() {
         return false;
     }
@@ -151,6 +176,17 @@ pub(super) fn any(nodes: &[WideNode], ray: &impl NodeRay, t_max: f32, mut test: 
     loop {
         let node = &nodes[index as usize];
         let (mut mask, _) = ray.hit(node, t_max);
+        let mut ahead = mask;
+        while ahead != 0 {
+            let k = ahead.trailing_zeros() as usize;
+            ahead &= ahead - 1;
+            let child = node.child[k];
+            if child & LEAF != 0 {
+                touch(child & !LEAF, node.count[k]);
+            } else {
+                prefetch_node(nodes, child);
+            }
+        }
         // The first inner child met is visited next without a trip through the stack.
         let mut next = None;
         while mask != 0 {
@@ -179,4 +215,46 @@ pub(super) fn any(nodes: &[WideNode], ray: &impl NodeRay, t_max: f32, mut test: 
             None => return false,
         };
     }
+}
+
+/// Asks for the cache lines of the blocks `first..first + count`.
+#[inline(always)]
+pub(in crate::trace::bvh) fn prefetch_blocks(blocks: &[super::leaf::Block], first: u32, count: u32) {
+    if let Some(b) = blocks.get(first as usize..(first + count) as usize) {
+        touch_lines(b.as_ptr().cast(), core::mem::size_of_val(b));
+    }
+}
+
+/// Asks for the cache lines of node `index`.
+#[inline(always)]
+fn prefetch_node(nodes: &[WideNode], index: u32) {
+    if let Some(n) = nodes.get(index as usize) {
+        touch_lines((n as *const WideNode).cast(), size_of::<WideNode>());
+    }
+}
+
+/// Asks for every cache line of the `bytes` bytes from `p`.
+#[inline(always)]
+fn touch_lines(p: *const u8, bytes: usize) {
+    let mut at = 0;
+    while at < bytes {
+        touch_line(p.wrapping_add(at));
+        at += 64;
+    }
+    // The last line, where `p` is not at a line's start.
+    if bytes > 0 && (p as usize) % 64 != 0 {
+        touch_line(p.wrapping_add(bytes - 1));
+    }
+}
+
+/// Asks for the cache line holding `p` (a hint: it never faults and changes no result).
+#[inline(always)]
+fn touch_line(p: *const u8) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads no memory and cannot fault, whatever the address.
+    unsafe {
+        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }

@@ -1,7 +1,8 @@
 //! Camera rays' nearest hits, eight rays from one point to a register, among the lone leaf's
 //! primitives.
 
-use super::{LANES, LanePrim, and3, cross, dot, load8, sphere_quadratic, splat3, sub3};
+use super::{LANES, and3, cross, dot, load8, sphere_quadratic, splat3, sub3};
+use crate::trace::bvh::leaf::LanePrim;
 use core::arch::x86_64::*;
 use sampler_core::glam::Vec3;
 
@@ -46,7 +47,7 @@ pub(in crate::trace::bvh) fn closest(
 /// ones) and their distances.
 #[inline]
 #[target_feature(enable = "avx2")]
-fn triangle_nearest(
+pub(super) fn triangle_nearest(
     v0: [__m256; 3],
     e1: [__m256; 3],
     e2: [__m256; 3],
@@ -78,7 +79,7 @@ fn triangle_nearest(
 /// and their distances, the nearer root where it is in the interval, else the farther.
 #[inline]
 #[target_feature(enable = "avx2")]
-fn sphere_nearest(
+pub(super) fn sphere_nearest(
     center: [__m256; 3],
     r2: __m256,
     o: [__m256; 3],

@@ -1,4 +1,5 @@
-//! Rays eight to an AVX2 register against the primitives of a scene that is one leaf.
+//! Rays eight to an AVX2 register: against the primitives of a scene that is one leaf, and
+//! camera rays through the tree as a packet (`packet.rs`).
 //!
 //! A leaf's blocks test one ray against four primitives at once (`leaf.rs`); a scene of a few
 //! primitives fills those lanes poorly (a rectangle's two triangles, three spheres: five of
@@ -7,40 +8,23 @@
 //! Each lane repeats the block's operations for its primitive in their order, so a ray's answer
 //! is the one the block test gives, bit for bit: `ahead.rs` answers shadow rays over t ∈ (0, ∞)
 //! as `Block::occludes` does, `closest.rs` finds camera rays' nearest hits as `Bvh::intersect`
-//! does.
+//! does, and `packet.rs` tests a leaf's primitives the same way against a packet's rays.
 
 mod ahead;
 mod closest;
+mod packet;
 
 pub(super) use ahead::blocked_ahead;
 pub(super) use closest::closest;
+pub(super) use packet::closest_packet;
 
 use super::Primitive;
-use super::leaf::{Block, NONE};
+use super::leaf::{Block, LanePrim, NONE};
 use core::arch::x86_64::*;
 use sampler_core::glam::Vec3;
 
 /// Rays per register.
 pub(super) const LANES: usize = super::rays_ahead::BLOCK;
-
-/// A primitive of the lone leaf as the lanes test it.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum LanePrim {
-    /// A vertex and the two edges from it.
-    Triangle { v0: Vec3, e1: Vec3, e2: Vec3 },
-    /// The centre and the squared radius (rounded as the blocks round it).
-    Sphere { center: Vec3, r2: f32 },
-}
-
-impl LanePrim {
-    /// The lane form of `p`.
-    fn of(p: &Primitive) -> Self {
-        match *p {
-            Primitive::Triangle { v0, e1, e2, .. } => LanePrim::Triangle { v0, e1, e2 },
-            Primitive::Sphere { center, radius, .. } => LanePrim::Sphere { center, r2: radius * radius },
-        }
-    }
-}
 
 /// The primitives of a tree that is one leaf, in the order its blocks hold them.
 #[derive(Clone, Debug)]
