@@ -242,7 +242,7 @@ fn touch_lines(p: *const u8, bytes: usize) {
         at += 64;
     }
     // The last line, where `p` is not at a line's start.
-    if bytes > 0 && (p as usize) % 64 != 0 {
+    if bytes > 0 && !(p as usize).is_multiple_of(64) {
         touch_line(p.wrapping_add(bytes - 1));
     }
 }
