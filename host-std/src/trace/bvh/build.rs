@@ -1,5 +1,5 @@
-//! The hierarchy's build: binned surface-area heuristic (16 bins along the widest centroid
-//! axis, up to 4 primitives per leaf, leaves of up to 16 where no split pays), median splits
+//! The hierarchy's build: binned surface-area heuristic (32 bins along each centroid axis, the
+//! cheapest split of the three kept; up to 4 primitives per leaf, leaves of up to 16 where no split pays), median splits
 //! past depth 40 so that the depth stays logarithmic. Subtrees of many primitives build their
 //! two halves on two threads; the halves are joined in the sequential build's order, so the
 //! tree is the same node for node at any thread count.
@@ -8,7 +8,7 @@ use super::{Aabb, Node, Primitive};
 use rayon::prelude::*;
 use sampler_core::glam::Vec3;
 
-const BINS: usize = 16;
+const BINS: usize = 32;
 /// A node of at most this many primitives is a leaf.
 const LEAF_SIZE: usize = 4;
 /// A node of at most this many primitives may stay a leaf when no split is cheaper.
@@ -127,19 +127,32 @@ fn split(items: &mut [Item], extent: Extent, depth: u32) -> Option<(usize, [Exte
     }
     let cb = extent.centroids;
     let size = cb.max - cb.min;
-    let axis = if size.x >= size.y && size.x >= size.z {
-        0
-    } else if size.y >= size.z {
-        1
-    } else {
-        2
-    };
-    if size[axis] <= 0.0 {
+    if size.max_element() <= 0.0 {
         return None; // all centroids coincide: keep one leaf
     }
-    let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / size[axis] * BINS as f32) as usize).min(BINS - 1);
-    let bins = binned(items, &bin_of);
-    let (cost, last_left) = best_split(&bins);
+    let bin_of =
+        |axis: usize| move |c: Vec3| (((c[axis] - cb.min[axis]) / size[axis] * BINS as f32) as usize).min(BINS - 1);
+    // The cheapest split over the three axes (the first of equal costs).
+    let mut best: Option<(f32, usize, usize, [Bin; BINS])> = None;
+    for axis in (0..3).filter(|&a| size[a] > 0.0) {
+        let bins = binned(items, &bin_of(axis));
+        let (cost, last_left) = best_split(&bins);
+        if best.as_ref().is_none_or(|b| cost < b.0) {
+            best = Some((cost, axis, last_left, bins));
+        }
+    }
+    let (cost, mut axis, last_left, bins) = best?;
+    if cost == f32::INFINITY {
+        // No axis separates the bins: the median split below goes along the widest.
+        axis = if size.x >= size.y && size.x >= size.z {
+            0
+        } else if size.y >= size.z {
+            1
+        } else {
+            2
+        };
+    }
+    let bin_of = bin_of(axis);
     if cost >= extent.bounds.area() * n as f32 && n <= LEAF_MAX {
         return None;
     }
