@@ -16,7 +16,10 @@ pub(crate) fn prefetch<T>(values: &[T]) {
         #[allow(unused_unsafe)]
         unsafe {
             _mm_prefetch::<_MM_HINT_T0>(first);
-            _mm_prefetch::<_MM_HINT_T0>(last);
+            // One value no larger than its alignment lies within one line.
+            if values.len() != 1 || size_of::<T>() > align_of::<T>() {
+                _mm_prefetch::<_MM_HINT_T0>(last);
+            }
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
