@@ -11,6 +11,7 @@ use sampler_core::glam::Vec3;
 pub(super) const NONE: u32 = u32::MAX;
 
 /// A primitive as lane tests read it, one primitive splat over rays (`ray_lanes/`).
+#[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug)]
 pub(super) enum LanePrim {
     /// A vertex and the two edges from it.
@@ -19,6 +20,7 @@ pub(super) enum LanePrim {
     Sphere { center: Vec3, r2: f32 },
 }
 
+#[cfg(target_arch = "x86_64")]
 impl LanePrim {
     /// The lane form of `p`.
     pub(super) fn of(p: &Primitive) -> Self {
@@ -95,6 +97,7 @@ impl Block {
 
     /// Lane k's primitive as the lane tests read it (the block's own rounding of a sphere's
     /// squared radius), or `None` where the lane is empty.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(super) fn lane(&self, k: usize) -> Option<LanePrim> {
         let column = |r: &[[f32; 4]; 3]| Vec3::new(r[0][k], r[1][k], r[2][k]);

@@ -4,8 +4,10 @@
 //! Primitive tests (`primitive.rs`, four to a leaf block in `leaf.rs`) decide every hit, so the
 //! closest hit is the one a test of every primitive finds. Rays also come in batches
 //! (`batch.rs`, `rays_ahead.rs`), which a scene that is one leaf answers eight rays to an AVX2
-//! register and a tree answers for camera rays as packets of eight (`ray_lanes/`). Area lights' surfaces are primitives too (`gather.rs`), each hit
-//! saying what it is the surface of (`surface.rs`); disks are tested beside the tree (`disk.rs`).
+//! register and a tree answers for camera rays as packets of eight (`ray_lanes/`). Traversals
+//! ask for their children's cache lines ahead (`prefetch.rs`). Area lights' surfaces are
+//! primitives too (`gather.rs`), each hit saying what it is the surface of (`surface.rs`);
+//! disks are tested beside the tree (`disk.rs`).
 
 mod batch;
 mod build;
@@ -13,6 +15,7 @@ mod disk;
 mod gather;
 mod lanes;
 mod leaf;
+mod prefetch;
 mod primitive;
 #[cfg(target_arch = "x86_64")]
 mod ray_lanes;

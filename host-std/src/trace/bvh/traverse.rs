@@ -3,11 +3,10 @@
 //! leaf children as soon as their box is met and stops at the first blocker. `Bvh` runs either
 //! in a function compiled for AVX2 where the CPU has it, a node's boxes then tested in one
 //! register (`wide_avx2.rs`), else with the two SSE halves (`wide.rs`). As soon as a node's
-//! boxes are tested, the cache lines of every child met are asked for: in a tree larger than
-//! the core's caches, those children's misses then overlap instead of each visit waiting on its
-//! own.
+//! boxes are tested, the cache lines of every child met are asked for (`prefetch.rs`).
 
 use super::Bvh;
+use super::prefetch::{prefetch_blocks, prefetch_node};
 use super::wide::{LEAF, NodeRay, RayLanes, WIDTH, WideNode};
 use sampler_core::glam::Vec3;
 use std::mem::MaybeUninit;
@@ -48,8 +47,8 @@ impl Bvh {
         t_max: &mut f32,
         best: &mut Option<usize>,
     ) {
-        let touch = |first, count| prefetch_blocks(&self.blocks, first, count);
-        closest(&self.nodes, ray, t_max, touch, |first, count, t_max| {
+        let prefetch_leaf = |first, count| prefetch_blocks(&self.blocks, first, count);
+        closest(&self.nodes, ray, t_max, prefetch_leaf, |first, count, t_max| {
             self.closest_in(first, count, o, d, t_min, t_max, best)
         });
     }
@@ -87,13 +86,13 @@ impl Bvh {
 
 /// Visits the primitives of every leaf whose box `ray` meets within `t_max`, nearest box
 /// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`, and
-/// `touch(first, count)` asks for a leaf's cache lines when its box is met.
+/// `prefetch_leaf(first, count)` asks for a leaf's cache lines when its box is met.
 #[inline(always)]
 pub(in crate::trace::bvh) fn closest(
     nodes: &[WideNode],
     ray: &impl NodeRay,
     t_max: &mut f32,
-    touch: impl Fn(u32, u32),
+    prefetch_leaf: impl Fn(u32, u32),
     mut visit: impl FnMut(u32, u32, &mut f32),
 ) {
     if nodes.is_empty() {
@@ -119,7 +118,7 @@ pub(in crate::trace::bvh) fn closest(
                 mask &= mask - 1;
                 let item = (node.child[k], node.count[k], near[k]);
                 if item.0 & LEAF != 0 {
-                    touch(item.0 & !LEAF, item.1);
+                    prefetch_leaf(item.0 & !LEAF, item.1);
                 } else {
                     prefetch_node(nodes, item.0);
                 }
@@ -158,13 +157,13 @@ pub(in crate::trace::bvh) fn closest(
 }
 
 /// True when `test(first, count)` finds a blocker in a leaf whose box `ray` meets within
-/// `t_max`; `touch(first, count)` asks for a leaf's cache lines when its box is met.
+/// `t_max`; `prefetch_leaf(first, count)` asks for a leaf's cache lines when its box is met.
 #[inline(always)]
 pub(super) fn any(
     nodes: &[WideNode],
     ray: &impl NodeRay,
     t_max: f32,
-    touch: impl Fn(u32, u32),
+    prefetch_leaf: impl Fn(u32, u32),
     mut test: impl FnMut(u32, u32) -> bool,
 ) -> bool {
     if nodes.is_empty() {
@@ -182,7 +181,7 @@ pub(super) fn any(
             ahead &= ahead - 1;
             let child = node.child[k];
             if child & LEAF != 0 {
-                touch(child & !LEAF, node.count[k]);
+                prefetch_leaf(child & !LEAF, node.count[k]);
             } else {
                 prefetch_node(nodes, child);
             }
@@ -215,46 +214,4 @@ pub(super) fn any(
             None => return false,
         };
     }
-}
-
-/// Asks for the cache lines of the blocks `first..first + count`.
-#[inline(always)]
-pub(in crate::trace::bvh) fn prefetch_blocks(blocks: &[super::leaf::Block], first: u32, count: u32) {
-    if let Some(b) = blocks.get(first as usize..(first + count) as usize) {
-        touch_lines(b.as_ptr().cast(), core::mem::size_of_val(b));
-    }
-}
-
-/// Asks for the cache lines of node `index`.
-#[inline(always)]
-fn prefetch_node(nodes: &[WideNode], index: u32) {
-    if let Some(n) = nodes.get(index as usize) {
-        touch_lines((n as *const WideNode).cast(), size_of::<WideNode>());
-    }
-}
-
-/// Asks for every cache line of the `bytes` bytes from `p`.
-#[inline(always)]
-fn touch_lines(p: *const u8, bytes: usize) {
-    let mut at = 0;
-    while at < bytes {
-        touch_line(p.wrapping_add(at));
-        at += 64;
-    }
-    // The last line, where `p` is not at a line's start.
-    if bytes > 0 && !(p as usize).is_multiple_of(64) {
-        touch_line(p.wrapping_add(bytes - 1));
-    }
-}
-
-/// Asks for the cache line holding `p` (a hint: it never faults and changes no result).
-#[inline(always)]
-fn touch_line(p: *const u8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch reads no memory and cannot fault, whatever the address.
-    unsafe {
-        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p.cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
 }

@@ -35,7 +35,8 @@ pub(super) struct WideNode {
 /// A ray prepared for a wide node's box tests.
 pub(super) trait NodeRay {
     /// Which children's boxes of `node` the ray meets within [0, t_max] (bit k for child k)
-    /// and the entry distance of each. NaN slab distances (a ray in a box's plane) leave the
+    /// and an entry distance of each, no larger than the ray's (a packet's: no larger than any
+    /// of its rays'). NaN slab distances (a ray in a box's plane) leave the
     /// interval as it is, so such boxes count as met.
     fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]);
 }

@@ -12,12 +12,18 @@
 //! bit the blocks' (`closest.rs`), so each ray's nearest distance is the one it finds alone.
 //! Where a ray meets two primitives at exactly its nearest distance, which one a lone ray keeps
 //! depends on the order it visits them: such a ray is left to `Bvh::intersect`.
+//!
+//! This rests on what a lone ray's nearest hit rests on too: a box test admits every hit its
+//! leaf's tests find (the box's rounded entry is not beyond a rounded hit inside it). The packet
+//! prunes boxes with a bound a few ulps wider than its rays' farthest nearest hit, so a box whose
+//! entry rounds just past a hit inside it is still entered.
 
 use super::closest::{sphere_nearest, triangle_nearest};
 use super::{LANES, load8, splat3};
 use crate::trace::bvh::Bvh;
 use crate::trace::bvh::leaf::LanePrim;
-use crate::trace::bvh::traverse::{closest, prefetch_blocks};
+use crate::trace::bvh::prefetch::prefetch_blocks;
+use crate::trace::bvh::traverse::closest;
 use crate::trace::bvh::wide::{NodeRay, WIDTH, WideNode, near_planes};
 use core::arch::x86_64::*;
 use sampler_core::glam::Vec3;
@@ -68,11 +74,11 @@ fn packet_hit(p: &PacketBoxes, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH
     let mut near = _mm256_setzero_ps();
     let mut far = _mm256_set1_ps(t_max);
     for axis in 0..3 {
-        let lo = _mm256_sub_ps(row(2 * axis + p.near[axis]), p.o[axis]);
-        let hi = _mm256_sub_ps(row(2 * axis + 1 - p.near[axis]), p.o[axis]);
-        let (a, b) = (_mm256_mul_ps(lo, p.inv_lo[axis]), _mm256_mul_ps(lo, p.inv_hi[axis]));
+        let to_near = _mm256_sub_ps(row(2 * axis + p.near[axis]), p.o[axis]);
+        let to_far = _mm256_sub_ps(row(2 * axis + 1 - p.near[axis]), p.o[axis]);
+        let (a, b) = (_mm256_mul_ps(to_near, p.inv_lo[axis]), _mm256_mul_ps(to_near, p.inv_hi[axis]));
         near = _mm256_max_ps(_mm256_min_ps(a, b), near);
-        let (a, b) = (_mm256_mul_ps(hi, p.inv_lo[axis]), _mm256_mul_ps(hi, p.inv_hi[axis]));
+        let (a, b) = (_mm256_mul_ps(to_far, p.inv_lo[axis]), _mm256_mul_ps(to_far, p.inv_hi[axis]));
         far = _mm256_min_ps(_mm256_max_ps(a, b), far);
     }
     let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(near, far)) as u32;
@@ -100,10 +106,11 @@ pub(in crate::trace::bvh) fn closest_packet(
     let (t_min, infinity) = (_mm256_set1_ps(t_min), _mm256_set1_ps(f32::INFINITY));
     let mut t_best = infinity;
     let mut best = _mm256_set1_epi32(-1);
-    let mut ties = _mm256_setzero_ps();
+    // Per ray the distance of its last tie: a tie counts where it is at the final nearest hit.
+    let mut t_tie = _mm256_set1_ps(f32::NAN);
     let mut t_max = f32::INFINITY;
-    let touch = |first, count| prefetch_blocks(&bvh.blocks, first, count);
-    closest(&bvh.nodes, &boxes, &mut t_max, touch, |first, count, t_max| {
+    let prefetch_leaf = |first, count| prefetch_blocks(&bvh.blocks, first, count);
+    closest(&bvh.nodes, &boxes, &mut t_max, prefetch_leaf, |first, count, t_max| {
         for b in &bvh.blocks[first as usize..(first + count) as usize] {
             for k in 0..4 {
                 let (hit, t) = match b.lane(k) {
@@ -116,18 +123,20 @@ pub(in crate::trace::bvh) fn closest_packet(
                     None => continue,
                 };
                 let nearer = _mm256_and_ps(hit, _mm256_cmp_ps::<_CMP_LT_OS>(t, t_best));
-                ties = _mm256_or_ps(ties, _mm256_and_ps(hit, _mm256_cmp_ps::<_CMP_EQ_OQ>(t, t_best)));
+                let tie = _mm256_and_ps(hit, _mm256_cmp_ps::<_CMP_EQ_OQ>(t, t_best));
+                t_tie = _mm256_blendv_ps(t_tie, t, tie);
                 t_best = _mm256_blendv_ps(t_best, t, nearer);
                 let id = _mm256_set1_epi32(b.prim[k] as i32);
                 best = _mm256_blendv_epi8(best, id, _mm256_castps_si256(nearer));
             }
         }
         // The farthest of the rays' nearest hits (none is NaN) bounds the boxes still worth
-        // entering.
+        // entering, a few ulps wider: a box's entry rounds apart from the hits inside it, and
+        // a lone ray whose bound was larger when it met such a box entered it.
         let m = _mm256_max_ps(t_best, _mm256_permute2f128_ps::<1>(t_best, t_best));
         let m = _mm256_max_ps(m, _mm256_shuffle_ps::<0b01_00_11_10>(m, m));
         let m = _mm256_max_ps(m, _mm256_shuffle_ps::<0b10_11_00_01>(m, m));
-        *t_max = _mm256_cvtss_f32(m);
+        *t_max = _mm256_cvtss_f32(m) * (1.0 + 8.0 * f32::EPSILON);
     });
     let (mut t, mut ids) = ([0.0f32; LANES], [0i32; LANES]);
     // SAFETY: `t` and `ids` are eight writable 4-byte lanes; the stores need no alignment.
@@ -135,7 +144,7 @@ pub(in crate::trace::bvh) fn closest_packet(
         _mm256_storeu_ps(t.as_mut_ptr(), t_best);
         _mm256_storeu_si256(ids.as_mut_ptr().cast(), best);
     }
-    let ties = _mm256_movemask_ps(ties) as u32;
+    let ties = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t_tie, t_best)) as u32;
     Some((t, ids.map(|id| usize::try_from(id).ok()), ties))
 }
 
@@ -236,5 +245,55 @@ mod tests {
         assert!(hits > 5000, "{hits} hits: too few to test the packets");
         assert!(packets > 500, "{packets} packets: too few rays went together");
         assert!(ties > 20, "{ties} rays met two primitives at their nearest distance: too few to test them");
+    }
+
+    #[test]
+    fn of_primitives_at_one_distance_a_packet_keeps_the_one_a_lone_ray_keeps() {
+        if !std::is_x86_feature_detected!("avx2") {
+            eprintln!("no AVX2 on this CPU: packets are never used here");
+            return;
+        }
+        // Overlapping squares in the plane y = 0 with power-of-two sides at dyadic corners:
+        // every one a ray meets is at the same distance, bit for bit, and the packet visits
+        // their leaves in another order than a lone ray does.
+        let mut shapes =
+            vec![(Shape::Rectangle { p0: Vec3::new(-2.0, 0.0, -2.0), e1: Vec3::X * 4.0, e2: Vec3::Z * 4.0 }, 0)];
+        for k in 0..150u32 {
+            let side = 0.5f32.powi(1 + (k % 3) as i32);
+            let corner = Vec3::new((k % 24) as f32 / 8.0 - 1.5, 0.0, (k / 24 * 3 % 24) as f32 / 8.0 - 1.5);
+            shapes.push((Shape::Rectangle { p0: corner, e1: Vec3::X * side, e2: Vec3::Z * side }, (k % 2) as usize));
+        }
+        let bvh = Bvh::build(&scene_of(shapes));
+        assert!(bvh.lone_leaf.is_none(), "a tree");
+        let mut next = numbers(0x5851_f42d_4c95_7f2d);
+        let o = Vec3::new(-2.25, 3.0, -2.0);
+        let (mut packets, mut tied, mut kept_otherwise) = (0, 0, 0);
+        for _ in 0..400 {
+            let centre = Vec3::new(0.6 + next() * 0.5, -1.0, 0.6 + next() * 0.5).normalize();
+            let dirs: [Vec3; LANES] =
+                core::array::from_fn(|_| (centre + 0.1 * Vec3::new(next(), 0.0, next())).normalize());
+            let mut found = vec![None; LANES];
+            bvh.intersect_from(o, &dirs, 0.0, &mut found);
+            // SAFETY: the CPU has AVX2 (checked above).
+            let Some((t, best, ties)) = (unsafe { closest_packet(&bvh, o, &dirs, 0.0) }) else {
+                continue; // directions on both sides of an axis
+            };
+            packets += 1;
+            for (k, d) in dirs.iter().enumerate() {
+                let want = bvh.intersect(o, *d, 0.0, f32::INFINITY);
+                assert_eq!(key(&found[k]), key(&want), "ray {k} along {d}");
+                if ties & (1 << k) != 0 {
+                    tied += 1;
+                    let packet = bvh.nearest_of(best[k], o, *d, 0.0, t[k]);
+                    kept_otherwise += usize::from(packet.map(|h| h.surface) != want.map(|h| h.surface));
+                }
+            }
+        }
+        assert!(packets > 300, "{packets} packets of 400");
+        assert!(tied > 1000, "{tied} rays met primitives at one distance: too few");
+        assert!(
+            kept_otherwise > 20,
+            "{kept_otherwise} tied rays: the packet alone keeps the lone ray's surface, so the tie rule goes untested"
+        );
     }
 }
