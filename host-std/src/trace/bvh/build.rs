@@ -1,6 +1,6 @@
 //! The hierarchy's build: binned surface-area heuristic (32 bins along each centroid axis, the
-//! cheapest split of the three kept; up to 4 primitives per leaf, leaves of up to 16 where no split pays), median splits
-//! past depth 40 so that the depth stays logarithmic. Subtrees of many primitives build their
+//! cheapest split of the three kept; up to 4 primitives per leaf, leaves of up to 16 where no
+//! split pays), median splits past depth 40 so that the depth stays logarithmic. Subtrees of many primitives build their
 //! two halves on two threads; the halves are joined in the sequential build's order, so the
 //! tree is the same node for node at any thread count.
 
