@@ -41,14 +41,11 @@ impl Bvh {
                 let mut packet = [dirs[dirs.len() - 1]; LANES];
                 packet[..dirs.len()].copy_from_slice(dirs);
                 // SAFETY: `avx2` is set only where the CPU has AVX2.
-                let Some((t, best, ties)) = (unsafe { ray_lanes::closest_packet(self, o, &packet, t_min) }) else {
-                    for (d, h) in dirs.iter().zip(out.iter_mut()) {
-                        *h = self.intersect(o, *d, t_min, f32::INFINITY);
-                    }
-                    continue;
-                };
+                let found = unsafe { ray_lanes::closest_packet(self, o, &packet, t_min) };
+                // Rays that make no packet go one at a time, as the packet's ties do.
+                let (t, best, alone) = found.unwrap_or(([0.0; LANES], [None; LANES], u32::MAX));
                 for (k, (d, h)) in dirs.iter().zip(out.iter_mut()).enumerate() {
-                    *h = if ties & (1 << k) != 0 {
+                    *h = if alone & (1 << k) != 0 {
                         self.intersect(o, *d, t_min, f32::INFINITY)
                     } else {
                         self.nearest_of(best[k], o, *d, t_min, t[k])

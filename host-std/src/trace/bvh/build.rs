@@ -1,8 +1,8 @@
 //! The hierarchy's build: binned surface-area heuristic (32 bins along each centroid axis, the
 //! cheapest split of the three kept; up to 4 primitives per leaf, leaves of up to 16 where no
-//! split pays), median splits past depth 40 so that the depth stays logarithmic. Subtrees of many primitives build their
-//! two halves on two threads; the halves are joined in the sequential build's order, so the
-//! tree is the same node for node at any thread count.
+//! split pays), median splits past depth 40 so that the depth stays logarithmic. Subtrees of
+//! many primitives build their two halves on two threads; the halves are joined in the
+//! sequential build's order, so the tree is the same node for node at any thread count.
 
 use super::{Aabb, Node, Primitive};
 use rayon::prelude::*;
@@ -144,13 +144,7 @@ fn split(items: &mut [Item], extent: Extent, depth: u32) -> Option<(usize, [Exte
     let (cost, mut axis, last_left, bins) = best?;
     if cost == f32::INFINITY {
         // No axis separates the bins: the median split below goes along the widest.
-        axis = if size.x >= size.y && size.x >= size.z {
-            0
-        } else if size.y >= size.z {
-            1
-        } else {
-            2
-        };
+        axis = size.max_position();
     }
     let bin_of = bin_of(axis);
     if cost >= extent.bounds.area() * n as f32 && n <= LEAF_MAX {

@@ -4,11 +4,22 @@
 //! faults, reads nothing and changes no result.
 
 use super::leaf::Block;
-use super::wide::WideNode;
+use super::wide::{LEAF, WideNode};
+
+/// Asks for the cache lines of a node's child (as `WideNode::child` and `count` hold it): an
+/// inner node's, or a leaf's blocks.
+#[inline(always)]
+pub(super) fn prefetch_child(nodes: &[WideNode], blocks: &[Block], child: u32, count: u32) {
+    if child & LEAF != 0 {
+        prefetch_blocks(blocks, child & !LEAF, count);
+    } else {
+        prefetch_node(nodes, child);
+    }
+}
 
 /// Asks for the cache lines of the blocks `first..first + count`.
 #[inline(always)]
-pub(super) fn prefetch_blocks(blocks: &[Block], first: u32, count: u32) {
+fn prefetch_blocks(blocks: &[Block], first: u32, count: u32) {
     if let Some(b) = blocks.get(first as usize..(first + count) as usize) {
         prefetch_lines(b.as_ptr().cast(), size_of_val(b));
     }
@@ -16,7 +27,7 @@ pub(super) fn prefetch_blocks(blocks: &[Block], first: u32, count: u32) {
 
 /// Asks for the cache lines of node `index`.
 #[inline(always)]
-pub(super) fn prefetch_node(nodes: &[WideNode], index: u32) {
+fn prefetch_node(nodes: &[WideNode], index: u32) {
     if let Some(n) = nodes.get(index as usize) {
         prefetch_lines((n as *const WideNode).cast(), size_of::<WideNode>());
     }

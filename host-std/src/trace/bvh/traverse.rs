@@ -6,7 +6,8 @@
 //! boxes are tested, the cache lines of every child met are asked for (`prefetch.rs`).
 
 use super::Bvh;
-use super::prefetch::{prefetch_blocks, prefetch_node};
+use super::leaf::Block;
+use super::prefetch::prefetch_child;
 use super::wide::{LEAF, NodeRay, RayLanes, WIDTH, WideNode};
 use sampler_core::glam::Vec3;
 use std::mem::MaybeUninit;
@@ -47,8 +48,7 @@ impl Bvh {
         t_max: &mut f32,
         best: &mut Option<usize>,
     ) {
-        let prefetch_leaf = |first, count| prefetch_blocks(&self.blocks, first, count);
-        closest(&self.nodes, ray, t_max, prefetch_leaf, |first, count, t_max| {
+        closest(&self.nodes, &self.blocks, ray, t_max, |first, count, t_max| {
             self.closest_in(first, count, o, d, t_min, t_max, best)
         });
     }
@@ -74,25 +74,18 @@ impl Bvh {
     /// Whether a primitive of the tree blocks the ray o + t·d, its boxes tested by `ray`.
     #[inline(always)]
     fn blocked_along(&self, ray: &impl NodeRay, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        any(
-            &self.nodes,
-            ray,
-            t_max,
-            |first, count| prefetch_blocks(&self.blocks, first, count),
-            |first, count| self.blocked_in(first, count, o, d, t_min, t_max),
-        )
+        any(&self.nodes, &self.blocks, ray, t_max, |first, count| self.blocked_in(first, count, o, d, t_min, t_max))
     }
 }
 
 /// Visits the primitives of every leaf whose box `ray` meets within `t_max`, nearest box
-/// first; `visit(first, count, t_max)` tests a leaf's primitives and may shrink `t_max`, and
-/// `prefetch_leaf(first, count)` asks for a leaf's cache lines when its box is met.
+/// first; `visit(first, count, t_max)` tests a leaf's `blocks` and may shrink `t_max`.
 #[inline(always)]
 pub(in crate::trace::bvh) fn closest(
     nodes: &[WideNode],
+    blocks: &[Block],
     ray: &impl NodeRay,
     t_max: &mut f32,
-    prefetch_leaf: impl Fn(u32, u32),
     mut visit: impl FnMut(u32, u32, &mut f32),
 ) {
     if nodes.is_empty() {
@@ -117,11 +110,7 @@ pub(in crate::trace::bvh) fn closest(
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let item = (node.child[k], node.count[k], near[k]);
-                if item.0 & LEAF != 0 {
-                    prefetch_leaf(item.0 & !LEAF, item.1);
-                } else {
-                    prefetch_node(nodes, item.0);
-                }
+                prefetch_child(nodes, blocks, item.0, item.1);
                 let mut j = n;
                 while j > 0 && order[j - 1].2 < item.2 {
                     order[j] = order[j - 1];
@@ -156,14 +145,14 @@ pub(in crate::trace::bvh) fn closest(
     }
 }
 
-/// True when `test(first, count)` finds a blocker in a leaf whose box `ray` meets within
-/// `t_max`; `prefetch_leaf(first, count)` asks for a leaf's cache lines when its box is met.
+/// True when `test(first, count)` finds a blocker in the `blocks` of a leaf whose box `ray`
+/// meets within `t_max`.
 #[inline(always)]
 pub(super) fn any(
     nodes: &[WideNode],
+    blocks: &[Block],
     ray: &impl NodeRay,
     t_max: f32,
-    prefetch_leaf: impl Fn(u32, u32),
     mut test: impl FnMut(u32, u32) -> bool,
 ) -> bool {
     if nodes.is_empty() {
@@ -175,16 +164,12 @@ pub(super) fn any(
     loop {
         let node = &nodes[index as usize];
         let (mut mask, _) = ray.hit(node, t_max);
+        // Every child met asked for before the first leaf's test waits on its own lines.
         let mut ahead = mask;
         while ahead != 0 {
             let k = ahead.trailing_zeros() as usize;
             ahead &= ahead - 1;
-            let child = node.child[k];
-            if child & LEAF != 0 {
-                prefetch_leaf(child & !LEAF, node.count[k]);
-            } else {
-                prefetch_node(nodes, child);
-            }
+            prefetch_child(nodes, blocks, node.child[k], node.count[k]);
         }
         // The first inner child met is visited next without a trip through the stack.
         let mut next = None;

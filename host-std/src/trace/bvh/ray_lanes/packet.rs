@@ -22,7 +22,6 @@ use super::closest::{sphere_nearest, triangle_nearest};
 use super::{LANES, load8, splat3};
 use crate::trace::bvh::Bvh;
 use crate::trace::bvh::leaf::LanePrim;
-use crate::trace::bvh::prefetch::prefetch_blocks;
 use crate::trace::bvh::traverse::closest;
 use crate::trace::bvh::wide::{NodeRay, WIDTH, WideNode, near_planes};
 use core::arch::x86_64::*;
@@ -109,8 +108,7 @@ pub(in crate::trace::bvh) fn closest_packet(
     // Per ray the distance of its last tie: a tie counts where it is at the final nearest hit.
     let mut t_tie = _mm256_set1_ps(f32::NAN);
     let mut t_max = f32::INFINITY;
-    let prefetch_leaf = |first, count| prefetch_blocks(&bvh.blocks, first, count);
-    closest(&bvh.nodes, &boxes, &mut t_max, prefetch_leaf, |first, count, t_max| {
+    closest(&bvh.nodes, &bvh.blocks, &boxes, &mut t_max, |first, count, t_max| {
         for b in &bvh.blocks[first as usize..(first + count) as usize] {
             for k in 0..4 {
                 let (hit, t) = match b.lane(k) {
