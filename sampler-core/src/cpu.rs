@@ -1,6 +1,10 @@
 //! What the CPU the code runs on can do, asked once: the core is `no_std`, so it reads CPUID
 //! itself (as `std::is_x86_feature_detected!` does) rather than leaving the choice to the host.
 //! Paths chosen by it compute the same results as the portable ones, bit for bit.
+//!
+//! A build may also assume extensions throughout (`-C target-cpu`: the workspace builds x86-64
+//! for x86-64-v3, `.cargo/config.toml`); [`missing_build_feature`] names one this CPU lacks, so
+//! that a program can say so before it runs an instruction the CPU does not have.
 
 /// Whether AVX2 instructions may run here: the CPU has them and the OS saves the YMM registers.
 #[cfg(target_arch = "x86_64")]
@@ -9,6 +13,10 @@ pub(crate) fn has_avx2() -> bool {
     use core::sync::atomic::{AtomicU8, Ordering};
     /// 0: not asked yet; 1: no; 2: yes.
     static ANSWER: AtomicU8 = AtomicU8::new(0);
+    // A build that assumes AVX2 throughout runs only where it is: no question to ask.
+    if cfg!(target_feature = "avx2") {
+        return true;
+    }
     match ANSWER.load(Ordering::Relaxed) {
         1 => false,
         2 => true,
@@ -18,6 +26,88 @@ pub(crate) fn has_avx2() -> bool {
             yes
         }
     }
+}
+
+/// An instruction-set extension this build assumes throughout (compiled with it enabled) that
+/// the CPU it runs on lacks, by CPUID; `None` where the build runs here. Asked at run time
+/// whatever the build assumes (`is_x86_feature_detected!` answers from the build where it
+/// assumes the feature).
+#[must_use]
+pub fn missing_build_feature() -> Option<&'static str> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        first_missing(&build_features(&Cpuid::read()))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        None
+    }
+}
+
+/// The first feature built in (`.1`) that the CPU lacks (`.2` false).
+#[cfg(target_arch = "x86_64")]
+fn first_missing(features: &[(&'static str, bool, bool)]) -> Option<&'static str> {
+    features.iter().find(|(_, built, here)| *built && !*here).map(|(name, ..)| *name)
+}
+
+/// The registers of CPUID (and XCR0) that name the extensions of x86-64-v2 to v4.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Default)]
+struct Cpuid {
+    /// Leaf 1, ECX.
+    leaf1_ecx: u32,
+    /// Leaf 7 sub-leaf 0, EBX.
+    leaf7_ebx: u32,
+    /// Leaf 0x8000_0001, ECX.
+    ext1_ecx: u32,
+    /// The OS-enabled register state (0 where OSXSAVE is off).
+    xcr0: u64,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Cpuid {
+    fn read() -> Self {
+        use core::arch::x86_64::{__cpuid, __cpuid_count};
+        // CPUID is always available on x86-64 and only reads identification registers.
+        #[allow(unused_unsafe)]
+        let (max_leaf, max_ext) = unsafe { (__cpuid(0).eax, __cpuid(0x8000_0000).eax) };
+        #[allow(unused_unsafe)]
+        let leaf1_ecx = unsafe { __cpuid(1).ecx };
+        #[allow(unused_unsafe)]
+        let leaf7_ebx = if max_leaf >= 7 { unsafe { __cpuid_count(7, 0).ebx } } else { 0 };
+        #[allow(unused_unsafe)]
+        let ext1_ecx = if max_ext >= 0x8000_0001 { unsafe { __cpuid(0x8000_0001).ecx } } else { 0 };
+        // SAFETY: XGETBV is enabled where OSXSAVE is set.
+        let xcr0 = if leaf1_ecx & (1 << 27) != 0 { unsafe { xcr0() } } else { 0 };
+        Self { leaf1_ecx, leaf7_ebx, ext1_ecx, xcr0 }
+    }
+}
+
+/// Each extension of x86-64-v2 to v4: its name, whether this build assumes it, whether `cpu`
+/// has it (the AVX families only where the OS saves their registers).
+#[cfg(target_arch = "x86_64")]
+fn build_features(cpu: &Cpuid) -> [(&'static str, bool, bool); 15] {
+    let (c1, b7, e1) = (cpu.leaf1_ecx, cpu.leaf7_ebx, cpu.ext1_ecx);
+    let bit = |r: u32, n: u32| r & (1 << n) != 0;
+    let ymm = cpu.xcr0 & 0b110 == 0b110;
+    let zmm = ymm && cpu.xcr0 & 0b1110_0000 == 0b1110_0000;
+    [
+        ("sse3", cfg!(target_feature = "sse3"), bit(c1, 0)),
+        ("ssse3", cfg!(target_feature = "ssse3"), bit(c1, 9)),
+        ("sse4.1", cfg!(target_feature = "sse4.1"), bit(c1, 19)),
+        ("sse4.2", cfg!(target_feature = "sse4.2"), bit(c1, 20)),
+        ("popcnt", cfg!(target_feature = "popcnt"), bit(c1, 23)),
+        ("avx", cfg!(target_feature = "avx"), bit(c1, 28) && ymm),
+        ("f16c", cfg!(target_feature = "f16c"), bit(c1, 29) && ymm),
+        ("fma", cfg!(target_feature = "fma"), bit(c1, 12) && ymm),
+        ("movbe", cfg!(target_feature = "movbe"), bit(c1, 22)),
+        ("avx2", cfg!(target_feature = "avx2"), bit(b7, 5) && ymm),
+        ("bmi1", cfg!(target_feature = "bmi1"), bit(b7, 3)),
+        ("bmi2", cfg!(target_feature = "bmi2"), bit(b7, 8)),
+        ("lzcnt", cfg!(target_feature = "lzcnt"), bit(e1, 5)),
+        ("avx512f", cfg!(target_feature = "avx512f"), bit(b7, 16) && zmm),
+        ("avx512bw", cfg!(target_feature = "avx512bw"), bit(b7, 30) && zmm),
+    ]
 }
 
 /// CPUID leaf 1 (AVX, OSXSAVE), XCR0 (XMM and YMM state enabled), leaf 7 (AVX2).
@@ -51,6 +141,28 @@ unsafe fn xcr0() -> u64 {
 
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
+    use super::{Cpuid, build_features, first_missing};
+
+    #[test]
+    fn a_feature_built_in_and_absent_is_named() {
+        let list = [("a", false, false), ("b", true, true), ("c", true, false), ("d", true, false)];
+        assert_eq!(first_missing(&list), Some("c"));
+        assert_eq!(first_missing(&list[..2]), None);
+        // A CPU without AVX state saved by the OS has none of the AVX family, whatever CPUID says.
+        let cpu = Cpuid { leaf1_ecx: u32::MAX, leaf7_ebx: u32::MAX, ext1_ecx: u32::MAX, xcr0: 0 };
+        let avx2 = build_features(&cpu).into_iter().find(|f| f.0 == "avx2").unwrap();
+        assert!(!avx2.2);
+        let cpu = Cpuid { xcr0: 0b111, ..cpu };
+        let here = build_features(&cpu);
+        assert!(here.iter().filter(|f| !f.0.starts_with("avx512")).all(|f| f.2));
+        assert!(here.iter().filter(|f| f.0.starts_with("avx512")).all(|f| !f.2));
+    }
+
+    #[test]
+    fn this_build_runs_here() {
+        assert_eq!(super::missing_build_feature(), None);
+    }
+
     #[test]
     fn agrees_with_std() {
         assert_eq!(super::has_avx2(), std::is_x86_feature_detected!("avx2"));

@@ -46,7 +46,7 @@ extern crate std;
 // The source groups what belongs together (`sphere/`, `env/`, `product/`, `baselines/`,
 // `estimator/`, `brdf/`); the public modules keep one flat path each.
 mod baselines;
-mod cpu;
+pub mod cpu;
 mod prefetch;
 mod product;
 mod sphere;

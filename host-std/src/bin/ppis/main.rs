@@ -84,6 +84,7 @@ fn parse_command_line() -> Cli {
 }
 
 fn main() {
+    refuse_a_cpu_the_build_cannot_run_on();
     end_quietly_on_a_closed_pipe();
     one_malloc_arena();
     let cli = parse_command_line();
@@ -97,6 +98,19 @@ fn main() {
     };
     if let Err(e) = result {
         eprintln!("ppis: error: {e:#}");
+        std::process::exit(2);
+    }
+}
+
+/// A build that assumes instruction-set extensions throughout (x86-64 builds assume
+/// x86-64-v3: `.cargo/config.toml`) would stop at its first such instruction on a CPU without
+/// them; it says so in one line instead, before any work.
+fn refuse_a_cpu_the_build_cannot_run_on() {
+    if let Some(feature) = sampler_core::cpu::missing_build_feature() {
+        eprintln!(
+            "ppis: error: this ppis is built for CPUs with {feature} (x86-64-v3: .cargo/config.toml) and this \
+             CPU lacks it; build it for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\""
+        );
         std::process::exit(2);
     }
 }
