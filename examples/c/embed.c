@@ -88,6 +88,12 @@ static void print_sample(const char *name, int k, ppis_sample s, float pdf) {
 }
 
 int main(void) {
+    /* A library built for x86-64-v3 says which extension this CPU lacks before any other call. */
+    const char *missing = ppis_missing_cpu_feature();
+    if (missing) {
+        fprintf(stderr, "embed: this library needs a CPU with %s\n", missing);
+        return 1;
+    }
     /* A 128 x 64 lat-long sky, brighter towards the zenith, with a 2 x 2 pixel sun. */
     enum { W = 128, H = 64 };
     static float latlong[W * H * 3];

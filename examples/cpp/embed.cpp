@@ -94,6 +94,9 @@ void print(const char *name, int k, const ppis_sample &s, float pdf) {
 }
 
 int run() {
+    // A library built for x86-64-v3 says which extension this CPU lacks before any other call.
+    if (const char *missing = ppis_missing_cpu_feature())
+        throw std::runtime_error(std::string("this library needs a CPU with ") + missing);
     // The same sky as the C example: brighter towards the zenith, a 2 x 2 pixel sun.
     constexpr int W = 128, H = 64;
     std::vector<float> latlong(W * H * 3);

@@ -475,6 +475,13 @@ ppis_frame ppis_frame_from_normal(ppis_vec3 n);
 // `out` must be valid for writes of `2 × count` doubles.
 ppis_status ppis_sobol02(uint64_t seed, uint32_t first, size_t count, double *out);
 
+// The name of an instruction-set extension this library was built to assume throughout that
+// the CPU it runs on lacks (x86-64 builds of the workspace assume x86-64-v3: AVX2, FMA, BMI2…),
+// as a NUL-terminated static string such as `"avx2"`; NULL where the library runs here. Ask
+// before any other call: on such a CPU any other function may stop the process at an illegal
+// instruction. This one reads CPUID and nothing else.
+const char *ppis_missing_cpu_feature(void);
+
 // The equal-area level that keeps a `width × height` lat-long map's detail.
 uint32_t ppis_equal_area_level(uint32_t width, uint32_t height);
 

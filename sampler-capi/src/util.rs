@@ -2,6 +2,7 @@
 //! lat-long maps resampled into the equal-area square.
 
 use crate::{ppis_frame, ppis_status, ppis_vec3, slice, slice_mut};
+use core::ffi::{CStr, c_char};
 use sampler_core::frame::Frame;
 use sampler_core::glam::{DVec2, Vec3};
 use sampler_core::latlong::{self, LatLongError};
@@ -29,6 +30,16 @@ pub unsafe extern "C" fn ppis_sobol02(seed: u64, first: u32, count: usize, out: 
         }
         Err(e) => e,
     }
+}
+
+/// The name of an instruction-set extension this library was built to assume throughout that
+/// the CPU it runs on lacks (x86-64 builds of the workspace assume x86-64-v3: AVX2, FMA, BMI2…),
+/// as a NUL-terminated static string such as `"avx2"`; NULL where the library runs here. Ask
+/// before any other call: on such a CPU any other function may stop the process at an illegal
+/// instruction. This one reads CPUID and nothing else.
+#[unsafe(no_mangle)]
+pub extern "C" fn ppis_missing_cpu_feature() -> *const c_char {
+    sampler_core::cpu::missing_build_feature().map_or(core::ptr::null(), CStr::as_ptr)
 }
 
 /// The equal-area level that keeps a `width × height` lat-long map's detail.

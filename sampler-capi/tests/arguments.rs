@@ -193,3 +193,10 @@ fn a_thousand_shading_points_allocate_nothing() {
         assert_eq!(COUNT.with(|c| c.get()), 0, "the C ABI allocated");
     }
 }
+
+#[test]
+fn the_library_names_no_missing_extension_on_a_cpu_that_runs_it() {
+    // The tests run, so this CPU runs the build: the answer is NULL; a CPU without an
+    // extension the build assumes is the core's test (`cpu::tests`).
+    assert!(ppis_missing_cpu_feature().is_null());
+}

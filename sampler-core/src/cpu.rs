@@ -7,6 +7,8 @@
 //! that a program can say so before it runs an instruction the CPU does not have.
 
 /// Whether AVX2 instructions may run here: the CPU has them and the OS saves the YMM registers.
+use core::ffi::CStr;
+
 #[cfg(target_arch = "x86_64")]
 #[inline]
 pub(crate) fn has_avx2() -> bool {
@@ -31,9 +33,9 @@ pub(crate) fn has_avx2() -> bool {
 /// An instruction-set extension this build assumes throughout (compiled with it enabled) that
 /// the CPU it runs on lacks, by CPUID; `None` where the build runs here. Asked at run time
 /// whatever the build assumes (`is_x86_feature_detected!` answers from the build where it
-/// assumes the feature).
+/// assumes the feature). The name is NUL-terminated so that the C ABI can hand it out.
 #[must_use]
-pub fn missing_build_feature() -> Option<&'static str> {
+pub fn missing_build_feature() -> Option<&'static CStr> {
     #[cfg(target_arch = "x86_64")]
     {
         first_missing(&build_features(&Cpuid::read()))
@@ -46,7 +48,7 @@ pub fn missing_build_feature() -> Option<&'static str> {
 
 /// The first feature built in (`.1`) that the CPU lacks (`.2` false).
 #[cfg(target_arch = "x86_64")]
-fn first_missing(features: &[(&'static str, bool, bool)]) -> Option<&'static str> {
+fn first_missing(features: &[(&'static CStr, bool, bool)]) -> Option<&'static CStr> {
     features.iter().find(|(_, built, here)| *built && !*here).map(|(name, ..)| *name)
 }
 
@@ -86,27 +88,27 @@ impl Cpuid {
 /// Each extension of x86-64-v2 to v4: its name, whether this build assumes it, whether `cpu`
 /// has it (the AVX families only where the OS saves their registers).
 #[cfg(target_arch = "x86_64")]
-fn build_features(cpu: &Cpuid) -> [(&'static str, bool, bool); 15] {
+fn build_features(cpu: &Cpuid) -> [(&'static CStr, bool, bool); 15] {
     let (c1, b7, e1) = (cpu.leaf1_ecx, cpu.leaf7_ebx, cpu.ext1_ecx);
     let bit = |r: u32, n: u32| r & (1 << n) != 0;
     let ymm = cpu.xcr0 & 0b110 == 0b110;
     let zmm = ymm && cpu.xcr0 & 0b1110_0000 == 0b1110_0000;
     [
-        ("sse3", cfg!(target_feature = "sse3"), bit(c1, 0)),
-        ("ssse3", cfg!(target_feature = "ssse3"), bit(c1, 9)),
-        ("sse4.1", cfg!(target_feature = "sse4.1"), bit(c1, 19)),
-        ("sse4.2", cfg!(target_feature = "sse4.2"), bit(c1, 20)),
-        ("popcnt", cfg!(target_feature = "popcnt"), bit(c1, 23)),
-        ("avx", cfg!(target_feature = "avx"), bit(c1, 28) && ymm),
-        ("f16c", cfg!(target_feature = "f16c"), bit(c1, 29) && ymm),
-        ("fma", cfg!(target_feature = "fma"), bit(c1, 12) && ymm),
-        ("movbe", cfg!(target_feature = "movbe"), bit(c1, 22)),
-        ("avx2", cfg!(target_feature = "avx2"), bit(b7, 5) && ymm),
-        ("bmi1", cfg!(target_feature = "bmi1"), bit(b7, 3)),
-        ("bmi2", cfg!(target_feature = "bmi2"), bit(b7, 8)),
-        ("lzcnt", cfg!(target_feature = "lzcnt"), bit(e1, 5)),
-        ("avx512f", cfg!(target_feature = "avx512f"), bit(b7, 16) && zmm),
-        ("avx512bw", cfg!(target_feature = "avx512bw"), bit(b7, 30) && zmm),
+        (c"sse3", cfg!(target_feature = "sse3"), bit(c1, 0)),
+        (c"ssse3", cfg!(target_feature = "ssse3"), bit(c1, 9)),
+        (c"sse4.1", cfg!(target_feature = "sse4.1"), bit(c1, 19)),
+        (c"sse4.2", cfg!(target_feature = "sse4.2"), bit(c1, 20)),
+        (c"popcnt", cfg!(target_feature = "popcnt"), bit(c1, 23)),
+        (c"avx", cfg!(target_feature = "avx"), bit(c1, 28) && ymm),
+        (c"f16c", cfg!(target_feature = "f16c"), bit(c1, 29) && ymm),
+        (c"fma", cfg!(target_feature = "fma"), bit(c1, 12) && ymm),
+        (c"movbe", cfg!(target_feature = "movbe"), bit(c1, 22)),
+        (c"avx2", cfg!(target_feature = "avx2"), bit(b7, 5) && ymm),
+        (c"bmi1", cfg!(target_feature = "bmi1"), bit(b7, 3)),
+        (c"bmi2", cfg!(target_feature = "bmi2"), bit(b7, 8)),
+        (c"lzcnt", cfg!(target_feature = "lzcnt"), bit(e1, 5)),
+        (c"avx512f", cfg!(target_feature = "avx512f"), bit(b7, 16) && zmm),
+        (c"avx512bw", cfg!(target_feature = "avx512bw"), bit(b7, 30) && zmm),
     ]
 }
 
@@ -145,17 +147,17 @@ mod tests {
 
     #[test]
     fn a_feature_built_in_and_absent_is_named() {
-        let list = [("a", false, false), ("b", true, true), ("c", true, false), ("d", true, false)];
-        assert_eq!(first_missing(&list), Some("c"));
+        let list = [(c"a", false, false), (c"b", true, true), (c"c", true, false), (c"d", true, false)];
+        assert_eq!(first_missing(&list), Some(c"c"));
         assert_eq!(first_missing(&list[..2]), None);
         // A CPU without AVX state saved by the OS has none of the AVX family, whatever CPUID says.
         let cpu = Cpuid { leaf1_ecx: u32::MAX, leaf7_ebx: u32::MAX, ext1_ecx: u32::MAX, xcr0: 0 };
-        let avx2 = build_features(&cpu).into_iter().find(|f| f.0 == "avx2").unwrap();
+        let avx2 = build_features(&cpu).into_iter().find(|f| f.0 == c"avx2").unwrap();
         assert!(!avx2.2);
         let cpu = Cpuid { xcr0: 0b111, ..cpu };
         let here = build_features(&cpu);
-        assert!(here.iter().filter(|f| !f.0.starts_with("avx512")).all(|f| f.2));
-        assert!(here.iter().filter(|f| f.0.starts_with("avx512")).all(|f| !f.2));
+        assert!(here.iter().filter(|f| !f.0.to_bytes().starts_with(b"avx512")).all(|f| f.2));
+        assert!(here.iter().filter(|f| f.0.to_bytes().starts_with(b"avx512")).all(|f| !f.2));
     }
 
     #[test]

@@ -107,6 +107,7 @@ fn main() {
 /// them; it says so in one line instead, before any work.
 fn refuse_a_cpu_the_build_cannot_run_on() {
     if let Some(feature) = sampler_core::cpu::missing_build_feature() {
+        let feature = feature.to_string_lossy();
         eprintln!(
             "ppis: error: this ppis is built for CPUs with {feature} (x86-64-v3: .cargo/config.toml) and this \
              CPU lacks it; build it for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\""
