@@ -479,7 +479,9 @@ ppis_status ppis_sobol02(uint64_t seed, uint32_t first, size_t count, double *ou
 // the CPU it runs on lacks (x86-64 builds of the workspace assume x86-64-v3: AVX2, FMA, BMI2…),
 // as a NUL-terminated static string such as `"avx2"`; NULL where the library runs here. Ask
 // before any other call: on such a CPU any other function may stop the process at an illegal
-// instruction. This one reads CPUID and nothing else.
+// instruction. This one is CPUID and integer arithmetic, but it is compiled like the rest, so
+// the build makes no promise about it: a host that must run on such CPUs builds the library
+// portably instead.
 const char *ppis_missing_cpu_feature(void);
 
 // The equal-area level that keeps a `width × height` lat-long map's detail.

@@ -36,7 +36,9 @@ pub unsafe extern "C" fn ppis_sobol02(seed: u64, first: u32, count: usize, out: 
 /// the CPU it runs on lacks (x86-64 builds of the workspace assume x86-64-v3: AVX2, FMA, BMI2…),
 /// as a NUL-terminated static string such as `"avx2"`; NULL where the library runs here. Ask
 /// before any other call: on such a CPU any other function may stop the process at an illegal
-/// instruction. This one reads CPUID and nothing else.
+/// instruction. This one is CPUID and integer arithmetic, but it is compiled like the rest, so
+/// the build makes no promise about it: a host that must run on such CPUs builds the library
+/// portably instead.
 #[unsafe(no_mangle)]
 pub extern "C" fn ppis_missing_cpu_feature() -> *const c_char {
     sampler_core::cpu::missing_build_feature().map_or(core::ptr::null(), CStr::as_ptr)

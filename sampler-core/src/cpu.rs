@@ -6,9 +6,9 @@
 //! for x86-64-v3, `.cargo/config.toml`); [`missing_build_feature`] names one this CPU lacks, so
 //! that a program can say so before it runs an instruction the CPU does not have.
 
-/// Whether AVX2 instructions may run here: the CPU has them and the OS saves the YMM registers.
 use core::ffi::CStr;
 
+/// Whether AVX2 instructions may run here: the CPU has them and the OS saves the YMM registers.
 #[cfg(target_arch = "x86_64")]
 #[inline]
 pub(crate) fn has_avx2() -> bool {
@@ -52,7 +52,7 @@ fn first_missing(features: &[(&'static CStr, bool, bool)]) -> Option<&'static CS
     features.iter().find(|(_, built, here)| *built && !*here).map(|(name, ..)| *name)
 }
 
-/// The registers of CPUID (and XCR0) that name the extensions of x86-64-v2 to v4.
+/// The registers of CPUID (and XCR0) that name the extensions of the x86-64 levels v2 to v4.
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Default)]
 struct Cpuid {
@@ -85,10 +85,11 @@ impl Cpuid {
     }
 }
 
-/// Each extension of x86-64-v2 to v4: its name, whether this build assumes it, whether `cpu`
-/// has it (the AVX families only where the OS saves their registers).
+/// Each extension the x86-64 levels v2 to v4 add (CMPXCHG16B, LAHF/SAHF and XSAVE aside: every
+/// CPU with the others has them): its name, whether this build assumes it, whether `cpu` has it
+/// (the AVX families only where the OS saves their registers).
 #[cfg(target_arch = "x86_64")]
-fn build_features(cpu: &Cpuid) -> [(&'static CStr, bool, bool); 15] {
+fn build_features(cpu: &Cpuid) -> [(&'static CStr, bool, bool); 18] {
     let (c1, b7, e1) = (cpu.leaf1_ecx, cpu.leaf7_ebx, cpu.ext1_ecx);
     let bit = |r: u32, n: u32| r & (1 << n) != 0;
     let ymm = cpu.xcr0 & 0b110 == 0b110;
@@ -109,25 +110,18 @@ fn build_features(cpu: &Cpuid) -> [(&'static CStr, bool, bool); 15] {
         (c"lzcnt", cfg!(target_feature = "lzcnt"), bit(e1, 5)),
         (c"avx512f", cfg!(target_feature = "avx512f"), bit(b7, 16) && zmm),
         (c"avx512bw", cfg!(target_feature = "avx512bw"), bit(b7, 30) && zmm),
+        (c"avx512cd", cfg!(target_feature = "avx512cd"), bit(b7, 28) && zmm),
+        (c"avx512dq", cfg!(target_feature = "avx512dq"), bit(b7, 17) && zmm),
+        (c"avx512vl", cfg!(target_feature = "avx512vl"), bit(b7, 31) && zmm),
     ]
 }
 
-/// CPUID leaf 1 (AVX, OSXSAVE), XCR0 (XMM and YMM state enabled), leaf 7 (AVX2).
+/// AVX and AVX2 by CPUID, with their registers saved by the OS.
 #[cfg(target_arch = "x86_64")]
 fn detect_avx2() -> bool {
-    use core::arch::x86_64::{__cpuid, __cpuid_count};
-    // CPUID is always available on x86-64 and only reads identification registers.
-    #[allow(unused_unsafe)]
-    let (max_leaf, leaf1) = unsafe { (__cpuid(0).eax, __cpuid(1)) };
-    let (avx, osxsave) = (leaf1.ecx & (1 << 28) != 0, leaf1.ecx & (1 << 27) != 0);
-    if !(avx && osxsave) || max_leaf < 7 {
-        return false;
-    }
-    // SAFETY: OSXSAVE is set, so XGETBV is enabled.
-    let xcr0 = unsafe { xcr0() };
-    #[allow(unused_unsafe)]
-    let leaf7 = unsafe { __cpuid_count(7, 0) };
-    xcr0 & 0b110 == 0b110 && leaf7.ebx & (1 << 5) != 0
+    let here = build_features(&Cpuid::read());
+    let has = |name: &CStr| here.iter().any(|f| f.0 == name && f.2);
+    has(c"avx") && has(c"avx2")
 }
 
 /// The OS-enabled state components (XCR0).
@@ -143,7 +137,7 @@ unsafe fn xcr0() -> u64 {
 
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
-    use super::{Cpuid, build_features, first_missing};
+    use super::{Cpuid, build_features, detect_avx2, first_missing};
 
     #[test]
     fn a_feature_built_in_and_absent_is_named() {
@@ -163,6 +157,18 @@ mod tests {
     #[test]
     fn this_build_runs_here() {
         assert_eq!(super::missing_build_feature(), None);
+    }
+
+    #[test]
+    fn the_run_time_answer_is_the_cpus() {
+        // Under a build that assumes AVX2, std answers from the build: the CPU's answer is
+        // CPUID's, the same registers the feature check reads.
+        let here = build_features(&Cpuid::read());
+        let avx2 = here.iter().find(|f| f.0 == c"avx2").unwrap().2;
+        assert_eq!(detect_avx2(), avx2);
+        if !cfg!(target_feature = "avx2") {
+            assert_eq!(detect_avx2(), std::is_x86_feature_detected!("avx2"));
+        }
     }
 
     #[test]

@@ -104,12 +104,12 @@ fn main() {
 
 /// A build that assumes instruction-set extensions throughout (x86-64 builds assume
 /// x86-64-v3: `.cargo/config.toml`) would stop at its first such instruction on a CPU without
-/// them; it says so in one line instead, before any work.
+/// them; it says so in one line instead, first thing.
 fn refuse_a_cpu_the_build_cannot_run_on() {
     if let Some(feature) = sampler_core::cpu::missing_build_feature() {
         let feature = feature.to_string_lossy();
         eprintln!(
-            "ppis: error: this ppis is built for CPUs with {feature} (x86-64-v3: .cargo/config.toml) and this \
+            "ppis: error: this ppis is built for CPUs with {feature} (`-C target-cpu` in .cargo/config.toml) and this \
              CPU lacks it; build it for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\""
         );
         std::process::exit(2);
