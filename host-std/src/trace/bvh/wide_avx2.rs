@@ -39,16 +39,30 @@ impl NodeRay for RayLanes8 {
 #[inline]
 #[target_feature(enable = "avx2")]
 fn hit8(r: &RayLanes8, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]) {
-    // SAFETY (the loads): every row is eight readable f32s; the loads need no alignment.
-    let row = |plane: usize| unsafe { _mm256_loadu_ps(node.planes[plane].as_ptr()) };
     let mut near = _mm256_setzero_ps();
     let mut far = _mm256_set1_ps(t_max);
     for axis in 0..3 {
-        let lo = row(2 * axis + r.near[axis]);
-        let hi = row(2 * axis + 1 - r.near[axis]);
+        let lo = plane_row(node, 2 * axis + r.near[axis]);
+        let hi = plane_row(node, 2 * axis + 1 - r.near[axis]);
         near = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(lo, r.o[axis]), r.inv[axis]), near);
         far = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(hi, r.o[axis]), r.inv[axis]), far);
     }
+    met(near, far)
+}
+
+/// Plane `plane` of a node's eight boxes in one register.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn plane_row(node: &WideNode, plane: usize) -> __m256 {
+    // SAFETY: every row is eight readable f32s; the load needs no alignment.
+    unsafe { _mm256_loadu_ps(node.planes[plane].as_ptr()) }
+}
+
+/// A node test's answer from its lanes' entry and exit distances: the children met (near ≤
+/// far) and the entry distances.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn met(near: __m256, far: __m256) -> (u32, [f32; WIDTH]) {
     let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(near, far)) as u32;
     let mut out = [0.0; WIDTH];
     // SAFETY: `out` is eight writable f32s; the store needs no alignment.

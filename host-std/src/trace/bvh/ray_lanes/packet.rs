@@ -24,6 +24,7 @@ use crate::trace::bvh::Bvh;
 use crate::trace::bvh::leaf::LanePrim;
 use crate::trace::bvh::traverse::closest;
 use crate::trace::bvh::wide::{NodeRay, WIDTH, WideNode, near_planes};
+use crate::trace::bvh::wide_avx2::{met, plane_row};
 use core::arch::x86_64::*;
 use sampler_core::glam::Vec3;
 
@@ -68,8 +69,7 @@ impl NodeRay for PacketBoxes {
 #[inline]
 #[target_feature(enable = "avx2")]
 fn packet_hit(p: &PacketBoxes, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]) {
-    // SAFETY (the loads): every row is eight readable f32s; the loads need no alignment.
-    let row = |plane: usize| unsafe { _mm256_loadu_ps(node.planes[plane].as_ptr()) };
+    let row = |plane: usize| plane_row(node, plane);
     let mut near = _mm256_setzero_ps();
     let mut far = _mm256_set1_ps(t_max);
     for axis in 0..3 {
@@ -80,11 +80,7 @@ fn packet_hit(p: &PacketBoxes, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH
         let (a, b) = (_mm256_mul_ps(to_far, p.inv_lo[axis]), _mm256_mul_ps(to_far, p.inv_hi[axis]));
         far = _mm256_min_ps(_mm256_max_ps(a, b), far);
     }
-    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(near, far)) as u32;
-    let mut out = [0.0; WIDTH];
-    // SAFETY: `out` is eight writable f32s; the store needs no alignment.
-    unsafe { _mm256_storeu_ps(out.as_mut_ptr(), near) };
-    (mask, out)
+    met(near, far)
 }
 
 /// The nearest hits of eight rays from `o` along `dirs` in (`t_min`, ∞) through `bvh`'s tree:
