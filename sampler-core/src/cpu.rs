@@ -8,13 +8,19 @@
 
 use core::ffi::CStr;
 
-/// Whether AVX2 instructions may run here: the CPU has them and the OS saves the YMM registers.
+/// Whether the paths that choose between AVX2 and portable code take AVX2: the CPU has it,
+/// the OS saves the YMM registers, and [`use_portable_paths`] was not called. Both forms
+/// compute the same results, bit for bit.
 #[cfg(target_arch = "x86_64")]
 #[inline]
-pub(crate) fn has_avx2() -> bool {
+#[must_use]
+pub fn has_avx2() -> bool {
     use core::sync::atomic::{AtomicU8, Ordering};
     /// 0: not asked yet; 1: no; 2: yes.
     static ANSWER: AtomicU8 = AtomicU8::new(0);
+    if PORTABLE.load(Ordering::Relaxed) {
+        return false;
+    }
     // A build that assumes AVX2 throughout runs only where it is: no question to ask.
     if cfg!(target_feature = "avx2") {
         return true;
@@ -28,6 +34,21 @@ pub(crate) fn has_avx2() -> bool {
             yes
         }
     }
+}
+
+/// Set once the portable paths are asked for.
+#[cfg(target_arch = "x86_64")]
+static PORTABLE: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+
+/// From now on in this process, every choice between an AVX2 path and a portable one (see
+/// [`has_avx2`]) takes the portable one, as on a CPU without AVX2; what was built before (a
+/// host's ray-tracing hierarchy, say) keeps the paths it chose. For tests and comparisons:
+/// the two forms are meant to give the same bits, and this is how a machine with AVX2 checks
+/// the other. The code the build compiles with its own instruction set (`-C target-cpu`) is
+/// not affected. A no-op off x86-64.
+pub fn use_portable_paths() {
+    #[cfg(target_arch = "x86_64")]
+    PORTABLE.store(true, core::sync::atomic::Ordering::Relaxed);
 }
 
 /// An instruction-set extension this build assumes throughout (compiled with it enabled) that

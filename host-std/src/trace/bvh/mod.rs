@@ -100,7 +100,8 @@ pub struct Bvh {
     /// disk is beside it and the CPU has AVX2.
     #[cfg(target_arch = "x86_64")]
     lanes: Option<ray_lanes::LoneLeaf>,
-    /// Whether the CPU has AVX2: rays then test a node's eight boxes in one register.
+    /// Whether rays take the AVX2 paths (`sampler_core::cpu::has_avx2`): they then test a
+    /// node's eight boxes in one register.
     #[cfg(target_arch = "x86_64")]
     avx2: bool,
 }
@@ -114,7 +115,7 @@ impl Bvh {
         let (nodes, blocks) = wide::collapse(&binary, &prims);
         let lone_leaf = wide::lone_leaf(&nodes);
         #[cfg(target_arch = "x86_64")]
-        let avx2 = std::is_x86_feature_detected!("avx2");
+        let avx2 = sampler_core::cpu::has_avx2();
         #[cfg(target_arch = "x86_64")]
         let lanes = lone_leaf
             .filter(|_| disks.is_empty() && avx2)
