@@ -13,7 +13,6 @@
 //! `f32::MAX`) take the f64 step.
 
 use super::EnvHierarchy;
-use super::pyramid::level_offset;
 use crate::cell::Cell;
 use crate::prefetch::prefetch;
 use crate::warp::{choose_child_branchless, choose_grandchild_branchless, grandchild_index};
@@ -178,14 +177,12 @@ impl EnvHierarchy<'_> {
     pub(super) fn warp_down_f32(&self, xi: &mut Vec2) -> Option<Cell> {
         let (mut cell, mut m) = (Cell::ROOT, 0usize);
         while cell.level + 2 <= self.finest {
-            let base = level_offset(cell.level + 2) + 16 * m;
-            let g: &[f32; 16] = self.pyramid[base..base + 16].try_into().ok()?;
+            let g: &[f32; 16] = self.nodes_below(cell.level, m).try_into().ok()?;
             let (c, gx, gy) = choose_grandchild_f32_branching(g, xi)?;
             (cell, m) = (cell.grandchild(gx, gy), 16 * m + c);
         }
         if cell.level < self.finest {
-            let base = level_offset(cell.level + 1) + 4 * m;
-            let q = &self.pyramid[base..base + 4];
+            let q = self.nodes_below(cell.level, m);
             cell = cell.child(choose_child_f32([q[0], q[1], q[2], q[3]], xi)?);
         }
         Some(cell)
@@ -208,12 +205,12 @@ impl EnvHierarchy<'_> {
     pub(super) fn descend_f32_scalar(&self, lanes: &mut [DescentF32]) {
         loop {
             for lane in lanes.iter().filter(|l| l.alive && l.cell.level < self.finest) {
-                prefetch(self.next_nodes_f32(lane));
+                prefetch(self.nodes_below(lane.cell.level, lane.morton));
             }
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.alive && l.cell.level < self.finest) {
                 busy = true;
-                let nodes = self.next_nodes_f32(lane);
+                let nodes = self.nodes_below(lane.cell.level, lane.morton);
                 if let Ok(g) = <&[f32; 16]>::try_from(nodes) {
                     match choose_grandchild_f32(g, &mut lane.xi) {
                         Some((c, gx, gy)) => {
@@ -231,19 +228,6 @@ impl EnvHierarchy<'_> {
             if !busy {
                 return;
             }
-        }
-    }
-
-    /// The nodes a descent above the finest level chooses among next: its sixteen
-    /// grandchildren, or its four children one level above the finest.
-    #[inline(always)]
-    fn next_nodes_f32(&self, lane: &DescentF32) -> &[f32] {
-        if lane.cell.level + 2 <= self.finest {
-            let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
-            &self.pyramid[base..base + 16]
-        } else {
-            let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
-            &self.pyramid[base..base + 4]
         }
     }
 }

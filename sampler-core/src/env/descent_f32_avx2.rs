@@ -331,22 +331,6 @@ mod tests {
     use std::vec;
     use std::vec::Vec;
 
-    /// Maps with every kind of mass: smooth, zeros in rows and columns, a 1e7× texel, a
-    /// denormal-sized one, a single texel, masses near `f32::MAX`, none.
-    fn maps(level: u32) -> Vec<Vec<[f32; 3]>> {
-        let n = 1usize << (2 * level);
-        let smooth: Vec<[f32; 3]> = (0..n).map(|i| [(i * 7 % 13) as f32 + 0.5, (i % 3) as f32, 1.0]).collect();
-        let mut holes = smooth.clone();
-        holes.iter_mut().enumerate().filter(|(i, _)| i % 5 < 2 || (i / 7) % 3 == 0).for_each(|(_, t)| *t = [0.0; 3]);
-        let mut sun = smooth.clone();
-        sun[n / 3] = [1e7; 3];
-        sun[n / 2] = [1e-38; 3];
-        let mut lone = vec![[0.0f32; 3]; n];
-        lone[n - 1] = [2.0; 3];
-        let huge: Vec<[f32; 3]> = (0..n).map(|i| [3e38 * ((i % 4) as f32 / 4.0); 3]).collect();
-        vec![smooth, holes, sun, lone, huge, vec![[0.0f32; 3]; n]]
-    }
-
     #[test]
     fn eight_lanes_in_a_register_descend_as_the_scalar_lanes() {
         if !crate::cpu::has_avx2() {
@@ -354,7 +338,7 @@ mod tests {
             return;
         }
         for level in [1u32, 2, 4, 5, 7] {
-            for rgb in maps(level) {
+            for rgb in super::super::test_maps::maps(level) {
                 let mut p = vec![0.0f32; pyramid_len(level)];
                 build_pyramid(level, &rgb, &mut p).unwrap();
                 let env = EnvHierarchy::new(level, &p, &rgb).unwrap();

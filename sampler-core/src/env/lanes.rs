@@ -123,19 +123,19 @@ impl EnvHierarchy<'_> {
         loop {
             // Every lane's next node first, so that their loads are in flight together.
             for lane in lanes.iter().filter(|l| l.alive && l.cell.level < self.finest) {
-                prefetch(self.next_nodes(lane));
+                prefetch(self.nodes_below(lane.cell.level, lane.morton));
             }
             let mut busy = false;
             for lane in lanes.iter_mut().filter(|l| l.alive && l.cell.level < self.finest) {
                 busy = true;
                 if lane.cell.level + 2 <= self.finest {
-                    let g: &[f32; 16] = self.next_nodes(lane).try_into().unwrap();
+                    let g: &[f32; 16] = self.nodes_below(lane.cell.level, lane.morton).try_into().unwrap();
                     match choose_grandchild_branchless(g, &mut lane.xi) {
                         Some((c, gx, gy)) => lane.step(2, gx, gy, c),
                         None => lane.alive = false,
                     }
                 } else {
-                    let q = self.next_nodes(lane);
+                    let q = self.nodes_below(lane.cell.level, lane.morton);
                     match choose_child([q[0], q[1], q[2], q[3]], &mut lane.xi) {
                         Some(c) => {
                             let (dx, dy) = child_offset(c);
@@ -151,15 +151,15 @@ impl EnvHierarchy<'_> {
         }
     }
 
-    /// The nodes a lane above the finest level chooses among next: its sixteen grandchildren,
-    /// or its four children one level above the finest.
+    /// The nodes a descent at node `morton` of `level`, above the finest level, chooses among
+    /// next: its sixteen grandchildren, or its four children one level above the finest.
     #[inline(always)]
-    fn next_nodes(&self, lane: &WarpLane) -> &[f32] {
-        if lane.cell.level + 2 <= self.finest {
-            let base = level_offset(lane.cell.level + 2) + 16 * lane.morton;
+    pub(super) fn nodes_below(&self, level: u32, morton: usize) -> &[f32] {
+        if level + 2 <= self.finest {
+            let base = level_offset(level + 2) + 16 * morton;
             &self.pyramid[base..base + 16]
         } else {
-            let base = level_offset(lane.cell.level + 1) + 4 * lane.morton;
+            let base = level_offset(level + 1) + 4 * morton;
             &self.pyramid[base..base + 4]
         }
     }

@@ -38,6 +38,8 @@ mod mis_heuristic;
 mod plane;
 mod pyramid;
 mod sample;
+#[cfg(test)]
+mod test_maps;
 mod texel_cdf;
 
 pub use compensation::compensate_pyramid;
