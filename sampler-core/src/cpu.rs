@@ -41,7 +41,7 @@ pub fn has_avx2() -> bool {
 static PORTABLE: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
 
 /// From now on in this process, every choice between an AVX2 path and a portable one (see
-/// [`has_avx2`]) takes the portable one, as on a CPU without AVX2; what was built before (a
+/// `has_avx2`) takes the portable one, as on a CPU without AVX2; what was built before (a
 /// host's ray-tracing hierarchy, say) keeps the paths it chose. For tests and comparisons:
 /// the two forms are meant to give the same bits, and this is how a machine with AVX2 checks
 /// the other. The code the build compiles with its own instruction set (`-C target-cpu`) is

@@ -3,6 +3,7 @@
 #[path = "../image_cases/mod.rs"]
 mod image_cases;
 
+// `image_cases` reaches the shared scenes as `super::common`.
 use crate::common;
 use image_cases::{EXPECTED, cases};
 

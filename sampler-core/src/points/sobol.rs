@@ -2,7 +2,7 @@
 //! each point to the next, with Owen scrambling by hashing ([`Sobol02`]) or a digital shift
 //! ([`sobol02_shifted`]).
 
-use super::sobol_x4::scrambled_four;
+use super::sobol_x4::Fours;
 use crate::rng::hash_combine;
 use glam::{DVec2, Vec2};
 
@@ -169,6 +169,7 @@ impl Sobol02 {
         let mut y_reversed = dim1_reversed(first);
         let mut i = first;
         let (fours, rest) = out.as_chunks_mut::<4>();
+        let form = Fours::new();
         for four in fours {
             // The first dimension is the index with its bits reversed, so reversed it is the
             // index; the second steps from each point to the next.
@@ -177,7 +178,7 @@ impl Sobol02 {
                 y_reversed ^= SOBOL_DIM1_STEPS_REVERSED[i.wrapping_add(k as u32).trailing_ones() as usize];
                 y
             });
-            scrambled_four(i, ys, seeds, four);
+            form.scrambled(i, ys, seeds, four);
             i = i.wrapping_add(4);
         }
         for (p, q) in rest.iter_mut().zip(self.points(i)) {

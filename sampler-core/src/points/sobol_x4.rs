@@ -6,21 +6,40 @@
 use super::sobol::{INV_2_32, scramble_reversed};
 use glam::DVec2;
 
-/// The points whose dimension-0 points reversed are `i, i + 1, i + 2, i + 3` (wrapping) and
-/// whose dimension-1 points reversed are `y_reversed`, Owen-scrambled with seeds `s0`, `s1`,
-/// into `out`.
-#[inline]
-pub(super) fn scrambled_four(i: u32, y_reversed: [u32; 4], (s0, s1): (u32, u32), out: &mut [DVec2; 4]) {
+/// Which form of the four-point hash a batch of points takes, asked once per batch (the
+/// register form where [`has_avx2`](crate::cpu::has_avx2) says so, else the scalar one).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Fours {
     #[cfg(target_arch = "x86_64")]
-    if crate::cpu::has_avx2() {
-        // SAFETY: AVX2 is available (checked above).
-        unsafe { avx2::scrambled_four(i, y_reversed, (s0, s1), out) };
-        return;
-    }
-    *out = scalar(i, y_reversed, (s0, s1));
+    avx2: bool,
 }
 
-/// [`scrambled_four`] one point at a time: the reference the register path reproduces.
+impl Fours {
+    /// The form this CPU (and the process's choice of paths) takes now.
+    #[inline]
+    pub(super) fn new() -> Self {
+        Self {
+            #[cfg(target_arch = "x86_64")]
+            avx2: crate::cpu::has_avx2(),
+        }
+    }
+
+    /// The points whose dimension-0 points reversed are `i, i + 1, i + 2, i + 3` (wrapping) and
+    /// whose dimension-1 points reversed are `y_reversed`, Owen-scrambled with seeds `s0`,
+    /// `s1`, into `out`.
+    #[inline]
+    pub(super) fn scrambled(self, i: u32, y_reversed: [u32; 4], (s0, s1): (u32, u32), out: &mut [DVec2; 4]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where `has_avx2` says the CPU has AVX2.
+            unsafe { avx2::scrambled_four(i, y_reversed, (s0, s1), out) };
+            return;
+        }
+        *out = scalar(i, y_reversed, (s0, s1));
+    }
+}
+
+/// [`Fours::scrambled`] one point at a time: the reference the register path reproduces.
 #[inline]
 fn scalar(i: u32, y_reversed: [u32; 4], (s0, s1): (u32, u32)) -> [DVec2; 4] {
     core::array::from_fn(|k| {
@@ -36,7 +55,7 @@ mod avx2 {
     use core::arch::x86_64::*;
     use glam::DVec2;
 
-    /// [`scrambled_four`](super::scrambled_four): lanes 0–3 dimension 0, lanes 4–7 dimension 1.
+    /// [`Fours::scrambled`](super::Fours::scrambled) in AVX2: lanes 0–3 dimension 0, lanes 4–7 dimension 1.
     ///
     /// # Safety
     /// The CPU must have AVX2.
@@ -110,7 +129,7 @@ mod tests {
             let y = [rng.next_u32(), rng.next_u32(), rng.next_u32(), rng.next_u32()];
             let seeds = (rng.next_u32(), rng.next_u32());
             let mut a = [DVec2::ZERO; 4];
-            scrambled_four(i, y, seeds, &mut a);
+            Fours::new().scrambled(i, y, seeds, &mut a);
             let b = scalar(i, y, seeds);
             assert_eq!(a, b, "{i} {y:?} {seeds:?}");
         }
