@@ -15,30 +15,29 @@ use core::ffi::CStr;
 #[inline]
 #[must_use]
 pub fn has_avx2() -> bool {
-    use core::sync::atomic::{AtomicU8, Ordering};
-    /// 0: not asked yet; 1: no; 2: yes.
-    static ANSWER: AtomicU8 = AtomicU8::new(0);
-    if PORTABLE.load(Ordering::Relaxed) {
-        return false;
-    }
-    // A build that assumes AVX2 throughout runs only where it is: no question to ask.
-    if cfg!(target_feature = "avx2") {
-        return true;
-    }
-    match ANSWER.load(Ordering::Relaxed) {
-        1 => false,
-        2 => true,
+    use core::sync::atomic::Ordering;
+    match AVX2.load(Ordering::Relaxed) {
+        NO => false,
+        YES => true,
         _ => {
-            let yes = detect_avx2();
-            ANSWER.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
-            yes
+            // A build that assumes AVX2 throughout runs only where it is: no question to ask.
+            let yes = cfg!(target_feature = "avx2") || detect_avx2();
+            // Only where nothing was stored meanwhile: `use_portable_paths` keeps its answer.
+            let _ = AVX2.compare_exchange(UNASKED, if yes { YES } else { NO }, Ordering::Relaxed, Ordering::Relaxed);
+            AVX2.load(Ordering::Relaxed) == YES
         }
     }
 }
 
-/// Set once the portable paths are asked for.
+/// The answer [`has_avx2`] gives: not asked yet, no, or yes.
 #[cfg(target_arch = "x86_64")]
-static PORTABLE: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+static AVX2: core::sync::atomic::AtomicU8 = core::sync::atomic::AtomicU8::new(UNASKED);
+#[cfg(target_arch = "x86_64")]
+const UNASKED: u8 = 0;
+#[cfg(target_arch = "x86_64")]
+const NO: u8 = 1;
+#[cfg(target_arch = "x86_64")]
+const YES: u8 = 2;
 
 /// From now on in this process, every choice between an AVX2 path and a portable one (see
 /// `has_avx2`) takes the portable one, as on a CPU without AVX2; what was built before (a
@@ -48,7 +47,7 @@ static PORTABLE: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool
 /// not affected. A no-op off x86-64.
 pub fn use_portable_paths() {
     #[cfg(target_arch = "x86_64")]
-    PORTABLE.store(true, core::sync::atomic::Ordering::Relaxed);
+    AVX2.store(NO, core::sync::atomic::Ordering::Relaxed);
 }
 
 /// An instruction-set extension this build assumes throughout (compiled with it enabled) that
