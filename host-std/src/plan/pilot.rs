@@ -105,7 +105,7 @@ pub const PILOT_SHADING_POINT_DIVISOR: usize = 4;
 const MIN_PILOT_SHADING_POINTS: usize = 4;
 
 /// Pixels looked at (centre rays) to find each material's pilot pixels.
-const MAX_SCANNED: usize = 1 << 14;
+pub(crate) const MAX_SCANNED: usize = 1 << 14;
 
 /// What the pilot measured for one material.
 #[derive(Clone, Debug)]
@@ -158,16 +158,20 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
 /// One material's pilot: its candidates' pixel pairs, per candidate (index into [`PLANS`]).
 type Measured = Vec<(usize, Vec<[[f64; 3]; 2]>)>;
 
-/// Runs the pilot on the render `ctx` (whose plans are the rules') and returns the plans (one
-/// per material; the rules' where a material has too few pixels to measure) and what was
-/// measured.
+/// Runs the pilot on the render `ctx` (whose plans are the rules') over each material's
+/// `pixels` ([`material_pixels`]) and returns the plans (one per material; the rules' where a
+/// material has too few pixels to measure), what was measured, and the pilot's cost in pixels
+/// of the render under MIS.
 pub(crate) fn choose(
     ctx: &Context<'_, '_>,
     env: &EnvHierarchy<'_>,
     env_peak: f32,
-) -> (Vec<MaterialPlan>, Vec<PilotResult>) {
+    pixels: &[Vec<(usize, usize)>],
+) -> (Vec<MaterialPlan>, Vec<PilotResult>, f64) {
     let defaults = ctx.plans;
-    let Some((found, tasks)) = pilot_tasks(ctx, env_peak) else { return (defaults.to_vec(), Vec::new()) };
+    let Some((found, tasks, spent)) = pilot_tasks(ctx, env_peak, pixels) else {
+        return (defaults.to_vec(), Vec::new(), 0.0);
+    };
     // The two-level candidates read the cell cones, which the rules' plans do not build.
     let env_budget = budgets(ctx).0;
     let plan =
@@ -194,18 +198,16 @@ pub(crate) fn choose(
         let scores = scores.iter().map(|s| s.as_ref().map(|s| s.value)).collect();
         results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
     }
-    (plans, results)
+    (plans, results, spent)
 }
 
-/// Each material's pilot pixels, and every (material, candidate) to measure; `None` when the
-/// pilot would cost more than [`MAX_PILOT_SHARE`] of the render.
-#[allow(clippy::type_complexity)]
-fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, usize)>>, Vec<(usize, usize)>)> {
+/// Each material's pixels among up to [`MAX_SCANNED`] of the image's (their centre rays' hits),
+/// in a fixed pseudo-random order over the image: the pilot's pixels, and the materials'
+/// shares of the image.
+pub(crate) fn material_pixels(ctx: &Context<'_, '_>) -> Vec<Vec<(usize, usize)>> {
     let camera = ctx.camera;
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let materials = ctx.scene.materials.len();
-    // Each material's pixels, in a fixed pseudo-random order over the image.
-    let mut found: Vec<Vec<(usize, usize)>> = vec![Vec::new(); materials];
+    let mut found: Vec<Vec<(usize, usize)>> = vec![Vec::new(); ctx.scene.materials.len()];
     let n = w * h;
     let order_seed = hash_combine(ctx.options.seed, 0x9170) as u32;
     for k in 0..n.min(MAX_SCANNED) {
@@ -217,11 +219,26 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
             found[material].push((x, y));
         }
     }
+    found
+}
+
+/// Each material's pilot pixels (the first of its `pixels`), every (material, candidate) to
+/// measure, and their cost in pixels of the render under MIS; `None` when the pilot would cost
+/// more than [`MAX_PILOT_SHARE`] of the render.
+#[allow(clippy::type_complexity)]
+fn pilot_tasks(
+    ctx: &Context<'_, '_>,
+    env_peak: f32,
+    pixels: &[Vec<(usize, usize)>],
+) -> Option<(Vec<Vec<(usize, usize)>>, Vec<(usize, usize)>, f64)> {
+    let (w, h) = (ctx.camera.width as usize, ctx.camera.height as usize);
+    let materials = ctx.scene.materials.len();
+    let n = w * h;
     // Every (material, candidate) to measure, and the cost of one pilot pixel of all of them,
     // twice.
     let v = samples_per_point(ctx.options);
     let tasks: Vec<(usize, usize)> = (0..materials)
-        .filter(|&m| found[m].len() >= MIN_PIXELS && ctx.plans[m].strategy != Strategy::PlaneProduct)
+        .filter(|&m| pixels[m].len() >= MIN_PIXELS && ctx.plans[m].strategy != Strategy::PlaneProduct)
         .flat_map(|m| {
             let bsdf = &ctx.scene.materials[m].bsdf;
             (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))
@@ -234,10 +251,8 @@ fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32) -> Option<(Vec<Vec<(usize, 
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
         return None;
     }
-    for f in &mut found {
-        f.truncate(per_material);
-    }
-    Some((found, tasks))
+    let found = pixels.iter().map(|f| f[..f.len().min(per_material)].to_vec()).collect();
+    Some((found, tasks, per_material as f64 * cost_per_pixel))
 }
 
 /// Renders every task's pixels twice, in parallel, and returns per task its pixel pairs, in a

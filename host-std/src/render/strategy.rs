@@ -94,7 +94,8 @@ pub struct MaterialPlan {
     /// BRDF samples its product samplers are built from.
     pub brdf_samples: usize,
     /// Visibility samples from the environment per shading point where the plan sets its own
-    /// (`auto`: fewer for a plan that costs more per sample, `plan::candidates`); `None`: the
+    /// (`auto`: fewer for a plan that costs more per sample, `plan::candidates`; more for one
+    /// that costs no more than MIS where other materials' plans do, `plan::pace`); `None`: the
     /// render's.
     pub env_budget: Option<usize>,
 }

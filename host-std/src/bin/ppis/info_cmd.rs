@@ -9,6 +9,7 @@ use anyhow::bail;
 use clap::Args;
 use host_std::light::environment::EnvSource;
 use host_std::plan::Method;
+use host_std::plan::pace::MAX_SLOWDOWN;
 use host_std::plan::pilot::{self, MAX_PILOT_SHARE, MAX_PIXELS, MIN_PIXELS, OVERRIDE_MARGIN, PILOT_SHARE, PLANS};
 use host_std::plan::pilot::{COSTLIER_OVERRIDE_MARGIN, SEPARATION};
 use host_std::plan::rules::{
@@ -145,12 +146,13 @@ fn sampling_summary() -> String {
     }
     let last = candidates.pop().unwrap_or_default();
     format!(
-        "product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {WIDE_LOBE_PRODUCT_SHARE} of its samples from the product on GGX conductors with α ≥ {WIDE_LOBE} when the map's peak is under {SUN_PEAK}, half elsewhere), two-level-mis (per pixel and material, reused likewise), plane-product (per normal of a diffuse material's flat objects, on first use); auto = plane-product on diffuse materials whose objects are all flat when the map's peak is under {SUN_PEAK}, product-mis on GGX conductors with α in {PRODUCT_ALPHA:?} ({PRODUCT_ALPHA_EXTENDED:?} when the map's peak is under {SUN_PEAK}: no sun), mis on the other materials ({AUTO_DIFFUSE_ENV_SHARE} of it env samples on diffuse surfaces when the peak is under {SUN_PEAK}), or BRDF sampling when the lighting is smooth (peak < {SMOOTH_LIGHTING_PEAK}) — then checked per material by a pilot render of {MIN_PIXELS}–{MAX_PIXELS} of its pixels with the candidate plans {} and {last} (those whose sample weights are bounded there, the two MIS methods at the rules' splits; of {} plans in all: {}), each at about MIS's cost per shading point (fewer samples for a costlier plan), which replaces the rule's plan where another measures {OVERRIDE_MARGIN}× better ({COSTLIER_OVERRIDE_MARGIN}× where it costs more per sample) and by {SEPARATION} standard errors (about {}% of the render, at most {}%: with fewer than {MIN_PIXELS} pixels per material within that, the rules decide alone)",
+        "product samplers for methods product and wavelet (per shading point), product-mis (per pixel and material, reused by nearby pixels; {WIDE_LOBE_PRODUCT_SHARE} of its samples from the product on GGX conductors with α ≥ {WIDE_LOBE} when the map's peak is under {SUN_PEAK}, half elsewhere), two-level-mis (per pixel and material, reused likewise), plane-product (per normal of a diffuse material's flat objects, on first use); auto = plane-product on diffuse materials whose objects are all flat when the map's peak is under {SUN_PEAK}, product-mis on GGX conductors with α in {PRODUCT_ALPHA:?} ({PRODUCT_ALPHA_EXTENDED:?} when the map's peak is under {SUN_PEAK}: no sun), mis on the other materials ({AUTO_DIFFUSE_ENV_SHARE} of it env samples on diffuse surfaces when the peak is under {SUN_PEAK}), or BRDF sampling when the lighting is smooth (peak < {SMOOTH_LIGHTING_PEAK}) — then checked per material by a pilot render of {MIN_PIXELS}–{MAX_PIXELS} of its pixels with the candidate plans {} and {last} (those whose sample weights are bounded there, the two MIS methods at the rules' splits; of {} plans in all: {}), each at about MIS's cost per shading point (fewer samples for a costlier plan), which replaces the rule's plan where another measures {OVERRIDE_MARGIN}× better ({COSTLIER_OVERRIDE_MARGIN}× where it costs more per sample) and by {SEPARATION} standard errors (about {}% of the render, at most {}%: with fewer than {MIN_PIXELS} pixels per material within that, the rules decide alone); the materials left at plain MIS's cost or below then take more samples where the others' plans make the image costlier, as long as that slows it by at most {}%",
         candidates.join(", "),
         PLANS.len(),
         (0..PLANS.len()).map(pilot::plan_name).collect::<Vec<_>>().join(", "),
         PILOT_SHARE * 100.0,
         MAX_PILOT_SHARE * 100.0,
+        ((MAX_SLOWDOWN - 1.0) * 100.0).round(),
     )
 }
 
