@@ -23,7 +23,6 @@ use crate::cpu_time::{cpu_seconds_since, process_cpu_time};
 use crate::light::baselines::{LightcutTable, sis_strata};
 use crate::light::lights::{LightOptions, LightTable};
 use crate::light::map_buffer::MapBuffer;
-use crate::plan::time_model::PLANE_BUILD_COST;
 use crate::render::brdf_samples::BrdfSamples;
 use crate::render::crop::Crop;
 use crate::render::plane_products::{PlaneProducts, on_planes_only};
@@ -241,14 +240,8 @@ pub fn render_crop(
     let cpu_start = process_cpu_time();
     let (chosen, pilot) = match (settings.method, env) {
         (Method::Auto, Some(e)) => {
-            let pixels = pilot::material_pixels(&ctx);
-            let (chosen, measured, pilot_cost) = pilot::choose(&ctx, e, env_peak, &pixels);
-            let shares: Vec<usize> = pixels.iter().map(Vec::len).collect();
-            let costs = pace::FixedCosts {
-                plane_build: plane_build_share(&ctx, e, &chosen, &shares),
-                pilot: pilot_cost / hit_pixels(&ctx, &shares).max(1.0),
-            };
-            (Some(pace::keep_pace(&chosen, &shares, budgets(&ctx).0, costs)), measured)
+            let (chosen, measured) = pace::auto_plans(&ctx, e, env_peak);
+            (Some(chosen), measured)
         }
         _ => (None, Vec::new()),
     };
@@ -283,25 +276,4 @@ pub fn render_crop(
         pilot_seconds,
         auto_plans,
     }
-}
-
-/// The frame's pixels whose centre rays meet a surface, from each material's hits among the
-/// scanned pixels (`shares`).
-fn hit_pixels(ctx: &Context<'_, '_>, shares: &[usize]) -> f64 {
-    let frame = ctx.camera.width as usize * ctx.camera.height as usize;
-    let scanned = frame.clamp(1, pilot::MAX_SCANNED);
-    shares.iter().sum::<usize>() as f64 * frame as f64 / scanned as f64
-}
-
-/// The plane pyramids' build over the time MIS takes for the pixels of the plane product's
-/// materials (`shares`: each material's hits among the scanned pixels), where `plans` sample
-/// one: one side of each plane is seen and built, [`PLANE_BUILD_COST`] MIS samples per texel.
-fn plane_build_share(ctx: &Context<'_, '_>, env: &EnvHierarchy<'_>, plans: &[MaterialPlan], shares: &[usize]) -> f64 {
-    let Some(planes) = ctx.planes else { return 0.0 };
-    let on_planes: Vec<usize> =
-        plans.iter().zip(shares).map(|(p, &n)| if p.strategy == Strategy::PlaneProduct { n } else { 0 }).collect();
-    let samples = hit_pixels(ctx, &on_planes) * ctx.options.spp as f64;
-    let texels = (1u64 << (2 * env.finest_level())) as f64;
-    let build = planes.len().div_ceil(2) as f64 * texels * PLANE_BUILD_COST;
-    if samples > 0.0 { build / samples } else { 0.0 }
 }

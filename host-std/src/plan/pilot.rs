@@ -158,19 +158,27 @@ pub fn eligible(c: usize, bsdf: &Bsdf, env_peak: f32) -> bool {
 /// One material's pilot: its candidates' pixel pairs, per candidate (index into [`PLANS`]).
 type Measured = Vec<(usize, Vec<[[f64; 3]; 2]>)>;
 
+/// What the pilot chose and what it took.
+pub(crate) struct Choice {
+    /// One plan per material: the rules' where a material has too few pixels to measure.
+    pub plans: Vec<MaterialPlan>,
+    /// What was measured, per material measured.
+    pub results: Vec<PilotResult>,
+    /// The pilot's work in pixels of the render under MIS, by [`PLANS`]' weights.
+    pub cost: f64,
+}
+
 /// Runs the pilot on the render `ctx` (whose plans are the rules') over each material's
-/// `pixels` ([`material_pixels`]) and returns the plans (one per material; the rules' where a
-/// material has too few pixels to measure), what was measured, and the pilot's cost in pixels
-/// of the render under MIS.
+/// `scanned` pixels ([`material_pixels`]).
 pub(crate) fn choose(
     ctx: &Context<'_, '_>,
     env: &EnvHierarchy<'_>,
     env_peak: f32,
-    pixels: &[Vec<(usize, usize)>],
-) -> (Vec<MaterialPlan>, Vec<PilotResult>, f64) {
+    scanned: &[Vec<(usize, usize)>],
+) -> Choice {
     let defaults = ctx.plans;
-    let Some((found, tasks, spent)) = pilot_tasks(ctx, env_peak, pixels) else {
-        return (defaults.to_vec(), Vec::new(), 0.0);
+    let Some(Tasks { pixels: found, tasks, cost }) = pilot_tasks(ctx, env_peak, scanned) else {
+        return Choice { plans: defaults.to_vec(), results: Vec::new(), cost: 0.0 };
     };
     // The two-level candidates read the cell cones, which the rules' plans do not build.
     let env_budget = budgets(ctx).0;
@@ -198,7 +206,7 @@ pub(crate) fn choose(
         let scores = scores.iter().map(|s| s.as_ref().map(|s| s.value)).collect();
         results.push(PilotResult { material: m, pixels: pixels.len(), scores, chosen, rule });
     }
-    (plans, results, spent)
+    Choice { plans, results, cost }
 }
 
 /// Each material's pixels among up to [`MAX_SCANNED`] of the image's (their centre rays' hits),
@@ -222,15 +230,19 @@ pub(crate) fn material_pixels(ctx: &Context<'_, '_>) -> Vec<Vec<(usize, usize)>>
     found
 }
 
-/// Each material's pilot pixels (the first of its `pixels`), every (material, candidate) to
-/// measure, and their cost in pixels of the render under MIS; `None` when the pilot would cost
-/// more than [`MAX_PILOT_SHARE`] of the render.
-#[allow(clippy::type_complexity)]
-fn pilot_tasks(
-    ctx: &Context<'_, '_>,
-    env_peak: f32,
-    pixels: &[Vec<(usize, usize)>],
-) -> Option<(Vec<Vec<(usize, usize)>>, Vec<(usize, usize)>, f64)> {
+/// What the pilot renders.
+struct Tasks {
+    /// Each material's pilot pixels.
+    pixels: Vec<Vec<(usize, usize)>>,
+    /// Every (material, candidate) to measure.
+    tasks: Vec<(usize, usize)>,
+    /// Their work in pixels of the render under MIS.
+    cost: f64,
+}
+
+/// The pilot's [`Tasks`] over each material's `scanned` pixels (the first of them); `None` when
+/// the pilot would cost more than [`MAX_PILOT_SHARE`] of the render.
+fn pilot_tasks(ctx: &Context<'_, '_>, env_peak: f32, scanned: &[Vec<(usize, usize)>]) -> Option<Tasks> {
     let (w, h) = (ctx.camera.width as usize, ctx.camera.height as usize);
     let materials = ctx.scene.materials.len();
     let n = w * h;
@@ -238,7 +250,7 @@ fn pilot_tasks(
     // twice.
     let v = samples_per_point(ctx.options);
     let tasks: Vec<(usize, usize)> = (0..materials)
-        .filter(|&m| pixels[m].len() >= MIN_PIXELS && ctx.plans[m].strategy != Strategy::PlaneProduct)
+        .filter(|&m| scanned[m].len() >= MIN_PIXELS && ctx.plans[m].strategy != Strategy::PlaneProduct)
         .flat_map(|m| {
             let bsdf = &ctx.scene.materials[m].bsdf;
             (0..PLANS.len()).filter(move |&c| eligible(c, bsdf, env_peak)).map(move |c| (m, c))
@@ -251,8 +263,8 @@ fn pilot_tasks(
     if per_material as f64 * cost_per_pixel > MAX_PILOT_SHARE * n as f64 {
         return None;
     }
-    let found = pixels.iter().map(|f| f[..f.len().min(per_material)].to_vec()).collect();
-    Some((found, tasks, per_material as f64 * cost_per_pixel))
+    let pixels = scanned.iter().map(|f| f[..f.len().min(per_material)].to_vec()).collect();
+    Some(Tasks { pixels, tasks, cost: per_material as f64 * cost_per_pixel })
 }
 
 /// Renders every task's pixels twice, in parallel, and returns per task its pixel pairs, in a
