@@ -102,6 +102,10 @@ pub struct Rendered {
     /// `auto`: every material's plan by name, in material order, whether the rules or the
     /// pilot chose it (empty for the other methods).
     pub auto_plans: Vec<String>,
+    /// `auto`: every material's light samples per shading point from the environment, in
+    /// material order — fewer than the render's for a plan costlier per sample, more where the
+    /// material keeps pace with costlier ones (`plan::pace`); empty for the other methods.
+    pub auto_samples: Vec<usize>,
 }
 
 impl Rendered {
@@ -252,9 +256,13 @@ pub fn render_crop(
         _ => None,
     };
     let pilot_seconds = start.elapsed().as_secs_f64();
-    let auto_plans = match settings.method {
-        Method::Auto => plans.iter().map(|p| method::strategy_name(p.strategy)).collect(),
-        _ => Vec::new(),
+    let (auto_plans, auto_samples) = match settings.method {
+        Method::Auto => {
+            let v = budgets(&ctx).0;
+            let samples = plans.iter().map(|p| p.env_budget.unwrap_or(v)).collect();
+            (plans.iter().map(|p| method::strategy_name(p.strategy)).collect(), samples)
+        }
+        _ => (Vec::new(), Vec::new()),
     };
     let image = render_tiles(&Context { plans, cones: ctx.cones.or(pilot_cones.as_ref()), ..ctx }, crop, start);
     // The baselines' lights are built per render: their build is part of their cost.
@@ -275,5 +283,6 @@ pub fn render_crop(
         pilot,
         pilot_seconds,
         auto_plans,
+        auto_samples,
     }
 }

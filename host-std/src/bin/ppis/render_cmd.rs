@@ -273,28 +273,29 @@ fn carry_distant_lights(
     choice
 }
 
-/// One line per material `auto`'s pilot measured.
+/// One line per material `auto`'s pilot measured, with its light samples per shading point.
 fn report_pilot(scene: &Scene, image: &Rendered) {
-    // Materials the rules planned alone, by plan, in the order the plans first appear.
-    let mut by_rules: Vec<(&str, Vec<String>)> = Vec::new();
+    // Materials the rules planned alone, by plan and samples, in the order they first appear.
+    let mut by_rules: Vec<((&str, usize), Vec<String>)> = Vec::new();
     for (m, plan, pilot) in image.auto_choices() {
         let label = scene.materials[m].bsdf.label();
+        let samples = image.auto_samples.get(m).copied().unwrap_or_default();
         let Some(r) = pilot else {
-            match by_rules.iter_mut().find(|(p, _)| *p == plan) {
+            match by_rules.iter_mut().find(|(key, _)| *key == (plan, samples)) {
                 Some((_, labels)) => labels.push(label),
-                None => by_rules.push((plan, vec![label])),
+                None => by_rules.push(((plan, samples), vec![label])),
             }
             continue;
         };
         eprintln!(
-            "ppis: auto: {label} → {plan}{} (pilot: {} pixels, {:.2} s in all)",
+            "ppis: auto: {label} → {plan}, {samples} samples per shading point{} (pilot: {} pixels, {:.2} s in all)",
             if Some(r.chosen) == r.rule { "" } else { ", measured ahead of the rule's plan" },
             r.pixels,
             image.pilot_seconds
         );
     }
-    for (plan, labels) in by_rules {
-        eprintln!("ppis: auto: {} → {plan} (by the rules)", counted(&labels));
+    for ((plan, samples), labels) in by_rules {
+        eprintln!("ppis: auto: {} → {plan}, {samples} samples per shading point (by the rules)", counted(&labels));
     }
 }
 

@@ -96,6 +96,8 @@ struct AutoPlan {
     /// 0 where no pilot ran for the material (the rules chose alone).
     pilot_pixels: usize,
     plan: String,
+    /// Light samples per shading point from the environment (`Rendered::auto_samples`).
+    samples_per_point: usize,
     rule_plan: Option<String>,
     /// Per candidate plan by name, its score (`null`: not measured or not trusted).
     scores: BTreeMap<String, Option<f64>>,
@@ -104,7 +106,7 @@ struct AutoPlan {
 impl AutoPlan {
     /// Material `m`'s entry: its plan, and the pilot's measurement where one ran (otherwise no
     /// pilot pixels, no scores, and the rules' plan is the plan).
-    fn new(scene: &Scene, m: usize, plan: &str, pilot: Option<&PilotResult>) -> Self {
+    fn new(scene: &Scene, m: usize, (plan, samples_per_point): (&str, usize), pilot: Option<&PilotResult>) -> Self {
         let material = scene.materials[m].bsdf.label();
         let plan = plan.to_string();
         match pilot {
@@ -112,12 +114,18 @@ impl AutoPlan {
                 material,
                 pilot_pixels: r.pixels,
                 plan,
+                samples_per_point,
                 rule_plan: r.rule.map(pilot::plan_name),
                 scores: (0..pilot::PLANS.len()).map(|c| (pilot::plan_name(c), r.scores[c])).collect(),
             },
-            None => {
-                AutoPlan { material, pilot_pixels: 0, rule_plan: Some(plan.clone()), plan, scores: BTreeMap::new() }
-            }
+            None => AutoPlan {
+                material,
+                pilot_pixels: 0,
+                rule_plan: Some(plan.clone()),
+                plan,
+                samples_per_point,
+                scores: BTreeMap::new(),
+            },
         }
     }
 }
@@ -138,7 +146,13 @@ impl Stats {
         let env_build = env.map_or(0.0, |e| e.stats.build_seconds);
         let scene = &prepared.scene;
         Stats {
-            auto_plans: image.auto_choices().map(|(m, plan, pilot)| AutoPlan::new(scene, m, plan, pilot)).collect(),
+            auto_plans: image
+                .auto_choices()
+                .map(|(m, plan, pilot)| {
+                    let samples = image.auto_samples.get(m).copied().unwrap_or_default();
+                    AutoPlan::new(scene, m, (plan, samples), pilot)
+                })
+                .collect(),
             brdf_samples: args.brdf_samples,
             bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
             bvh_seconds: prepared.bvh_seconds,
