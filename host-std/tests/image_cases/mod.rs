@@ -19,7 +19,6 @@ use super::common;
 use host_std::light::environment::Environment;
 use host_std::plan::Method;
 use host_std::plan::{Rendered, Settings, render};
-use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::builtin;
 use host_std::scene::{Bsdf, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
@@ -92,16 +91,7 @@ fn hash(image: &Rendered) -> u64 {
 }
 
 fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
-    Settings {
-        method,
-        spp,
-        shading_points,
-        brdf_samples: BrdfSamples::PerLobe,
-        seed: 11,
-        progress: false,
-        shadows: true,
-        lights: Default::default(),
-    }
+    common::settings(method, spp, shading_points, 11)
 }
 
 fn rendered(scene: &Scene, env: &Environment, s: &Settings) -> Rendered {

@@ -6,7 +6,6 @@
 use crate::common;
 use host_std::light::environment::Environment;
 use host_std::plan::{Method, Rendered, Settings, render, render_crop};
-use host_std::render::brdf_samples::BrdfSamples;
 use host_std::render::crop::Crop;
 use host_std::scene::{Bsdf, builtin};
 use host_std::trace::bvh::Bvh;
@@ -14,16 +13,7 @@ use sampler_core::brdf::RoughConductor;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, shading_points: usize) -> Settings {
-    Settings {
-        method,
-        spp,
-        shading_points,
-        brdf_samples: BrdfSamples::PerLobe,
-        seed: 5,
-        progress: false,
-        shadows: true,
-        lights: Default::default(),
-    }
+    common::settings(method, spp, shading_points, 5)
 }
 
 fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {

@@ -7,6 +7,7 @@
 //! a tolerance several times its standard error. And the image stays bit-identical at any
 //! thread count, and area lights occlude.
 
+use crate::common;
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::{Method, Settings, render};
 use host_std::render::brdf_samples::BrdfSamples;
@@ -19,16 +20,7 @@ use sampler_core::light::{DistantLight, PointLight, SceneLight, SphereLight};
 const ALBEDO: f32 = 0.5;
 
 fn settings(method: Method, spp: usize) -> Settings {
-    Settings {
-        method,
-        spp,
-        shading_points: 4,
-        brdf_samples: BrdfSamples::Fixed(64),
-        seed: 11,
-        progress: false,
-        shadows: true,
-        lights: Default::default(),
-    }
+    Settings { brdf_samples: BrdfSamples::Fixed(64), ..common::settings(method, spp, 4, 11) }
 }
 
 /// A Lambert square of side 0.2 at the origin facing +z, seen from straight above so that it

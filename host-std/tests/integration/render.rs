@@ -1,10 +1,10 @@
 //! End-to-end properties of the tracer: the image does not depend on the thread count, every
 //! method converges to the analytic white-furnace answer, and nothing non-finite comes out.
 
+use crate::common;
 use host_std::light::environment::{EnvSource, Environment, Placement};
 use host_std::plan::Method;
 use host_std::plan::{Settings, render};
-use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::builtin;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use host_std::trace::bvh::Bvh;
@@ -12,16 +12,7 @@ use sampler_core::brdf::Lambert;
 use sampler_core::glam::Vec3;
 
 fn settings(method: Method, spp: usize, p: usize) -> Settings {
-    Settings {
-        method,
-        spp,
-        shading_points: p,
-        brdf_samples: BrdfSamples::PerLobe,
-        seed: 7,
-        progress: false,
-        shadows: true,
-        lights: Default::default(),
-    }
+    common::settings(method, spp, p, 7)
 }
 
 fn render_with_threads(scene: &Scene, env: &Environment, s: &Settings, threads: usize) -> Vec<[f32; 3]> {

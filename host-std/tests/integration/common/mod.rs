@@ -1,5 +1,7 @@
 //! Scenes shared by the integration tests.
 
+use host_std::plan::{Method, Settings};
+use host_std::render::brdf_samples::BrdfSamples;
 use host_std::scene::{Bsdf, CameraSpec, Material, Object, Scene, Shape};
 use sampler_core::glam::Vec3;
 
@@ -23,5 +25,20 @@ pub fn pilot_sphere(bsdf: Bsdf) -> Scene {
         env: None,
         lights: Vec::new(),
         hide_emitters: true,
+    }
+}
+
+/// Render settings of `method` at `spp` samples and `shading_points` per pixel, seeded by
+/// `seed`: each material's per-lobe K, shadows on, no progress bar.
+pub fn settings(method: Method, spp: usize, shading_points: usize, seed: u64) -> Settings {
+    Settings {
+        method,
+        spp,
+        shading_points,
+        brdf_samples: BrdfSamples::PerLobe,
+        seed,
+        progress: false,
+        shadows: true,
+        lights: Default::default(),
     }
 }
