@@ -70,6 +70,12 @@ impl EnvHierarchy<'_> {
                 *lane = DescentF32::from_root(*u);
             }
             self.descend_f32(&mut lanes[..n]);
+            // Every caller reads the drawn texels' radiance next: asked for now, it arrives
+            // while the directions below are computed, instead of one miss after another in
+            // the caller's loop (env-only draws have nothing else to overlap it with).
+            for lane in &lanes[..n] {
+                self.prefetch_radiance(lane.cell.x, lane.cell.y);
+            }
             // The points, then the directions at once.
             for (uv, lane) in uvs.iter_mut().zip(&lanes[..n]) {
                 *uv = lane.cell.point_f32(lane.xi);
