@@ -151,6 +151,11 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized, const POWER: bool>(
     // The sampler's draws, all in one batch (its descents side by side).
     let mut drawn = [None; WAVE];
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
+    // The descents' own loads push the BRDF samples' texels out of the nearest cache: asked
+    // for again, they are back by the time the lookups below read them.
+    for &(x, y) in &texels_brdf[..n_brdf] {
+        env.prefetch_texel(x, y);
+    }
     // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
     // for now, it arrives meanwhile (their density came with the draw).
     let mut texels_drawn = [(0u32, 0u32); WAVE];
