@@ -227,13 +227,15 @@ pub const BRACKET_DOUBLINGS: usize = 3;
 /// No bracketing render goes beyond this many visibility samples per pixel.
 const MAX_BRACKET_SPP: usize = 1 << 20;
 
-/// `auto`'s plan per material as the report lists it, `(material, plan)`: " (pilot)" where the
-/// pilot overrode the rules; materials with the same label and plan listed once.
+/// `auto`'s plan per material as the report lists it, `(material, plan)`: its light samples per
+/// shading point (which its cost and the pacing set), and " (pilot)" where the pilot overrode
+/// the rules; materials with the same label and plan listed once.
 fn auto_plans(scene: &Scene, image: &Rendered) -> Vec<(String, String)> {
     let mut plans: Vec<(String, String)> = Vec::new();
     for (m, plan, pilot) in image.auto_choices() {
         let changed = if pilot.is_some_and(|r| Some(r.chosen) != r.rule) { " (pilot)" } else { "" };
-        let entry = (scene.materials[m].bsdf.label(), format!("{plan}{changed}"));
+        let samples = image.auto_samples.get(m).map_or(String::new(), |s| format!(" at {s} samples per point"));
+        let entry = (scene.materials[m].bsdf.label(), format!("{plan}{samples}{changed}"));
         if !plans.contains(&entry) {
             plans.push(entry);
         }

@@ -295,6 +295,18 @@ fn report_sweeps_brdf_samples() {
     assert!(report.contains("| product-mis K=16 | 2 |"), "{report}");
 }
 
+/// The report names each material's `auto` plan with its light samples per shading point.
+#[test]
+fn report_lists_auto_s_plans_with_their_samples_per_point() {
+    let tmp = scratch("report_auto");
+    let dir = tmp.path();
+    tiny_report(dir, &["--spp", "2", "--methods", "mis,auto", "--base", "mis"]);
+    let md = std::fs::read_to_string(dir.join("rep/report.md")).unwrap();
+    let line = md.lines().find(|l| l.starts_with("auto at 2 spp: ")).unwrap_or_else(|| panic!("{md}"));
+    // The default scene under its sun: the rules give every material MIS, at the render's two.
+    assert!(line.contains("carpaint → mis at 2 samples per point"), "{line}");
+}
+
 #[test]
 fn report_compares_against_the_first_method_when_product_is_not_among_them() {
     let tmp = scratch("base");
