@@ -31,7 +31,7 @@ pub fn plan_time(strategy: Strategy) -> PlanTime {
         Strategy::ProductMis { product_share } if product_share > 0.5 => (2.23, 0.95),
         Strategy::ProductMis { .. } => (1.88, 2.07),
         Strategy::TwoLevelMis { .. } => (1.11, 3.2),
-        Strategy::PlaneProduct => (1.2, 0.0),
+        Strategy::PlaneProduct => (1.35, 0.0),
         _ => (1.0, 0.0),
     };
     PlanTime { per_sample, per_point }

@@ -229,12 +229,12 @@ const MAX_BRACKET_SPP: usize = 1 << 20;
 
 /// `auto`'s plan per material as the report lists it, `(material, plan)`: its light samples per
 /// shading point (which its cost and the pacing set), and " (pilot)" where the pilot overrode
-/// the rules; materials with the same label and plan listed once.
+/// the rules; materials with the same label, plan and samples listed once.
 fn auto_plans(scene: &Scene, image: &Rendered) -> Vec<(String, String)> {
     let mut plans: Vec<(String, String)> = Vec::new();
     for (m, plan, pilot) in image.auto_choices() {
         let changed = if pilot.is_some_and(|r| Some(r.chosen) != r.rule) { " (pilot)" } else { "" };
-        let samples = image.auto_samples.get(m).map_or(String::new(), |s| format!(" at {s} samples per point"));
+        let samples = image.auto_samples.get(m).map_or(String::new(), |s| format!(", {s} samples per shading point"));
         let entry = (scene.materials[m].bsdf.label(), format!("{plan}{samples}{changed}"));
         if !plans.contains(&entry) {
             plans.push(entry);

@@ -70,10 +70,10 @@ impl EnvHierarchy<'_> {
                 *lane = DescentF32::from_root(*u);
             }
             self.descend_f32(&mut lanes[..n]);
-            // Every caller reads the drawn texels' radiance next: asked for now, it arrives
-            // while the directions below are computed, instead of one miss after another in
-            // the caller's loop (env-only draws have nothing else to overlap it with).
-            for lane in &lanes[..n] {
+            // Callers read the drawn texels' radiance next: asked for now, it arrives while the
+            // directions below are computed, instead of one miss after another in the caller's
+            // loop (env-only draws have nothing else to overlap it with).
+            for lane in lanes[..n].iter().filter(|l| l.alive) {
                 self.prefetch_radiance(lane.cell.x, lane.cell.y);
             }
             // The points, then the directions at once.

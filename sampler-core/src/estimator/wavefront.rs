@@ -135,8 +135,8 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized, const POWER: bool>(
         }
     }
     // The BRDF's draws first, each at its own shading point, and their points of the square:
-    // the texels they read (radiance, the sampler's density) are asked for now and arrive
-    // while the sampler's descents below run.
+    // the texels they read (radiance, the sampler's density) are asked for now and reach the
+    // outer caches while the sampler's descents below run.
     let mut brdf: [Option<BrdfSample>; WAVE] = [None; WAVE];
     let mut dirs = [Vec3::Z; WAVE];
     draw_brdf(points, &brdf_points[..n_brdf], &u_brdf[..n_brdf], &mut brdf[..n_brdf], &mut dirs[..n_brdf]);
@@ -152,12 +152,15 @@ fn wave<S: DirectionSampler + ?Sized, B: Brdf + ?Sized, const POWER: bool>(
     let mut drawn = [None; WAVE];
     sampler.sample_many(&u_sampler[..n_sampler], &mut drawn[..n_sampler]);
     // The descents' own loads push the BRDF samples' texels out of the nearest cache: asked
-    // for again, they are back by the time the lookups below read them.
-    for &(x, y) in &texels_brdf[..n_brdf] {
-        env.prefetch_texel(x, y);
+    // for again, they are back in it by the time the lookups below read them.
+    if n_sampler > 0 {
+        for &(x, y) in &texels_brdf[..n_brdf] {
+            env.prefetch_texel(x, y);
+        }
     }
-    // Their texels' radiance is read in the last loop, after the BRDF samples' lookups: asked
-    // for now, it arrives meanwhile (their density came with the draw).
+    // The draws' radiance is read in the last loop, after the BRDF samples' lookups: asked for
+    // now, it arrives meanwhile (their density came with the draw). The environment's own
+    // descents asked for it already; the products' did not.
     let mut texels_drawn = [(0u32, 0u32); WAVE];
     for (t, d) in texels_drawn.iter_mut().zip(&drawn[..n_sampler]) {
         if let Some(d) = d {
