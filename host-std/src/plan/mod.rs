@@ -109,11 +109,13 @@ pub struct Rendered {
 }
 
 impl Rendered {
-    /// `auto`: per material, in material order, its index, its plan's name and what the pilot
-    /// measured where one ran for it (`None`: the rules chose alone).
-    pub fn auto_choices(&self) -> impl Iterator<Item = (usize, &str, Option<&PilotResult>)> {
+    /// `auto`: per material, in material order, its index, its plan's name, its light samples
+    /// per shading point and what the pilot measured where one ran for it (`None`: the rules
+    /// chose alone).
+    pub fn auto_choices(&self) -> impl Iterator<Item = (usize, &str, usize, Option<&PilotResult>)> {
         let pilot = |m: usize| self.pilot.iter().find(|r| r.material == m);
-        self.auto_plans.iter().enumerate().map(move |(m, plan)| (m, plan.as_str(), pilot(m)))
+        let plans = self.auto_plans.iter().zip(&self.auto_samples).enumerate();
+        plans.map(move |(m, (plan, &samples))| (m, plan.as_str(), samples, pilot(m)))
     }
 
     /// Adds a pilot's time, run before the render and part of its cost, to the render's.

@@ -232,10 +232,9 @@ const MAX_BRACKET_SPP: usize = 1 << 20;
 /// the rules; materials with the same label, plan and samples listed once.
 fn auto_plans(scene: &Scene, image: &Rendered) -> Vec<(String, String)> {
     let mut plans: Vec<(String, String)> = Vec::new();
-    for (m, plan, pilot) in image.auto_choices() {
+    for (m, plan, samples, pilot) in image.auto_choices() {
         let changed = if pilot.is_some_and(|r| Some(r.chosen) != r.rule) { " (pilot)" } else { "" };
-        let samples = image.auto_samples.get(m).map_or(String::new(), |s| format!(", {s} samples per shading point"));
-        let entry = (scene.materials[m].bsdf.label(), format!("{plan}{samples}{changed}"));
+        let entry = (scene.materials[m].bsdf.label(), format!("{plan}, {samples} samples per shading point{changed}"));
         if !plans.contains(&entry) {
             plans.push(entry);
         }

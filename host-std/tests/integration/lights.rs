@@ -263,7 +263,7 @@ fn a_diffuse_plane_samples_the_map_times_its_cosine_with_no_noise_but_the_texels
         // `auto` names the plan it rendered the plane's material with, though no pilot ran.
         let image = render(&scene, &bvh, Some(&env.hierarchy()), &settings(Method::Auto, 16));
         let plans: Vec<_> =
-            image.auto_choices().map(|(m, plan, pilot)| (m, plan.to_string(), pilot.is_some())).collect();
+            image.auto_choices().map(|(m, plan, _, pilot)| (m, plan.to_string(), pilot.is_some())).collect();
         let expected = if name == "sky" { "mis" } else { "plane-product" };
         assert_eq!(plans, [(0, expected.to_string(), false)], "{name}: auto's plans");
     }

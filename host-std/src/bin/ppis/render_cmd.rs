@@ -277,9 +277,8 @@ fn carry_distant_lights(
 fn report_pilot(scene: &Scene, image: &Rendered) {
     // Materials the rules planned alone, by plan and samples, in the order they first appear.
     let mut by_rules: Vec<((&str, usize), Vec<String>)> = Vec::new();
-    for (m, plan, pilot) in image.auto_choices() {
+    for (m, plan, samples, pilot) in image.auto_choices() {
         let label = scene.materials[m].bsdf.label();
-        let samples = image.auto_samples.get(m).copied().unwrap_or_default();
         let Some(r) = pilot else {
             match by_rules.iter_mut().find(|(key, _)| *key == (plan, samples)) {
                 Some((_, labels)) => labels.push(label),

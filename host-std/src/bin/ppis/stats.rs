@@ -148,10 +148,7 @@ impl Stats {
         Stats {
             auto_plans: image
                 .auto_choices()
-                .map(|(m, plan, pilot)| {
-                    let samples = image.auto_samples.get(m).copied().unwrap_or_default();
-                    AutoPlan::new(scene, m, (plan, samples), pilot)
-                })
+                .map(|(m, plan, samples, pilot)| AutoPlan::new(scene, m, (plan, samples), pilot))
                 .collect(),
             brdf_samples: args.brdf_samples,
             bvh_cpu_seconds: prepared.cpu_seconds.map(|c| c[2]),
